@@ -1,0 +1,187 @@
+"""Equations of motion of the full two-body problem, Maciejewski (1995) form, in the primary's
+body frame (physics.md §3; physics-derivations.md §2.6), and the member parameter layout.
+
+Internal state (30 numbers, scaled units: length = initial osculating semimajor axis a,
+time = 1/n, mass = m1 + m2, so G = 1):
+
+    y = [R(3), V(3), w1(3), w2(3), S(9, row-major), S1(9, row-major)]
+
+with V = P/m the relative velocity (P the relative momentum, m the reduced mass),
+w1 = Γ1/C1 and w2 = Γ2/C2 the spin angular momenta divided by each body's largest
+principal moment. These constant rescalings make every component O(1), so one relative
+tolerance controls the secondary's spin (Γ2 ~ 1e-5 in plain scaled units) as tightly as
+the orbit. The equations are the physics.md ones divided by m, C1, C2:
+
+    dR/dt  = R × Ω1 + V            dV/dt  = V × Ω1 − (∂U/∂R)/m
+    dw1/dt = w1 × Ω1 + μ1/C1       dw2/dt = w2 × Ω1 + μ2/C2
+    dS/dt  = hat(Ω2 − Ω1) S        dS1/dt = S1 hat(Ω1)
+
+with Ω1 = I1⁻¹ C1 w1 (principal frame), Ω2 = S I2⁻¹ Sᵀ C2 w2 (primary frame). The form
+dS/dt = hat(Ω2 − Ω1) S equals S hat(Ω2') − hat(Ω1) S because S hat(x) Sᵀ = hat(S x).
+"""
+
+import taichi as ti
+
+from ti_spinorbit.bodies import ROW_LENGTH
+
+from .potential import mutual, vec3, mat3
+
+NSTATE = 30
+state = ti.types.vector(NSTATE, ti.f64)
+
+# Member parameter row layout (scaled units): two body rows, then derived constants.
+BODY_A = 0
+BODY_B = ROW_LENGTH
+P_MRED = 2 * ROW_LENGTH          # reduced mass m1 m2 / (m1 + m2)
+P_C1 = P_MRED + 1                # largest principal moment of the primary
+P_C2 = P_MRED + 2                # largest principal moment of the secondary
+P_IA = P_MRED + 3                # C1 / (A1, B1, C1)
+P_IB = P_MRED + 6                # C2 / (A2, B2, C2)
+P_CONTACT = P_MRED + 9           # sum of bounding radii: collision below this distance
+P_ESCAPE = P_MRED + 10           # escape beyond this distance
+NPAR = P_MRED + 11
+
+# Offsets in the state vector.
+Y_R, Y_V, Y_W1, Y_W2, Y_S, Y_S1 = 0, 3, 6, 9, 12, 21
+
+
+@ti.func
+def get3(y, o: ti.template()):
+    return vec3(y[o], y[o + 1], y[o + 2])
+
+
+@ti.func
+def get33(y, o: ti.template()):
+    return mat3([[y[o], y[o + 1], y[o + 2]], [y[o + 3], y[o + 4], y[o + 5]],
+                 [y[o + 6], y[o + 7], y[o + 8]]])
+
+
+@ti.func
+def put3(y: ti.template(), o: ti.template(), v):
+    for k in ti.static(range(3)):
+        y[o + k] = v[k]
+
+
+@ti.func
+def put33(y: ti.template(), o: ti.template(), m):
+    for r in ti.static(range(3)):
+        for c in ti.static(range(3)):
+            y[o + 3 * r + c] = m[r, c]
+
+
+@ti.func
+def angular_velocities(p: ti.template(), i, y):
+    """Ω1 (primary frame = its body frame) and Ω2 (secondary's, primary-frame components)."""
+    w1 = get3(y, Y_W1)
+    w2 = get3(y, Y_W2)
+    S = get33(y, Y_S)
+    om1 = vec3(p[i, P_IA] * w1[0], p[i, P_IA + 1] * w1[1], p[i, P_IA + 2] * w1[2])
+    w2b = S.transpose() @ w2
+    om2 = S @ vec3(p[i, P_IB] * w2b[0], p[i, P_IB + 1] * w2b[1], p[i, P_IB + 2] * w2b[2])
+    return om1, om2
+
+
+@ti.func
+def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """dy/dt of the scaled state of member i (G = 1)."""
+    R = get3(y, Y_R)
+    V = get3(y, Y_V)
+    w1 = get3(y, Y_W1)
+    w2 = get3(y, Y_W2)
+    S = get33(y, Y_S)
+    om1, om2 = angular_velocities(p, i, y)
+    U, dUdR, mu1, mu2 = mutual(p, i, BODY_A, BODY_B, 1.0, R, S, order, odd)
+    dy = state(0.0)
+    put3(dy, Y_R, R.cross(om1) + V)
+    put3(dy, Y_V, V.cross(om1) - dUdR / p[i, P_MRED])
+    put3(dy, Y_W1, w1.cross(om1) + mu1 / p[i, P_C1])
+    put3(dy, Y_W2, w2.cross(om1) + mu2 / p[i, P_C2])
+    dom = om2 - om1
+    for c in ti.static(range(3)):  # columns of S: d s_c/dt = (Ω2 − Ω1) × s_c
+        col = dom.cross(vec3(S[0, c], S[1, c], S[2, c]))
+        for r in ti.static(range(3)):
+            dy[Y_S + 3 * r + c] = col[r]
+    for r in ti.static(range(3)):  # rows of S1: d r/dt = r × Ω1
+        put3(dy, Y_S1 + 3 * r, get3(y, Y_S1 + 3 * r).cross(om1))
+    return dy
+
+
+@ti.func
+def pericentre_function(y):
+    """g = R·V: negative before, positive after a pericentre passage (osculating f = 0)."""
+    return get3(y, Y_R).dot(get3(y, Y_V))
+
+
+@ti.func
+def pericentre_rate(y, dy):
+    """dg/dt = dR/dt·V + R·dV/dt (frame terms cancel: R·(R×Ω1) = 0, V·(V×Ω1) = 0)."""
+    return get3(dy, Y_R).dot(get3(y, Y_V)) + get3(y, Y_R).dot(get3(dy, Y_V))
+
+
+@ti.func
+def section_angles(p: ti.template(), i, y):
+    """(α, θ̇): angle (rad) from the line of centres to the secondary's long axis, measured
+    about the orbit normal, and the secondary's spin rate about that normal (units of n).
+    At pericentre α is the section angle θ_p."""
+    R = get3(y, Y_R)
+    V = get3(y, Y_V)
+    S = get33(y, Y_S)
+    h = R.cross(V)
+    nrm = h / h.norm()
+    rhat = R / R.norm()
+    xb = vec3(S[0, 0], S[1, 0], S[2, 0])
+    alpha = ti.atan2(nrm.dot(rhat.cross(xb)), rhat.dot(xb))
+    om1, om2 = angular_velocities(p, i, y)
+    return alpha, om2.dot(nrm)
+
+
+@ti.func
+def osculating_elements(y):
+    """Osculating semimajor axis and eccentricity (scaled units, μ = G(m1+m2) = 1)."""
+    R = get3(y, Y_R)
+    V = get3(y, Y_V)
+    eps = 0.5 * V.dot(V) - 1.0 / R.norm()
+    h2 = R.cross(V).norm_sqr()
+    return -0.5 / eps, ti.sqrt(ti.max(0.0, 1.0 + 2.0 * eps * h2))
+
+
+@ti.func
+def energy_split(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """(orbit, primary spin, secondary spin) energies, scaled units: orbit = |P|²/2m + U."""
+    R = get3(y, Y_R)
+    V = get3(y, Y_V)
+    S = get33(y, Y_S)
+    om1, om2 = angular_velocities(p, i, y)
+    U, dUdR, mu1, mu2 = mutual(p, i, BODY_A, BODY_B, 1.0, R, S, order, odd)
+    e_orb = 0.5 * p[i, P_MRED] * V.dot(V) + U
+    e1 = 0.5 * p[i, P_C1] * get3(y, Y_W1).dot(om1)
+    e2 = 0.5 * p[i, P_C2] * get3(y, Y_W2).dot(om2)
+    return e_orb, e1, e2
+
+
+@ti.func
+def angular_momentum_split(p: ti.template(), i, y):
+    """Inertial-frame (orbit, primary spin, secondary spin) angular momenta, scaled units."""
+    S1 = get33(y, Y_S1)
+    R = get3(y, Y_R)
+    V = get3(y, Y_V)
+    l_orb = S1 @ (p[i, P_MRED] * R.cross(V))
+    l1 = S1 @ (p[i, P_C1] * get3(y, Y_W1))
+    l2 = S1 @ (p[i, P_C2] * get3(y, Y_W2))
+    return l_orb, l1, l2
+
+
+@ti.func
+def orthonormality_error(y):
+    """max |SᵀS − 1| and max |S1ᵀS1 − 1| (should stay at the tolerance level)."""
+    S = get33(y, Y_S)
+    S1 = get33(y, Y_S1)
+    d = S.transpose() @ S - ti.Matrix.identity(ti.f64, 3)
+    d1 = S1.transpose() @ S1 - ti.Matrix.identity(ti.f64, 3)
+    m = 0.0
+    m1 = 0.0
+    for r in ti.static(range(3)):
+        for c in ti.static(range(3)):
+            m = ti.max(m, ti.abs(d[r, c]))
+            m1 = ti.max(m1, ti.abs(d1[r, c]))
+    return m, m1

@@ -1,0 +1,23 @@
+"""ti_spinorbit: coupled spin and orbital motion of binary asteroids, thousands at once.
+
+The full two-body problem of two rigid bodies under their mutual gravity, with a
+fourth-order mutual potential built from inertia integrals, integrated for whole ensembles
+by Taichi kernels (one adaptive Cash-Karp loop per member). Reference science: Naidu &
+Margot 2015, AJ 149:80.
+
+Importing the package does not initialise Taichi; the first computation does (CPU, f64), or
+call ``ti_spinorbit.init(arch=...)`` first.
+"""
+
+from .bodies import Body, Ellipsoid, Sphere
+from .potential import mutual_potential
+from .runtime import init
+from .section import SectionResult, TimeSeriesResult, surface_of_section, time_series
+from .systems import G, BinarySystem
+from . import catalog
+
+__version__ = "0.1.0"
+
+__all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
+           "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
+           "__version__"]

@@ -1,0 +1,197 @@
+"""Rigid bodies described by their mass and inertia integrals of orders 2 to 4.
+
+A body lives in its own principal-axis frame with the origin at its centre of mass
+(physics.md §1). What the mutual potential needs of it is
+
+    T^{lmn} = ∫_B x^l y^m z^n dm      (kg m^{l+m+n}),   l + m + n = 2, 3, 4,
+
+computed once here, never per step. Order 1 vanishes (centre of mass) and order 2 must be
+diagonal (principal axes); orders 3 and 4 may be anything, so a lumpy body with odd
+integrals plugs into the same kernels as an ellipsoid.
+
+Sources: uniform ellipsoid integrals, Tricarico 2008 eq. 19 / Hou et al. 2017 eq. 26
+(physics-derivations.md §2.5):
+    T^{lmn} = 3 M a^l b^m c^n (l-1)!!(m-1)!!(n-1)!! / (l+m+n+3)!!   (all indices even), else 0.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, Tuple
+
+import numpy as np
+
+from ._validate import require_finite, require_positive
+
+# Fixed orders of the monomials, shared with the kernels (kernels/potential.py unrolls them).
+EXPONENTS_2 = ((2, 0, 0), (0, 2, 0), (0, 0, 2))
+EXPONENTS_3 = tuple((l, m, 3 - l - m) for l in range(3, -1, -1) for m in range(3 - l, -1, -1))
+EXPONENTS_4 = tuple((l, m, 4 - l - m) for l in range(4, -1, -1) for m in range(4 - l, -1, -1))
+#: Length of :meth:`Body.as_row`: mass, 3 second-order, 10 third-order, 15 fourth-order.
+ROW_LENGTH = 1 + len(EXPONENTS_2) + len(EXPONENTS_3) + len(EXPONENTS_4)
+
+
+def _double_factorial(n: int) -> int:
+    return 1 if n <= 0 else n * _double_factorial(n - 2)
+
+
+def _multi_index(exponents):
+    """Indices (i, j, k, ...) into a symmetric tensor for a monomial x^l y^m z^n."""
+    l, m, n = exponents
+    return (0,) * l + (1,) * m + (2,) * n
+
+
+@dataclass(frozen=True)
+class Body:
+    """A rigid body given by its mass and inertia integrals in its principal-axis frame.
+
+    Parameters
+    ----------
+    mass : float
+        Mass in kg (> 0).
+    integrals : dict
+        ``{(l, m, n): T^{lmn}}`` for l + m + n in {2, 3, 4}, SI units (kg m^{l+m+n}).
+        Missing entries are zero. Second-order off-diagonal terms must vanish: the frame is
+        the principal-axis frame.
+    bounding_radius : float
+        Radius (m) of a sphere about the centre of mass that contains the body; used for the
+        collision test and the overlap check at start.
+    name : str
+        Free text used in plots and saved files.
+    """
+
+    mass: float
+    integrals: Dict[Tuple[int, int, int], float]
+    bounding_radius: float
+    name: str = "body"
+    _row: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        require_positive("mass", self.mass)
+        require_positive("bounding_radius", self.bounding_radius)
+        for key, value in self.integrals.items():
+            if len(key) != 3 or sum(key) not in (2, 3, 4) or min(key) < 0:
+                raise ValueError(
+                    f"integrals: key {key!r} is not (l, m, n) with l + m + n in 2..4")
+            require_finite(f"integrals[{key}]", value)
+        trace = sum(self.integrals.get(k, 0.0) for k in EXPONENTS_2)
+        if not trace > 0.0:
+            raise ValueError(f"integrals: second-order trace must be > 0 (got {trace!r})")
+        for k in ((1, 1, 0), (1, 0, 1), (0, 1, 1)):
+            if abs(self.integrals.get(k, 0.0)) > 1e-12 * trace:
+                raise ValueError(
+                    f"integrals[{k}] = {self.integrals[k]!r}: the body frame must be its "
+                    "principal-axis frame (off-diagonal second-order integrals must be 0); "
+                    "Body.from_point_masses rotates a mass distribution into it")
+        row = [self.mass]
+        for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
+            row += [float(self.integrals.get(k, 0.0)) for k in group]
+        object.__setattr__(self, "_row", np.array(row, dtype=np.float64))
+
+    # ---- derived quantities -------------------------------------------------------------
+    def integral(self, l: int, m: int, n: int) -> float:
+        """T^{lmn} in SI units (kg m^{l+m+n}); 0 for entries not stored."""
+        if (l, m, n) == (0, 0, 0):
+            return self.mass
+        return float(self.integrals.get((l, m, n), 0.0))
+
+    @property
+    def moments(self) -> np.ndarray:
+        """Principal moments of inertia (A, B, C) about x, y, z, kg m^2."""
+        t200, t020, t002 = (self.integral(*k) for k in EXPONENTS_2)
+        return np.array([t020 + t002, t200 + t002, t200 + t020])
+
+    @property
+    def has_odd_integrals(self) -> bool:
+        """True when any integral with an odd index is non-zero (no mirror symmetry)."""
+        return any(v != 0.0 and any(i % 2 for i in k) for k, v in self.integrals.items())
+
+    def moment_tensor(self, order: int) -> np.ndarray:
+        """Full symmetric moment tensor M^(k)_{i..} = ∫ x_i ... dm in the body frame (SI)."""
+        if order == 0:
+            return np.array(self.mass)
+        tensor = np.zeros((3,) * order)
+        if order == 1:
+            return tensor
+        for idx in np.ndindex(*tensor.shape):
+            counts = (idx.count(0), idx.count(1), idx.count(2))
+            tensor[idx] = self.integral(*counts)
+        return tensor
+
+    def as_row(self) -> np.ndarray:
+        """Mass and integrals in the fixed order the kernels read (copy, SI units)."""
+        return self._row.copy()
+
+    # ---- constructors for general bodies ------------------------------------------------
+    @classmethod
+    def from_point_masses(cls, points, masses, name="point cloud", bounding_radius=None):
+        """A body made of point masses (m, kg), shifted to its centre of mass and rotated into
+        its principal axes (x = smallest moment, i.e. the long axis).
+
+        Returns ``(body, rotation)``: ``rotation`` takes the input frame to the body frame."""
+        points = np.asarray(points, dtype=np.float64)
+        masses = np.asarray(masses, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3 or masses.shape != points.shape[:1]:
+            raise ValueError("points must have shape (n, 3) and masses shape (n,)")
+        require_finite("points", points)
+        if np.any(masses <= 0) or not np.all(np.isfinite(masses)):
+            raise ValueError("masses must all be finite and > 0")
+        total = masses.sum()
+        p = points - (masses[:, None] * points).sum(0) / total
+        second = np.einsum("n,ni,nj->ij", masses, p, p)
+        inertia = np.trace(second) * np.eye(3) - second
+        w, vecs = np.linalg.eigh(inertia)  # ascending moments: x long axis
+        if np.linalg.det(vecs) < 0:
+            vecs[:, 2] *= -1
+        rotation = vecs.T
+        q = p @ rotation.T
+        integrals = {}
+        for order, group in ((2, EXPONENTS_2), (3, EXPONENTS_3), (4, EXPONENTS_4)):
+            for l, m, n in group:
+                integrals[(l, m, n)] = float(np.sum(masses * q[:, 0] ** l * q[:, 1] ** m * q[:, 2] ** n))
+        # principal frame: zero the off-diagonal second order left by round-off
+        radius = bounding_radius or float(np.max(np.linalg.norm(q, axis=1)))
+        return cls(float(total), integrals, radius, name), rotation
+
+
+def Ellipsoid(a, b, c, density=None, *, mass=None, name="ellipsoid") -> Body:
+    """Uniform triaxial ellipsoid with semi-axes a ≥ b ≥ c (m) along x, y, z.
+
+    Give exactly one of ``density`` (kg m^-3) or ``mass`` (kg). x is the long axis and z the
+    short one (the spin axis of a principal-axis rotator)."""
+    for label, value in (("a", a), ("b", b), ("c", c)):
+        require_positive(label, value)
+    if not a >= b >= c:
+        raise ValueError(f"semi-axes must satisfy a >= b >= c (got a={a}, b={b}, c={c})")
+    volume = 4.0 / 3.0 * math.pi * a * b * c
+    mass = _mass_from(volume, density, mass)
+    integrals = {}
+    for order in (2, 4):
+        for l in range(0, order + 1, 2):
+            for m in range(0, order - l + 1, 2):
+                n = order - l - m
+                integrals[(l, m, n)] = (
+                    3.0 * mass * a**l * b**m * c**n
+                    * _double_factorial(l - 1) * _double_factorial(m - 1) * _double_factorial(n - 1)
+                    / _double_factorial(l + m + n + 3))
+    body = Body(mass, integrals, float(a), name)
+    object.__setattr__(body, "semi_axes", (float(a), float(b), float(c)))
+    return body
+
+
+def Sphere(radius, density=None, *, mass=None, name="sphere") -> Body:
+    """Uniform sphere of ``radius`` (m); give ``density`` (kg m^-3) or ``mass`` (kg).
+
+    Its exterior field is exactly that of a point mass; the integrals are kept anyway so the
+    same kernels serve every body."""
+    require_positive("radius", radius)
+    return Ellipsoid(radius, radius, radius, density, mass=mass, name=name)
+
+
+def _mass_from(volume, density, mass):
+    if (density is None) == (mass is None):
+        raise ValueError("give exactly one of density (kg/m^3) or mass (kg)")
+    if mass is not None:
+        require_positive("mass", mass)
+        return float(mass)
+    require_positive("density", density)
+    return float(density) * volume

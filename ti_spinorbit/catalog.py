@@ -1,0 +1,81 @@
+"""Catalogue of the binary systems of Naidu & Margot 2015, Table 1 (packaged data).
+
+The numbers live in ``data/systems.json`` with their source notes; this module turns an
+entry into a :class:`~ti_spinorbit.systems.BinarySystem` following the paper's secondary
+prescription (physics.md §9): a = sqrt(ab · a/b), b = sqrt(ab / (a/b)), mass
+ρ_s (4/3) π ab c, whatever the elongation.
+"""
+
+import json
+import math
+from functools import lru_cache
+from importlib import resources
+
+from ._validate import require_positive, require_range
+from .bodies import Ellipsoid, Sphere
+from .systems import BinarySystem
+
+HOUR = 3600.0
+
+
+@lru_cache(maxsize=1)
+def _data():
+    text = resources.files("ti_spinorbit.data").joinpath("systems.json").read_text()
+    return json.loads(text)["systems"]
+
+
+def names():
+    """Catalogued system names, in table order."""
+    return list(_data())
+
+
+def entry(name):
+    """The raw catalogue entry (a copy), SI units as stored."""
+    return dict(_data()[_resolve(name)])
+
+
+def _resolve(name):
+    table = _data()
+    if not isinstance(name, str):
+        raise TypeError(f"system name must be a string (got {name!r})")
+    key = {k.lower().replace(" ", ""): k for k in table}.get(name.lower().replace(" ", "").replace("_", ""))
+    if key is None:
+        raise ValueError(f"unknown system {name!r}; known systems: {', '.join(table)}")
+    return key
+
+
+def system(name, elongation=None, secondary_density=None, eccentricity=None) -> BinarySystem:
+    """A catalogued system as a BinarySystem, optionally with the elongation a/b (>= 1),
+    secondary density ρ_s (kg m^-3) or eccentricity (0 <= e < 1) changed.
+
+    The energy-test case ("test") has fixed shapes; only its eccentricity may change."""
+    key = _resolve(name)
+    d = _data()[key]
+    e = d["e"] if eccentricity is None else eccentricity
+    require_range("eccentricity", e, 0.0, 1.0)
+    if key == "test":
+        if elongation is not None or secondary_density is not None:
+            raise ValueError("the 'test' system has fixed shapes: only eccentricity may be changed")
+        p = d["primary"]
+        primary = Ellipsoid(*p["semi_axes_m"], p["density"], name="test primary")
+        secondary = Ellipsoid(*d["secondary_semi_axes_m"], d["rho_s"], name="test secondary")
+        return BinarySystem(primary, secondary, d["a_m"], e,
+                            primary_spin_period=d["primary_spin_period_h"] * HOUR, name="test")
+    q = d["elongation"] if elongation is None else elongation
+    require_range("elongation", q, 1.0, 10.0, high_open=False)
+    rho_s = d["rho_s"] if secondary_density is None else secondary_density
+    require_positive("secondary_density", rho_s)
+    a_s, b_s, c_s = math.sqrt(d["ab"] * q), math.sqrt(d["ab"] / q), d["c"]
+    if c_s > b_s:
+        raise ValueError(f"elongation {q} makes b = {b_s:.4g} m < c = {c_s} m for {key}: "
+                         f"the largest allowed is {d['ab'] / c_s**2:.4g}")
+    mass_s = rho_s * 4.0 / 3.0 * math.pi * d["ab"] * c_s
+    primary = Sphere(d["R_p"], d["rho_p"], name=f"{key} primary")
+    secondary = Ellipsoid(a_s, b_s, c_s, mass=mass_s, name=f"{key} secondary")
+    return BinarySystem(primary, secondary, d["a_m"], e, name=key)
+
+
+def secondary_spin_period(name):
+    """Initial spin period of the secondary in s where the catalogue gives one, else None."""
+    h = _data()[_resolve(name)].get("secondary_spin_period_h")
+    return None if h is None else h * HOUR

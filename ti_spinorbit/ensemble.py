@@ -1,0 +1,203 @@
+"""Ensemble driver: member table in, windows of kernel launches, drained buffers out.
+
+Data flow: ``BinarySystem`` rows + initial states (numpy, scaled units) -> :class:`Ensemble`
+-> one ``kernels.ensemble.advance`` launch per window -> per-member event / sample lists and
+diagnostics -> :class:`RunOutput`, which the result classes of ``section`` turn into SI.
+
+Decisions:
+* A window is ``window_orbits`` initial orbital periods (scaled time 2π per orbit for every
+  member, since each member's time unit is its own 1/n). Event buffers hold
+  ``window_orbits + 4`` crossings; a member that fills its buffer pauses and resumes in the
+  next launch, so the window length changes launch overhead, never results.
+* Arrays are numpy and handed to the kernels as external ndarrays; on the CPU Taichi uses
+  them in place.
+"""
+
+from dataclasses import dataclass, field
+from typing import Callable, List, Optional
+
+import numpy as np
+
+from . import runtime
+from ._validate import require_count, require_positive, require_range
+
+#: Default tolerance floor: atol = rtol unless given (the scaled state is O(1)).
+DEFAULT_WINDOW_ORBITS = 16
+MIN_STEP = 1e-10  # scaled time (1/n): below this a member stops with "step underflow"
+
+
+@dataclass
+class RunOutput:
+    """What the kernels produced, still in scaled units (per member)."""
+
+    events: List[np.ndarray]          # each (count, 6): kernels.ensemble.EVENT_FIELDS
+    samples: List[np.ndarray]         # each (count, 6): SAMPLE_FIELDS (empty without sampling)
+    diag_start: np.ndarray            # (N, 14) DIAG_FIELDS at t = 0
+    diag_end: np.ndarray              # (N, 14) at the final time reached
+    t: np.ndarray                     # final time reached, scaled
+    y: np.ndarray                     # final state, scaled (N, 30)
+    status: np.ndarray                # (N,) int, kernels.ensemble.STATUS_NAMES
+    counters: np.ndarray              # (N, 3) accepted, rejected, RHS calls
+    launches: int = 0
+    seconds: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+
+def check_tolerances(rtol, atol):
+    """Validate rtol/atol; returns floats (atol defaults to rtol)."""
+    require_range("rtol", rtol, 1e-16, 1e-2, low_open=False, high_open=False)
+    atol = rtol if atol is None else atol
+    require_positive("atol", atol)
+    return float(rtol), float(atol)
+
+
+class Ensemble:
+    """N members, each with its own parameters and initial state (scaled units).
+
+    Parameters
+    ----------
+    par : (N, NPAR) array
+        Member parameter rows (``BinarySystem.parameter_row``).
+    y0 : (N, 30) array
+        Initial scaled states (``BinarySystem.initial_state``).
+    order : {0, 2, 3, 4}
+        Truncation order of the mutual potential.
+    rtol, atol : float
+        Tolerances on the scaled state (error in tolerance units, max norm).
+    """
+
+    def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,
+                 min_step=MIN_STEP):
+        from .bodies import ROW_LENGTH
+        from .kernels import eom
+
+        runtime.ensure_init()
+        self.par = np.ascontiguousarray(par, dtype=np.float64)
+        self.y = np.ascontiguousarray(y0, dtype=np.float64).copy()
+        if self.par.ndim != 2 or self.par.shape[1] != eom.NPAR or self.y.shape != (len(self.par), eom.NSTATE):
+            raise ValueError("par must be (N, NPAR) and y0 (N, 30) with the same N")
+        if order not in (0, 2, 3, 4):
+            raise ValueError(f"order must be 0, 2, 3 or 4 (got {order!r})")
+        self.order = int(order)
+        self.rtol, self.atol = check_tolerances(rtol, atol)
+        if odd is None:  # any non-zero odd-index integral in either body row?
+            odd = bool(np.any(self.par[:, _odd_columns(ROW_LENGTH)] != 0.0))
+        self.odd = bool(odd)
+        self.min_step = float(min_step)
+        n = len(self.par)
+        self.n = n
+        self.t = np.zeros(n)
+        self.h = np.full(n, 0.5 * self.rtol ** 0.2)  # a first guess the controller fixes
+        self.status = np.zeros(n, dtype=np.int32)
+        self.counters = np.zeros((n, 3), dtype=np.int64)
+
+    def diagnostics(self, y=None) -> np.ndarray:
+        from .kernels import ensemble as K
+
+        y = self.y if y is None else np.ascontiguousarray(y, dtype=np.float64)
+        out = np.zeros((len(y), len(K.DIAG_FIELDS)))
+        K.diagnostics(self.par, y, out, self.order, self.odd)
+        return out
+
+    def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
+            progress: Optional[Callable[[float], None]] = None) -> RunOutput:
+        """Integrate every member to ``t_stop`` (scaled; scalar or per member).
+
+        ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
+        called after every window."""
+        import time
+
+        from .kernels import ensemble as K
+
+        n = self.n
+        t_stop = np.broadcast_to(np.asarray(t_stop, dtype=np.float64), (n,)).copy()
+        require_positive("t_stop", t_stop)
+        window_orbits = require_count("window_orbits", window_orbits, 1, 10**6)
+        window = 2.0 * np.pi * window_orbits
+        cap = window_orbits + 4
+        sampling = sample_dt is not None
+        if sampling:
+            require_positive("sample_dt", sample_dt)
+            scap = int(np.ceil(window / sample_dt)) + 2
+            next_sample = np.full(n, float(sample_dt))
+        else:
+            scap = 1
+            next_sample = np.zeros(n)
+        events_buf = np.zeros((n, cap, len(K.EVENT_FIELDS)))
+        samples_buf = np.zeros((n, scap, len(K.SAMPLE_FIELDS)))
+        n_events = np.zeros(n, dtype=np.int32)
+        n_samples = np.zeros(n, dtype=np.int32)
+        yc = np.zeros_like(self.y)
+        tc = np.zeros(n)
+        events = [[] for _ in range(n)]
+        samples = [[] for _ in range(n)]
+        if sampling:  # the first sample is the initial state
+            first = self._sample_initial()
+            for i in range(n):
+                samples[i].append(first[i:i + 1])
+        diag_start = self.diagnostics()
+        total = float(t_stop.max())
+        launches = 0
+        t0 = time.perf_counter()
+        while True:
+            running = self.status == K.RUNNING
+            if not running.any():
+                break
+            t_end = np.minimum(t_stop, self.t + window)
+            K.advance(self.par, self.y, yc, self.t, tc, self.h, t_end, self.status, self.counters,
+                      events_buf, n_events, samples_buf, n_samples, next_sample,
+                      self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
+                      self.order, self.odd, sampling)
+            launches += 1
+            for i in np.nonzero(n_events)[0]:
+                events[i].append(events_buf[i, :n_events[i]].copy())
+            for i in np.nonzero(n_samples)[0]:
+                samples[i].append(samples_buf[i, :n_samples[i]].copy())
+            n_events[:] = 0
+            n_samples[:] = 0
+            finished = (self.status == K.RUNNING) & (self.t >= t_stop)
+            self.status[finished] = K.DONE
+            if progress is not None:
+                progress(float(np.mean(np.minimum(self.t, t_stop)) / np.mean(t_stop)))
+        seconds = time.perf_counter() - t0
+        width = len(K.EVENT_FIELDS)
+        return RunOutput(
+            events=[np.concatenate(e) if e else np.zeros((0, width)) for e in events],
+            samples=[np.concatenate(s) if s else np.zeros((0, len(K.SAMPLE_FIELDS))) for s in samples],
+            diag_start=diag_start, diag_end=self.diagnostics(), t=self.t.copy(), y=self.y.copy(),
+            status=self.status.copy(), counters=self.counters.copy(), launches=launches,
+            seconds=seconds, extra={"total_time": total})
+
+    def _sample_initial(self):
+        """Sample row at t = 0 (same columns as the kernel's samples)."""
+        from .kernels import eom
+
+        y = self.y
+        R = y[:, eom.Y_R:eom.Y_R + 3]
+        S = y[:, eom.Y_S:eom.Y_S + 9].reshape(-1, 3, 3)
+        S1 = y[:, eom.Y_S1:eom.Y_S1 + 9].reshape(-1, 3, 3)
+        V = y[:, eom.Y_V:eom.Y_V + 3]
+        nrm = np.cross(R, V)
+        nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+        rhat = R / np.linalg.norm(R, axis=1)[:, None]
+        xb = S[:, :, 0]
+        alpha = np.arctan2(np.einsum("ij,ij->i", nrm, np.cross(rhat, xb)),
+                           np.einsum("ij,ij->i", rhat, xb))
+        xin = np.einsum("nij,nj->ni", S1, xb)
+        d = self.diagnostics()
+        w2 = y[:, eom.Y_W2:eom.Y_W2 + 3]
+        w2b = np.einsum("nji,nj->ni", S, w2) * self.par[:, eom.P_IB:eom.P_IB + 3]
+        om2 = np.einsum("nij,nj->ni", S, w2b)
+        thetadot = np.einsum("ij,ij->i", om2, nrm)
+        return np.stack([np.zeros(len(y)), alpha, np.arctan2(xin[:, 1], xin[:, 0]), thetadot,
+                         np.linalg.norm(R, axis=1), d[:, 0] + d[:, 1] + d[:, 2]], axis=1)
+
+
+def _odd_columns(row_length):
+    """Parameter columns holding integrals with an odd index, for both body rows."""
+    from .bodies import EXPONENTS_3, EXPONENTS_4
+    from .kernels.potential import T3, T4
+
+    cols = [T3 + k for k in range(len(EXPONENTS_3))]
+    cols += [T4 + k for k, e in enumerate(EXPONENTS_4) if any(x % 2 for x in e)]
+    return cols + [row_length + c for c in cols]

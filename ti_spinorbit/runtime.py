@@ -1,0 +1,81 @@
+"""Taichi runtime: one idempotent ``init`` for the whole package.
+
+Nothing calls ``ti.init`` at import time. Every entry point that launches a kernel calls
+:func:`ensure_init`, which initialises Taichi once with the package defaults (CPU, f64,
+offline kernel cache). Call :func:`init` yourself first to pick another arch.
+
+Decisions (architecture.md, "Kernel design"):
+* ``default_fp = f64`` and ``default_ip = i32`` always: tolerances down to 1e-15 must work.
+* ``fast_math=False``: on CUDA fast math degrades f64 sqrt/division.
+* The environment variable ``TI_SPINORBIT_ARCH`` (``cpu``, ``cuda``, ``vulkan``, ...)
+  overrides the arch of the lazy default and of ``init()`` called without an arch.
+* ``TI_SKIP_VERSION_CHECK=ON`` is set before Taichi is imported (no network in CI).
+"""
+
+import os
+
+os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
+
+_STATE = {"arch": None}
+ARCH_ENV = "TI_SPINORBIT_ARCH"
+_KNOWN_ARCHS = ("cpu", "x64", "arm64", "cuda", "vulkan", "metal", "opengl", "gpu")
+
+
+def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None):
+    """Initialise Taichi for ti_spinorbit (idempotent).
+
+    Parameters
+    ----------
+    arch : str, optional
+        ``"cpu"`` (default), ``"cuda"``, ``"vulkan"``, ... ; ``TI_SPINORBIT_ARCH`` overrides
+        the default. Asking for a GPU arch that is not available raises RuntimeError instead
+        of silently falling back to the CPU.
+    offline_cache : bool
+        Keep compiled kernels on disk (``~/.cache/taichi`` unless ``TI_OFFLINE_CACHE_FILE_PATH``
+        is set), so a fresh process starts in seconds.
+    cpu_max_num_threads : int, optional
+        Threads for the CPU backend (default: all cores).
+
+    Returns the arch name in use. Calling again with the same arch is a no-op; calling with
+    a different arch re-initialises Taichi, which invalidates existing ensembles.
+    """
+    import taichi as ti
+
+    name = (arch or os.environ.get(ARCH_ENV) or "cpu").lower()
+    if name not in _KNOWN_ARCHS:
+        raise ValueError(f"arch must be one of {', '.join(_KNOWN_ARCHS)} (got {arch!r})")
+    if _STATE["arch"] == name:
+        return name
+    ti_arch = {"cpu": ti.cpu, "x64": ti.x64, "arm64": ti.arm64, "cuda": ti.cuda,
+               "vulkan": ti.vulkan, "metal": ti.metal, "opengl": ti.opengl, "gpu": ti.gpu}[name]
+    kwargs = dict(arch=ti_arch, default_fp=ti.f64, default_ip=ti.i32, offline_cache=offline_cache,
+                  fast_math=False, debug=debug, log_level=ti.WARN, enable_fallback=False)
+    if cpu_max_num_threads:
+        kwargs["cpu_max_num_threads"] = int(cpu_max_num_threads)
+    if _STATE["arch"] is not None:
+        ti.reset()
+    try:
+        ti.init(**kwargs)
+    except Exception as exc:  # Taichi raises a bare RuntimeError with little context
+        _STATE["arch"] = None
+        raise RuntimeError(f"Taichi could not start on arch {name!r}: {exc}") from exc
+    _STATE["arch"] = name
+    _STATE["generation"] = _STATE.get("generation", 0) + 1
+    return name
+
+
+def ensure_init():
+    """Initialise with the defaults if nobody has called :func:`init` yet."""
+    if _STATE["arch"] is None:
+        init()
+    return _STATE["arch"]
+
+
+def current_arch():
+    """The arch Taichi was initialised with, or None."""
+    return _STATE["arch"]
+
+
+def generation():
+    """Increments at every (re-)initialisation; owners of fields use it to notice a reset."""
+    return _STATE.get("generation", 0)

@@ -1,0 +1,209 @@
+"""Surfaces of section and dense time series of ensembles (physics.md §6-7).
+
+``surface_of_section`` records, at every pericentre passage of the osculating mutual orbit,
+the angle θ_p from the line of apsides to the secondary's long axis and the secondary's spin
+rate θ̇_p/n (Naidu & Margot 2015 §2.3, Figs. 4-6). ``time_series`` samples one or more members
+densely (spin rate, α, r, energy) for libration and spin-rate studies (their Figs. 2, 8, 9).
+
+Inputs broadcast: a system (or a list giving one member per system), θ_p (deg) and θ̇_p/n,
+scalars or arrays, are broadcast against each other to N members.
+"""
+
+from dataclasses import dataclass, field
+from typing import List, Sequence, Union
+
+import numpy as np
+
+from ._validate import require_count, require_finite
+from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
+from .systems import ESCAPE_DISTANCE, BinarySystem
+
+SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
+
+
+def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
+                  escape_distance=ESCAPE_DISTANCE):
+    """Broadcast systems and initial conditions into a member table.
+
+    Returns (systems list of length N, par (N, NPAR), y0 (N, 30), theta_p_deg (N,),
+    thetadot_p (N,))."""
+    systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else list(system_or_systems)
+    if not systems or not all(isinstance(s, BinarySystem) for s in systems):
+        raise TypeError("system_or_systems must be a BinarySystem or a non-empty list of them")
+    theta_p = np.asarray(theta_p, dtype=np.float64)
+    thetadot_p = np.asarray(thetadot_p, dtype=np.float64)
+    require_finite("theta_p", theta_p)
+    require_finite("thetadot_p", thetadot_p)
+    index = np.arange(len(systems)) if len(systems) > 1 else np.zeros((), dtype=int)
+    try:
+        index, theta_p, thetadot_p = np.broadcast_arrays(index, theta_p, thetadot_p)
+    except ValueError:
+        raise ValueError(f"cannot broadcast {len(systems)} systems, theta_p of shape "
+                         f"{theta_p.shape} and thetadot_p of shape {thetadot_p.shape}") from None
+    index, theta_p, thetadot_p = (np.ravel(x) for x in (index, theta_p, thetadot_p))
+    members = [systems[k] for k in index]
+    rows = {}
+    par = np.stack([rows.setdefault(id(s), s.parameter_row(escape_distance)) for s in members])
+    y0 = np.stack([s.initial_state(np.radians(tp), td)
+                   for s, tp, td in zip(members, theta_p, thetadot_p)])
+    return members, par, y0, theta_p.copy(), thetadot_p.copy()
+
+
+def _drifts(out: RunOutput):
+    """Relative energy and angular-momentum drift per member, |X(t_end) − X(0)| / |X(0)|."""
+    e0 = out.diag_start[:, :3].sum(1)
+    e1 = out.diag_end[:, :3].sum(1)
+    l0 = out.diag_start[:, 3:6] + out.diag_start[:, 6:9] + out.diag_start[:, 9:12]
+    l1 = out.diag_end[:, 3:6] + out.diag_end[:, 6:9] + out.diag_end[:, 9:12]
+    return (np.abs(e1 - e0) / np.abs(e0),
+            np.linalg.norm(l1 - l0, axis=1) / np.linalg.norm(l0, axis=1))
+
+
+def _pad(rows: List[np.ndarray], width: int):
+    out = np.full((len(rows), width), np.nan)
+    for i, r in enumerate(rows):
+        out[i, :len(r)] = r
+    return out
+
+
+@dataclass
+class SectionResult:
+    """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
+
+    Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
+    ``t`` s; ``r`` pericentre distance m; ``a``, ``e`` osculating elements (m, -); ``count``
+    crossings per member; ``energy_drift``, ``angmom_drift`` relative drifts over the run;
+    ``status`` codes with ``status_names``; ``accepted``, ``rejected``, ``rhs_calls``."""
+
+    theta_p: np.ndarray
+    thetadot_p: np.ndarray
+    t: np.ndarray
+    r: np.ndarray
+    a: np.ndarray
+    e: np.ndarray
+    count: np.ndarray
+    energy_drift: np.ndarray
+    angmom_drift: np.ndarray
+    status: np.ndarray
+    accepted: np.ndarray
+    rejected: np.ndarray
+    rhs_calls: np.ndarray
+    initial_theta_p: np.ndarray
+    initial_thetadot_p: np.ndarray
+    systems: list = field(repr=False)
+    rtol: float = 1e-12
+    atol: float = 1e-12
+    order: int = 4
+    orbits: float = 0.0
+    seconds: float = 0.0
+
+    @property
+    def status_names(self) -> List[str]:
+        from .kernels.ensemble import STATUS_NAMES
+        return [STATUS_NAMES[s] for s in self.status]
+
+    @property
+    def member_orbits_per_second(self) -> float:
+        return float(self.orbits * len(self.count) / self.seconds) if self.seconds else float("nan")
+
+    def plot(self, ax=None, colors=None, **kwargs):
+        """Scatter θ̇_p/n against θ_p (deg) in the paper's convention; returns the axes."""
+        from .plotting import plot_section
+        return plot_section(self, ax=ax, colors=colors, **kwargs)
+
+
+def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-12,
+                       atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
+                       escape_distance=ESCAPE_DISTANCE, progress=None) -> SectionResult:
+    """Surface of section at pericentre for an ensemble of trajectories.
+
+    Parameters
+    ----------
+    system_or_systems : BinarySystem or list of BinarySystem
+        One system for all members, or one per member (broadcast with the other inputs).
+    theta_p : float or array
+        Initial angle of the secondary's long axis from the line of centres, degrees.
+    thetadot_p : float or array
+        Initial spin rate of the secondary, units of the mean motion n.
+    orbits : float
+        Integration time in initial orbital periods 2π/n (each member its own n).
+    rtol, atol : float
+        Integrator tolerances on the scaled state (atol defaults to rtol).
+    order : {0, 2, 3, 4}
+        Truncation order of the mutual potential.
+    window_orbits : int
+        Orbits per kernel launch (affects speed only).
+    escape_distance : float
+        Stop a member as "escape" beyond this distance, units of a.
+    progress : callable, optional
+        ``progress(fraction)`` after every window.
+
+    Returns
+    -------
+    SectionResult
+    """
+    orbits = float(orbits)
+    if not np.isfinite(orbits) or orbits <= 0:
+        raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
+    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
+    out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, progress=progress)
+    width = max([len(ev) for ev in out.events] + [1])
+    n = np.array([s.mean_motion for s in members])
+    a = np.array([s.a for s in members])
+    col = lambda k: _pad([ev[:, k] for ev in out.events], width)  # noqa: E731
+    energy_drift, angmom_drift = _drifts(out)
+    return SectionResult(
+        theta_p=np.mod(np.degrees(col(1)), 180.0), thetadot_p=col(2), t=col(0) / n[:, None],
+        r=col(3) * a[:, None], a=col(4) * a[:, None], e=col(5),
+        count=np.array([len(ev) for ev in out.events]), energy_drift=energy_drift,
+        angmom_drift=angmom_drift, status=out.status, accepted=out.counters[:, 0],
+        rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
+        initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
+        orbits=orbits, seconds=out.seconds)
+
+
+@dataclass
+class TimeSeriesResult:
+    """Densely sampled trajectories (padded with NaN to (N, max samples)).
+
+    ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
+    long axis from the initial pericentre direction (inertial, orbit plane); ``thetadot``
+    spin rate about the orbit normal, units of n; ``r`` m; ``energy`` total, J."""
+
+    t: np.ndarray
+    alpha: np.ndarray
+    theta: np.ndarray
+    thetadot: np.ndarray
+    r: np.ndarray
+    energy: np.ndarray
+    status: np.ndarray
+    systems: list = field(repr=False)
+    initial_theta_p: np.ndarray = None
+    initial_thetadot_p: np.ndarray = None
+
+
+def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
+                rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
+                escape_distance=ESCAPE_DISTANCE) -> TimeSeriesResult:
+    """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
+
+    Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
+    initial orbital period), so samples carry the integrator's accuracy."""
+    samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
+    orbits = float(orbits)
+    if not np.isfinite(orbits) or orbits <= 0:
+        raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
+    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
+    out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
+                  sample_dt=2.0 * np.pi / samples_per_orbit)
+    width = max(len(s) for s in out.samples)
+    col = lambda k: _pad([s[:, k] for s in out.samples], width)  # noqa: E731
+    n = np.array([s.mean_motion for s in members])
+    a = np.array([s.a for s in members])
+    e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])
+    return TimeSeriesResult(
+        t=col(0) / n[:, None], alpha=np.degrees(col(1)), theta=np.degrees(col(2)),
+        thetadot=col(3), r=col(4) * a[:, None], energy=col(5) * e_unit[:, None],
+        status=out.status, systems=members, initial_theta_p=tp, initial_thetadot_p=td)

@@ -1,0 +1,189 @@
+"""A binary system (two bodies + initial osculating mutual orbit) and its member table rows.
+
+This is the first arrow of the data flow: physical description in SI units -> scaled member
+parameters and initial state (numpy), which the kernels consume.
+
+Scaled units (physics.md §3): length = a (initial osculating semimajor axis), time = 1/n with
+n = sqrt(G (m1 + m2) / a³), mass = m1 + m2; hence G = 1 and one orbital period is 2π.
+
+Initial conditions (physics.md §5): pericentre of the osculating Kepler orbit (a, e,
+μ = G(m1+m2)) with the line of centres along the primary's x (long) axis, both equators in
+the orbit plane, the secondary's long axis rotated by θ_p from the line of centres, the
+secondary spinning at θ̇_p·n about the orbit normal and the primary at 2π/P about its z axis.
+The state is fully 3-D even though these starts are planar.
+"""
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from ._validate import require_finite, require_positive, require_range
+from .bodies import Body
+
+#: Newtonian constant of gravitation, m^3 kg^-1 s^-2 (CODATA 2018).
+G = 6.67430e-11
+
+#: Default escape radius in units of a: beyond it a member is stopped with status "escape".
+ESCAPE_DISTANCE = 50.0
+
+
+@dataclass(frozen=True)
+class BinarySystem:
+    """Primary + secondary on an initial osculating orbit.
+
+    Parameters
+    ----------
+    primary, secondary : Body
+        e.g. ``Sphere(600, 1581)``, ``Ellipsoid(245, 163, 190, 2618)``.
+    a : float
+        Initial osculating semimajor axis of the mutual orbit, m.
+    e : float
+        Initial osculating eccentricity, 0 <= e < 1.
+    primary_spin_period : float, optional
+        Primary's spin period about its short axis, s (None: not spinning; irrelevant for a
+        spherical primary).
+    name : str
+        Label used in plots and saved files.
+    """
+
+    primary: Body
+    secondary: Body
+    a: float
+    e: float
+    primary_spin_period: Optional[float] = None
+    name: str = "binary"
+
+    def __post_init__(self):
+        for label, body in (("primary", self.primary), ("secondary", self.secondary)):
+            if not isinstance(body, Body):
+                raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body), "
+                                f"got {type(body).__name__}")
+        require_positive("a", self.a)
+        require_range("e", self.e, 0.0, 1.0)
+        if self.primary_spin_period is not None:
+            require_finite("primary_spin_period", self.primary_spin_period)
+            if self.primary_spin_period == 0:
+                raise ValueError("primary_spin_period must be non-zero (None for no spin)")
+        contact = self.primary.bounding_radius + self.secondary.bounding_radius
+        pericentre = self.a * (1.0 - self.e)
+        if pericentre <= contact:
+            raise ValueError(
+                f"bodies overlap at pericentre: a(1-e) = {pericentre:.6g} m must exceed the sum "
+                f"of bounding radii {contact:.6g} m (increase a or decrease e)")
+
+    # ---- physical quantities (SI) ----------------------------------------------------------
+    @property
+    def total_mass(self) -> float:
+        """m1 + m2, kg."""
+        return self.primary.mass + self.secondary.mass
+
+    @property
+    def mean_motion(self) -> float:
+        """n = sqrt(G (m1 + m2) / a³) of the initial osculating orbit, rad/s."""
+        return math.sqrt(G * self.total_mass / self.a**3)
+
+    @property
+    def orbital_period(self) -> float:
+        """2π/n, s."""
+        return 2.0 * math.pi / self.mean_motion
+
+    @property
+    def mass_ratio(self) -> float:
+        """Primary-to-secondary mass ratio m1/m2."""
+        return self.primary.mass / self.secondary.mass
+
+    @property
+    def omega0(self) -> float:
+        """Secondary's libration frequency in units of n: sqrt(3 (B − A) / C) (physics.md §1)."""
+        A, B, C = self.secondary.moments
+        return math.sqrt(3.0 * (B - A) / C)
+
+    # ---- scaled member rows -------------------------------------------------------------
+    def scaled_body_row(self, body: Body) -> np.ndarray:
+        """Body.as_row in scaled units: T^{lmn} / ((m1+m2) a^{l+m+n})."""
+        from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
+
+        row = body.as_row()
+        M = self.total_mass
+        scale = [M] + [M * self.a**2] * len(EXPONENTS_2) + [M * self.a**3] * len(EXPONENTS_3) \
+            + [M * self.a**4] * len(EXPONENTS_4)
+        return row / np.array(scale)
+
+    def parameter_row(self, escape_distance: float = ESCAPE_DISTANCE) -> np.ndarray:
+        """The kernels' parameter row (kernels/eom.py layout), scaled units."""
+        from .kernels import eom
+
+        p = np.zeros(eom.NPAR)
+        p[eom.BODY_A:eom.BODY_A + len(self.primary.as_row())] = self.scaled_body_row(self.primary)
+        p[eom.BODY_B:eom.BODY_B + len(self.secondary.as_row())] = self.scaled_body_row(self.secondary)
+        m1, m2 = self.primary.mass / self.total_mass, self.secondary.mass / self.total_mass
+        p[eom.P_MRED] = m1 * m2
+        I1 = self.primary.moments / (self.total_mass * self.a**2)
+        I2 = self.secondary.moments / (self.total_mass * self.a**2)
+        p[eom.P_C1], p[eom.P_C2] = I1.max(), I2.max()
+        p[eom.P_IA:eom.P_IA + 3] = I1.max() / I1
+        p[eom.P_IB:eom.P_IB + 3] = I2.max() / I2
+        p[eom.P_CONTACT] = (self.primary.bounding_radius + self.secondary.bounding_radius) / self.a
+        p[eom.P_ESCAPE] = escape_distance
+        return p
+
+    def initial_state(self, theta_p: float, thetadot_p: float) -> np.ndarray:
+        """Scaled 30-element state at pericentre (physics.md §5).
+
+        theta_p in radians from the line of centres, thetadot_p in units of n."""
+        from .kernels import eom
+
+        e = self.e
+        r = 1.0 - e
+        v = math.sqrt((1.0 + e) / (1.0 - e))        # vis-viva at pericentre, μ = a = 1
+        omega1 = 0.0 if self.primary_spin_period is None else \
+            2.0 * math.pi / (self.primary_spin_period * self.mean_motion)
+        I1 = self.primary.moments / (self.total_mass * self.a**2)
+        I2 = self.secondary.moments / (self.total_mass * self.a**2)
+        c, s = math.cos(theta_p), math.sin(theta_p)
+        S = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        y = np.zeros(eom.NSTATE)
+        y[eom.Y_R:eom.Y_R + 3] = (r, 0.0, 0.0)
+        y[eom.Y_V:eom.Y_V + 3] = (0.0, v, 0.0)
+        y[eom.Y_W1 + 2] = I1[2] * omega1 / I1.max()
+        # spin about z (a principal axis of both frames since S is a z-rotation)
+        y[eom.Y_W2 + 2] = I2[2] * thetadot_p / I2.max()
+        y[eom.Y_S:eom.Y_S + 9] = S.ravel()
+        y[eom.Y_S1:eom.Y_S1 + 9] = np.eye(3).ravel()
+        return y
+
+    def to_physical(self, y: np.ndarray) -> np.ndarray:
+        """Scaled internal state -> SI physical state [R, P, Γ1, Γ2, S, S1] (reference layout)."""
+        from .kernels import eom
+
+        y = np.asarray(y, dtype=np.float64)
+        out = y.copy()
+        L, T, M = self.a, 1.0 / self.mean_motion, self.total_mass
+        m_red = self.primary.mass * self.secondary.mass / M
+        C1 = self.primary.moments.max()
+        C2 = self.secondary.moments.max()
+        out[..., eom.Y_R:eom.Y_R + 3] *= L
+        out[..., eom.Y_V:eom.Y_V + 3] *= m_red * L / T
+        out[..., eom.Y_W1:eom.Y_W1 + 3] *= C1 / T
+        out[..., eom.Y_W2:eom.Y_W2 + 3] *= C2 / T
+        return out
+
+    def from_physical(self, x: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`to_physical`."""
+        ones = np.ones(30)
+        factor = self.to_physical(ones)
+        return np.asarray(x, dtype=np.float64) / factor
+
+    def describe(self) -> dict:
+        """All inputs with units, for saved files and plots."""
+        def body(b):
+            d = {"name": b.name, "mass_kg": b.mass, "bounding_radius_m": b.bounding_radius}
+            if hasattr(b, "semi_axes"):
+                d["semi_axes_m"] = list(b.semi_axes)
+            return d
+        return {"name": self.name, "primary": body(self.primary), "secondary": body(self.secondary),
+                "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
+                "mean_motion_rad_s": self.mean_motion, "mass_ratio": self.mass_ratio,
+                "omega0": self.omega0}
