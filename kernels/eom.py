@@ -119,23 +119,6 @@ def pericentre_rate(y, dy):
 
 
 @ti.func
-def section_angles(p: ti.template(), i, y):
-    """(α, θ̇): angle (rad) from the line of centres to the secondary's long axis, measured
-    about the orbit normal, and the secondary's spin rate about that normal (units of n).
-    At pericentre α is the section angle θ_p."""
-    R = get3(y, Y_R)
-    V = get3(y, Y_V)
-    S = get33(y, Y_S)
-    h = R.cross(V)
-    nrm = h / h.norm()
-    rhat = R / R.norm()
-    xb = vec3(S[0, 0], S[1, 0], S[2, 0])
-    alpha = ti.atan2(nrm.dot(rhat.cross(xb)), rhat.dot(xb))
-    om1, om2 = angular_velocities(p, i, y)
-    return alpha, om2.dot(nrm)
-
-
-@ti.func
 def osculating_elements(y):
     """Osculating semimajor axis and eccentricity (scaled units, μ = G(m1+m2) = 1)."""
     R = get3(y, Y_R)

@@ -69,7 +69,7 @@ class Body:
         require_positive("mass", self.mass)
         require_positive("bounding_radius", self.bounding_radius)
         for key, value in self.integrals.items():
-            if len(key) != 3 or sum(key) not in (2, 3, 4) or min(key) < 0:
+            if not isinstance(key, tuple) or len(key) != 3 or sum(key) not in (2, 3, 4) or min(key) < 0:
                 raise ValueError(
                     f"integrals: key {key!r} is not (l, m, n) with l + m + n in 2..4")
             require_finite(f"integrals[{key}]", value)
@@ -106,7 +106,10 @@ class Body:
         return any(v != 0.0 and any(i % 2 for i in k) for k, v in self.integrals.items())
 
     def moment_tensor(self, order: int) -> np.ndarray:
-        """Full symmetric moment tensor M^(k)_{i..} = ∫ x_i ... dm in the body frame (SI)."""
+        """Full symmetric moment tensor M^(k)_{i..} = ∫ x_i ... dm in the body frame (SI),
+        k = 0..4."""
+        if order not in (0, 1, 2, 3, 4):
+            raise ValueError(f"order must be 0..4 (got {order!r})")
         if order == 0:
             return np.array(self.mass)
         tensor = np.zeros((3,) * order)
@@ -146,10 +149,13 @@ class Body:
         q = p @ rotation.T
         integrals = {}
         for order, group in ((2, EXPONENTS_2), (3, EXPONENTS_3), (4, EXPONENTS_4)):
+            # integrals that vanish by symmetry come out as round-off: zero them so that a
+            # symmetric cloud does not switch on the kernels' odd-order terms
+            floor = 1e-13 * float(np.sum(masses * np.linalg.norm(q, axis=1) ** order))
             for l, m, n in group:
-                integrals[(l, m, n)] = float(np.sum(masses * q[:, 0] ** l * q[:, 1] ** m * q[:, 2] ** n))
-        # principal frame: zero the off-diagonal second order left by round-off
-        radius = bounding_radius or float(np.max(np.linalg.norm(q, axis=1)))
+                value = float(np.sum(masses * q[:, 0] ** l * q[:, 1] ** m * q[:, 2] ** n))
+                integrals[(l, m, n)] = value if abs(value) > floor else 0.0
+        radius = float(np.max(np.linalg.norm(q, axis=1))) if bounding_radius is None else bounding_radius
         return cls(float(total), integrals, radius, name), rotation
 
 

@@ -13,7 +13,7 @@ Decisions:
   them in place.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, List, Optional
 
 import numpy as np
@@ -30,8 +30,8 @@ MIN_STEP = 1e-10  # scaled time (1/n): below this a member stops with "step unde
 class RunOutput:
     """What the kernels produced, still in scaled units (per member)."""
 
-    events: List[np.ndarray]          # each (count, 6): kernels.ensemble.EVENT_FIELDS
-    samples: List[np.ndarray]         # each (count, 6): SAMPLE_FIELDS (empty without sampling)
+    events: List[np.ndarray]          # each (count, 31): time, then the state at the crossing
+    samples: List[np.ndarray]         # each (count, 31): time, state (empty without sampling)
     diag_start: np.ndarray            # (N, 14) DIAG_FIELDS at t = 0
     diag_end: np.ndarray              # (N, 14) at the final time reached
     t: np.ndarray                     # final time reached, scaled
@@ -40,7 +40,6 @@ class RunOutput:
     counters: np.ndarray              # (N, 3) accepted, rejected, RHS calls
     launches: int = 0
     seconds: float = 0.0
-    extra: dict = field(default_factory=dict)
 
 
 def check_tolerances(rtol, atol):
@@ -91,12 +90,17 @@ class Ensemble:
         self.status = np.zeros(n, dtype=np.int32)
         self.counters = np.zeros((n, 3), dtype=np.int64)
 
-    def diagnostics(self, y=None) -> np.ndarray:
+    def diagnostics(self, y=None, member=None) -> np.ndarray:
+        """DIAG_FIELDS (energies, angular momenta, orthonormality) of states y (default: the
+        current ones) belonging to members ``member`` (default 0..N-1), scaled units."""
         from .kernels import ensemble as K
 
-        y = self.y if y is None else np.ascontiguousarray(y, dtype=np.float64)
+        y = self.y if y is None else np.ascontiguousarray(y, dtype=np.float64).reshape(-1, 30)
+        member = np.arange(len(y), dtype=np.int32) if member is None else \
+            np.ascontiguousarray(member, dtype=np.int32)
         out = np.zeros((len(y), len(K.DIAG_FIELDS)))
-        K.diagnostics(self.par, y, out, self.order, self.odd)
+        if len(y):
+            K.diagnostics(self.par, y, member, out, self.order, self.odd)
         return out
 
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
@@ -104,7 +108,8 @@ class Ensemble:
         """Integrate every member to ``t_stop`` (scaled; scalar or per member).
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
-        called after every window."""
+        called after every window. Window ends are soft (no step is shortened for them), so
+        the window length changes launch overhead only, never results."""
         import time
 
         from .kernels import ensemble as K
@@ -118,34 +123,32 @@ class Ensemble:
         sampling = sample_dt is not None
         if sampling:
             require_positive("sample_dt", sample_dt)
-            scap = int(np.ceil(window / sample_dt)) + 2
+            scap = int(np.ceil(window / sample_dt)) + 4
             next_sample = np.full(n, float(sample_dt))
         else:
             scap = 1
             next_sample = np.zeros(n)
-        events_buf = np.zeros((n, cap, len(K.EVENT_FIELDS)))
-        samples_buf = np.zeros((n, scap, len(K.SAMPLE_FIELDS)))
+        events_buf = np.zeros((n, cap, K.RECORD_WIDTH))
+        samples_buf = np.zeros((n, scap, K.RECORD_WIDTH))
         n_events = np.zeros(n, dtype=np.int32)
         n_samples = np.zeros(n, dtype=np.int32)
         yc = np.zeros_like(self.y)
         tc = np.zeros(n)
+        f = np.zeros_like(self.y)
+        K.evaluate_rhs(self.par, self.y, f, self.order, self.odd)
+        self.counters[:, K.C_RHS] += 1
         events = [[] for _ in range(n)]
         samples = [[] for _ in range(n)]
         if sampling:  # the first sample is the initial state
-            first = self._sample_initial()
             for i in range(n):
-                samples[i].append(first[i:i + 1])
+                samples[i].append(np.concatenate([[0.0], self.y[i]])[None])
         diag_start = self.diagnostics()
-        total = float(t_stop.max())
         launches = 0
         t0 = time.perf_counter()
-        while True:
-            running = self.status == K.RUNNING
-            if not running.any():
-                break
+        while np.any(self.status == K.RUNNING):
             t_end = np.minimum(t_stop, self.t + window)
-            K.advance(self.par, self.y, yc, self.t, tc, self.h, t_end, self.status, self.counters,
-                      events_buf, n_events, samples_buf, n_samples, next_sample,
+            K.advance(self.par, self.y, yc, f, self.t, tc, self.h, t_end, t_stop, self.status,
+                      self.counters, events_buf, n_events, samples_buf, n_samples, next_sample,
                       self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
                       self.order, self.odd, sampling)
             launches += 1
@@ -160,37 +163,13 @@ class Ensemble:
             if progress is not None:
                 progress(float(np.mean(np.minimum(self.t, t_stop)) / np.mean(t_stop)))
         seconds = time.perf_counter() - t0
-        width = len(K.EVENT_FIELDS)
+        empty = np.zeros((0, K.RECORD_WIDTH))
         return RunOutput(
-            events=[np.concatenate(e) if e else np.zeros((0, width)) for e in events],
-            samples=[np.concatenate(s) if s else np.zeros((0, len(K.SAMPLE_FIELDS))) for s in samples],
+            events=[np.concatenate(e) if e else empty for e in events],
+            samples=[np.concatenate(s) if s else empty for s in samples],
             diag_start=diag_start, diag_end=self.diagnostics(), t=self.t.copy(), y=self.y.copy(),
             status=self.status.copy(), counters=self.counters.copy(), launches=launches,
-            seconds=seconds, extra={"total_time": total})
-
-    def _sample_initial(self):
-        """Sample row at t = 0 (same columns as the kernel's samples)."""
-        from .kernels import eom
-
-        y = self.y
-        R = y[:, eom.Y_R:eom.Y_R + 3]
-        S = y[:, eom.Y_S:eom.Y_S + 9].reshape(-1, 3, 3)
-        S1 = y[:, eom.Y_S1:eom.Y_S1 + 9].reshape(-1, 3, 3)
-        V = y[:, eom.Y_V:eom.Y_V + 3]
-        nrm = np.cross(R, V)
-        nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-        rhat = R / np.linalg.norm(R, axis=1)[:, None]
-        xb = S[:, :, 0]
-        alpha = np.arctan2(np.einsum("ij,ij->i", nrm, np.cross(rhat, xb)),
-                           np.einsum("ij,ij->i", rhat, xb))
-        xin = np.einsum("nij,nj->ni", S1, xb)
-        d = self.diagnostics()
-        w2 = y[:, eom.Y_W2:eom.Y_W2 + 3]
-        w2b = np.einsum("nji,nj->ni", S, w2) * self.par[:, eom.P_IB:eom.P_IB + 3]
-        om2 = np.einsum("nij,nj->ni", S, w2b)
-        thetadot = np.einsum("ij,ij->i", om2, nrm)
-        return np.stack([np.zeros(len(y)), alpha, np.arctan2(xin[:, 1], xin[:, 0]), thetadot,
-                         np.linalg.norm(R, axis=1), d[:, 0] + d[:, 1] + d[:, 2]], axis=1)
+            seconds=seconds)
 
 
 def _odd_columns(row_length):

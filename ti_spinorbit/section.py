@@ -59,13 +59,6 @@ def _drifts(out: RunOutput):
             np.linalg.norm(l1 - l0, axis=1) / np.linalg.norm(l0, axis=1))
 
 
-def _pad(rows: List[np.ndarray], width: int):
-    out = np.full((len(rows), width), np.nan)
-    for i, r in enumerate(rows):
-        out[i, :len(r)] = r
-    return out
-
-
 @dataclass
 class SectionResult:
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
@@ -148,19 +141,40 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, progress=progress)
-    width = max([len(ev) for ev in out.events] + [1])
+    cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"))
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
-    col = lambda k: _pad([ev[:, k] for ev in out.events], width)  # noqa: E731
     energy_drift, angmom_drift = _drifts(out)
     return SectionResult(
-        theta_p=np.mod(np.degrees(col(1)), 180.0), thetadot_p=col(2), t=col(0) / n[:, None],
-        r=col(3) * a[:, None], a=col(4) * a[:, None], e=col(5),
+        theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=cols["thetadot"],
+        t=cols["t"] / n[:, None], r=cols["r"] * a[:, None], a=cols["a"] * a[:, None], e=cols["e"],
         count=np.array([len(ev) for ev in out.events]), energy_drift=energy_drift,
         angmom_drift=angmom_drift, status=out.status, accepted=out.counters[:, 0],
         rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
         orbits=orbits, seconds=out.seconds)
+
+
+def _derived_columns(par, records, names, ensemble=None):
+    """Observables of per-member record lists, padded to (N, max count); adds "t" and, with
+    an ``ensemble``, the total "energy" (scaled)."""
+    from .observables import derive
+
+    width = max([len(r) for r in records] + [1])
+    cols = {k: np.full((len(records), width), np.nan) for k in ("t",) + tuple(names)}
+    if ensemble is not None:
+        cols["energy"] = np.full((len(records), width), np.nan)
+    for i, rec in enumerate(records):
+        if not len(rec):
+            continue
+        d = derive(par[i][None], rec[:, 1:])
+        cols["t"][i, :len(rec)] = rec[:, 0]
+        for k in names:
+            cols[k][i, :len(rec)] = d[k]
+        if ensemble is not None:
+            diag = ensemble.diagnostics(rec[:, 1:], np.full(len(rec), i))
+            cols["energy"][i, :len(rec)] = diag[:, :3].sum(1)
+    return cols
 
 
 @dataclass
@@ -198,12 +212,11 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
                   sample_dt=2.0 * np.pi / samples_per_orbit)
-    width = max(len(s) for s in out.samples)
-    col = lambda k: _pad([s[:, k] for s in out.samples], width)  # noqa: E731
+    cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r"), ensemble=ens)
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
     e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])
     return TimeSeriesResult(
-        t=col(0) / n[:, None], alpha=np.degrees(col(1)), theta=np.degrees(col(2)),
-        thetadot=col(3), r=col(4) * a[:, None], energy=col(5) * e_unit[:, None],
+        t=cols["t"] / n[:, None], alpha=np.degrees(cols["alpha"]), theta=np.degrees(cols["theta"]),
+        thetadot=cols["thetadot"], r=cols["r"] * a[:, None], energy=cols["energy"] * e_unit[:, None],
         status=out.status, systems=members, initial_theta_p=tp, initial_thetadot_p=td)

@@ -1,0 +1,252 @@
+"""The Cash-Karp 4(5) tableau (kernels/tableau.py) and the generic Taichi step built from it
+(kernels/integrator.py, ``make_step``).
+
+* Exact identities and every Butcher order condition (all rooted trees) in rational
+  arithmetic: order 5 for the propagated weights b, order 4 (and not 5) for the embedded b̂.
+* The compiled step on the Kepler problem (nonlinear system, exact solution from Kepler's
+  equation): global error slope 5 on a log–log fit, and the embedded error estimate scales
+  like h^5 and matches the true local error of the 4th-order solution.
+"""
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+import taichi as ti
+
+from ti_spinorbit import runtime
+from ti_spinorbit.kernels.integrator import make_step
+from ti_spinorbit.kernels.tableau import CASH_KARP, CASH_KARP_EXACT, Tableau
+
+EXACT_A, EXACT_B, EXACT_B_HAT, EXACT_C = (CASH_KARP_EXACT[k] for k in ("a", "b", "b_hat", "c"))
+STAGES = len(EXACT_B)
+
+
+# ---- rooted trees and elementary weights (Butcher) -----------------------------------------
+# A tree is the sorted tuple of its children's trees; the single node is ().
+def _grow(tree):
+    """Every tree obtained by attaching one new leaf to some node of ``tree``."""
+    yield tuple(sorted(tree + ((),)))
+    for k, child in enumerate(tree):
+        for grown in _grow(child):
+            yield tuple(sorted(tree[:k] + (grown,) + tree[k + 1:]))
+
+
+def trees_of_order(n):
+    level = {()}
+    for _ in range(n - 1):
+        level = {g for t in level for g in _grow(t)}
+    return sorted(level)
+
+
+def tree_order(tree):
+    return 1 + sum(tree_order(c) for c in tree)
+
+
+def density(tree):
+    """γ(t) = |t| Π γ(children): the condition is b ⋅ Φ(t) = 1/γ(t)."""
+    return tree_order(tree) * math.prod(density(c) for c in tree)
+
+
+def stage_weights(tree, a):
+    """Φ(t) per stage: Π over the root's children u of (A Φ(u)); the single node gives 1."""
+    phi = [Fraction(1)] * STAGES
+    for child in tree:
+        inner = stage_weights(child, a)
+        phi = [phi[i] * sum((a[i][j] * inner[j] for j in range(i)), Fraction(0))
+               for i in range(STAGES)]
+    return phi
+
+
+def condition_residual(tree, weights):
+    return sum(w * p for w, p in zip(weights, stage_weights(tree, EXACT_A))) - Fraction(1, density(tree))
+
+
+def tree_name(tree):
+    return "[" + "".join(tree_name(c) for c in tree) + "]" if tree else "o"
+
+
+TREES_UP_TO_5 = [t for n in range(1, 6) for t in trees_of_order(n)]
+
+
+def test_tree_enumeration():
+    """The generator itself: 1, 1, 2, 4, 9, 20 trees of orders 1..6, known densities."""
+    assert [len(trees_of_order(n)) for n in range(1, 7)] == [1, 1, 2, 4, 9, 20]
+    bushy5 = ((), (), (), ())
+    tall5 = (((((),),),),)
+    assert density(bushy5) == 5 and density(tall5) == 120
+
+
+# ---- exact identities ----------------------------------------------------------------------
+def test_exact_tableau_identities():
+    one = Fraction(1)
+    assert all(isinstance(x, Fraction) for x in EXACT_B + EXACT_B_HAT + EXACT_C)
+    assert [len(row) for row in EXACT_A] == list(range(STAGES)) and STAGES == 6
+    assert sum(EXACT_B) == one
+    assert sum(EXACT_B_HAT) == one
+    assert sum(b - bh for b, bh in zip(EXACT_B, EXACT_B_HAT)) == 0
+    assert EXACT_C[0] == 0
+    for row, c in zip(EXACT_A, EXACT_C):
+        assert sum(row, Fraction(0)) == c
+
+
+def test_named_order_conditions_of_b():
+    """The standard ones, written out: quadrature Σ b c^k = 1/(k+1) (k ≤ 4) and the
+    lower-order coupling conditions."""
+    b, c, a = EXACT_B, EXACT_C, EXACT_A
+    ac = [sum((a[i][j] * c[j] for j in range(i)), Fraction(0)) for i in range(STAGES)]
+    ac2 = [sum((a[i][j] * c[j] ** 2 for j in range(i)), Fraction(0)) for i in range(STAGES)]
+    aac = [sum((a[i][j] * ac[j] for j in range(i)), Fraction(0)) for i in range(STAGES)]
+    for k in range(5):
+        assert sum(bi * ci**k for bi, ci in zip(b, c)) == Fraction(1, k + 1)
+    dot = lambda *vs: sum(math.prod(x) for x in zip(*vs))  # noqa: E731
+    assert dot(b, ac) == Fraction(1, 6)
+    assert dot(b, c, ac) == Fraction(1, 8)
+    assert dot(b, ac2) == Fraction(1, 12)
+    assert dot(b, aac) == Fraction(1, 24)
+    assert dot(b, c, c, ac) == Fraction(1, 10)
+    assert dot(b, ac, ac) == Fraction(1, 20)
+
+
+@pytest.mark.parametrize("tree", TREES_UP_TO_5, ids=tree_name)
+def test_order_conditions_of_propagated_weights(tree):
+    """b is a 5th-order method: all 17 conditions up to order 5 hold exactly."""
+    assert condition_residual(tree, EXACT_B) == 0
+
+
+@pytest.mark.parametrize("tree", [t for t in TREES_UP_TO_5 if tree_order(t) <= 4], ids=tree_name)
+def test_order_conditions_of_embedded_weights(tree):
+    assert condition_residual(tree, EXACT_B_HAT) == 0
+
+
+def test_orders_are_exactly_5_and_4():
+    """b̂ violates some order-5 condition (else the error estimate would be O(h^6)), and b
+    violates some order-6 one (the pair is 4(5), not higher)."""
+    assert any(condition_residual(t, EXACT_B_HAT) != 0 for t in trees_of_order(5))
+    assert any(condition_residual(t, EXACT_B) != 0 for t in trees_of_order(6))
+
+
+def test_float_tableau_matches_exact():
+    assert CASH_KARP.order == 5 and CASH_KARP.stages == STAGES
+    assert CASH_KARP.c == tuple(float(x) for x in EXACT_C)
+    assert CASH_KARP.b == tuple(float(x) for x in EXACT_B)
+    assert CASH_KARP.b_hat == tuple(float(x) for x in EXACT_B_HAT)
+    assert CASH_KARP.a == tuple(tuple(float(x) for x in row) for row in EXACT_A)
+    for e, b, bh in zip(CASH_KARP.e, EXACT_B, EXACT_B_HAT):
+        assert e == pytest.approx(float(b - bh), rel=0, abs=2**-53)
+
+
+# ---- the compiled step on the Kepler problem -------------------------------------------------
+ECC = 0.3            # mean motion 1, semimajor axis 1, μ = 1: period 2π
+vec4 = ti.types.vector(4, ti.f64)
+nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
+nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
+nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
+
+
+def kepler_exact(t):
+    """(x, y, vx, vy) at time t from pericentre on the +x axis (Kepler's equation by Newton)."""
+    E = t
+    for _ in range(50):
+        E -= (E - ECC * math.sin(E) - t) / (1.0 - ECC * math.cos(E))
+    w = 1.0 / (1.0 - ECC * math.cos(E))
+    s = math.sqrt(1.0 - ECC**2)
+    return np.array([math.cos(E) - ECC, s * math.sin(E), -math.sin(E) * w, s * math.cos(E) * w])
+
+
+@ti.func
+def kepler_rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """Planar Kepler problem, μ = 1 (p, i, order, odd unused: make_step's RHS contract)."""
+    r2 = y[0] * y[0] + y[1] * y[1]
+    inv_r3 = 1.0 / (r2 * ti.sqrt(r2))
+    return vec4(y[2], y[3], -y[0] * inv_r3, -y[1] * inv_r3)
+
+
+def make_fixed_step_kernel(tableau):
+    step = make_step(kepler_rhs, 4, tableau)
+
+    @ti.kernel
+    def fixed_steps(y0: nd1f, h: nd1f, n_steps: nd1i, y_end: nd2f, dy_first: nd2f,
+                    err_first: nd2f):
+        """Member j: n_steps[j] steps of size h[j] from y0, k1 = f(y) recomputed each step."""
+        for j in range(h.shape[0]):
+            y = vec4(y0[0], y0[1], y0[2], y0[3])
+            for k in range(n_steps[j]):
+                k1 = kepler_rhs(y0, j, y, 4, False)
+                dy, err = step(y0, j, y, k1, h[j], 4, False)
+                if k == 0:
+                    for c in ti.static(range(4)):
+                        dy_first[j, c] = dy[c]
+                        err_first[j, c] = err[c]
+                y += dy
+            for c in ti.static(range(4)):
+                y_end[j, c] = y[c]
+
+    def run(y0, h, n_steps):
+        h = np.asarray(h, dtype=np.float64)
+        outs = [np.zeros((len(h), 4)) for _ in range(3)]
+        fixed_steps(np.asarray(y0, dtype=np.float64), h,
+                    np.asarray(n_steps, dtype=np.int32), *outs)
+        return outs
+
+    return run
+
+
+@pytest.fixture(scope="module")
+def cash_karp_steps():
+    runtime.ensure_init()
+    return make_fixed_step_kernel(CASH_KARP)
+
+
+T_END = 3.0                                   # about half an orbit, through pericentre region
+N_STEPS = np.array([24, 34, 48, 68, 96])
+
+
+def global_errors(run):
+    h = T_END / N_STEPS
+    y_end, _, _ = run(kepler_exact(0.0), h, N_STEPS)
+    exact = kepler_exact(T_END)
+    return h, np.max(np.abs(y_end - exact), axis=1)
+
+
+def test_global_error_is_fifth_order(cash_karp_steps):
+    h, err = global_errors(cash_karp_steps)
+    assert np.all(err > 1e-12), err           # well above round-off: the fit sees truncation
+    assert np.all(np.diff(err) < 0), err
+    slope = np.polyfit(np.log(h), np.log(err), 1)[0]
+    assert slope == pytest.approx(5.0, abs=0.3), (slope, err)
+
+
+def test_slope_fit_tells_fourth_from_fifth_order():
+    """Negative control: propagating the embedded weights instead (an order-4 method) gives
+    slope 4 on the same problem, so the fit above really discriminates."""
+    runtime.ensure_init()
+    swapped = Tableau("embedded 4th order", 4, CASH_KARP.c, CASH_KARP.a,
+                      CASH_KARP.b_hat, CASH_KARP.b)
+    h, err = global_errors(make_fixed_step_kernel(swapped))
+    slope = np.polyfit(np.log(h), np.log(err), 1)[0]
+    assert slope == pytest.approx(4.0, abs=0.3), (slope, err)
+
+
+def test_local_error_estimate(cash_karp_steps):
+    """One step from a generic point of the orbit: err = y5 − y4 scales like h^5, equals the
+    true local error of the embedded 4th-order solution within 10 % (so it bounds it within a
+    small factor), and the propagated 5th-order solution is locally O(h^6) and smaller still."""
+    t0 = 0.7
+    y0 = kepler_exact(t0)
+    h = 0.1 * 2.0 ** (-np.arange(6) / 2)
+    _, dy, err = cash_karp_steps(y0, h, np.ones(len(h), dtype=np.int32))
+    exact = np.array([kepler_exact(t0 + hj) for hj in h]) - y0
+    true5 = np.max(np.abs(exact - dy), axis=1)
+    true4 = np.max(np.abs(exact - (dy - err)), axis=1)
+    est = np.max(np.abs(err), axis=1)
+    assert np.all(true5 > 1e-13), true5       # the smallest local error still above round-off
+    slope = {name: np.polyfit(np.log(h), np.log(v), 1)[0]
+             for name, v in (("est", est), ("true4", true4), ("true5", true5))}
+    assert slope["est"] == pytest.approx(5.0, abs=0.3), slope
+    assert slope["true4"] == pytest.approx(5.0, abs=0.3), slope
+    assert slope["true5"] == pytest.approx(6.0, abs=0.3), slope
+    ratio = est / true4
+    assert np.all((ratio > 0.9) & (ratio < 1.1)), ratio
+    assert np.all(true5 < 0.3 * est), true5 / est
