@@ -79,3 +79,10 @@ def secondary_spin_period(name):
     """Initial spin period of the secondary in s where the catalogue gives one, else None."""
     h = _data()[_resolve(name)].get("secondary_spin_period_h")
     return None if h is None else h * HOUR
+
+
+def section_starts(name):
+    """Initial θ̇_p/n of the paper's surfaces of section for this system (θ_p = 0), or a
+    default spread over 0.5-2.5 where the paper shows none."""
+    values = _data()[_resolve(name)].get("section_thetadot_p")
+    return list(values) if values else [0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5]
