@@ -163,7 +163,10 @@ def _derived_columns(par, records, names, ensemble=None):
     width = max([len(r) for r in records] + [1])
     cols = {k: np.full((len(records), width), np.nan) for k in ("t",) + tuple(names)}
     if ensemble is not None:
-        cols["energy"] = np.full((len(records), width), np.nan)
+        for k in ("energy_orbit", "energy_primary", "energy_secondary"):
+            cols[k] = np.full((len(records), width), np.nan)
+        for k in ("angmom_orbit", "angmom_primary", "angmom_secondary"):
+            cols[k] = np.full((len(records), width, 3), np.nan)
     for i, rec in enumerate(records):
         if not len(rec):
             continue
@@ -173,7 +176,10 @@ def _derived_columns(par, records, names, ensemble=None):
             cols[k][i, :len(rec)] = d[k]
         if ensemble is not None:
             diag = ensemble.diagnostics(rec[:, 1:], np.full(len(rec), i))
-            cols["energy"][i, :len(rec)] = diag[:, :3].sum(1)
+            for c, k in enumerate(("energy_orbit", "energy_primary", "energy_secondary")):
+                cols[k][i, :len(rec)] = diag[:, c]
+            for c, k in enumerate(("angmom_orbit", "angmom_primary", "angmom_secondary")):
+                cols[k][i, :len(rec)] = diag[:, 3 + 3 * c:6 + 3 * c]
     return cols
 
 
@@ -183,7 +189,10 @@ class TimeSeriesResult:
 
     ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
     long axis from the initial pericentre direction (inertial, orbit plane); ``thetadot``
-    spin rate about the orbit normal, units of n; ``r`` m; ``energy`` total, J."""
+    spin rate about the orbit normal, units of n; ``r`` m; ``energy`` total, J, and its split
+    ``energy_orbit`` (|P|²/2m + V), ``energy_primary``, ``energy_secondary`` (spins), J;
+    ``angmom_orbit``, ``angmom_primary``, ``angmom_secondary`` inertial angular momenta,
+    (N, samples, 3), kg m² s⁻¹."""
 
     t: np.ndarray
     alpha: np.ndarray
@@ -191,6 +200,12 @@ class TimeSeriesResult:
     thetadot: np.ndarray
     r: np.ndarray
     energy: np.ndarray
+    energy_orbit: np.ndarray
+    energy_primary: np.ndarray
+    energy_secondary: np.ndarray
+    angmom_orbit: np.ndarray
+    angmom_primary: np.ndarray
+    angmom_secondary: np.ndarray
     status: np.ndarray
     systems: list = field(repr=False)
     initial_theta_p: np.ndarray = None
@@ -215,8 +230,11 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r"), ensemble=ens)
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
-    e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])
+    e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])[:, None]
+    l_unit = (e_unit / n[:, None])[..., None]
+    energies = {k: cols[k] * e_unit for k in ("energy_orbit", "energy_primary", "energy_secondary")}
     return TimeSeriesResult(
         t=cols["t"] / n[:, None], alpha=np.degrees(cols["alpha"]), theta=np.degrees(cols["theta"]),
-        thetadot=cols["thetadot"], r=cols["r"] * a[:, None], energy=cols["energy"] * e_unit[:, None],
+        thetadot=cols["thetadot"], r=cols["r"] * a[:, None], energy=sum(energies.values()),
+        **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
         status=out.status, systems=members, initial_theta_p=tp, initial_thetadot_p=td)
