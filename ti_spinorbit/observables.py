@@ -4,7 +4,8 @@ The kernels record the raw 30-element state at events and samples; everything a 
 reads is derived here, vectorised over records:
 
 * α: angle from the line of centres to the secondary's long axis, measured about the orbit
-  normal (R × V), in (−π, π]. At pericentre this is the section angle θ_p.
+  normal (R × V), in (−π, π]: α = θ − f, so at pericentre α is the section angle θ_p.
+  (physics.md §7 writes θ + α = f, i.e. the opposite sign; amplitudes are the same.)
 * θ̇: the secondary's inertial spin rate about the orbit normal, units of n.
 * θ: the long axis's angle from the inertial x axis (the initial pericentre direction) in the
   inertial xy plane (the initial orbit plane).
