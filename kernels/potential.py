@@ -83,6 +83,26 @@ def _powers(x):
 
 
 @ti.func
+def _monomials(p: ti.template(), i, off: ti.template(), table: ti.template(), px, py, pz,
+               odd: ti.template()):
+    """Q = Σ c T^{lmn} x^l y^m z^n over a monomial table and its gradient; with ``odd``
+    False the monomials with an odd exponent are not emitted."""
+    q = 0.0
+    dq = vec3(0.0)
+    for o, c, k, even in ti.static(table):
+        if ti.static(odd or even):
+            t = c * p[i, off + o]
+            q += t * px[k[0]] * py[k[1]] * pz[k[2]]
+            if ti.static(k[0] > 0):
+                dq[0] += t * k[0] * px[k[0] - 1] * py[k[1]] * pz[k[2]]
+            if ti.static(k[1] > 0):
+                dq[1] += t * k[1] * px[k[0]] * py[k[1] - 1] * pz[k[2]]
+            if ti.static(k[2] > 0):
+                dq[2] += t * k[2] * px[k[0]] * py[k[1]] * pz[k[2] - 1]
+    return q, dq
+
+
+@ti.func
 def single_body_terms(p: ti.template(), i, off: ti.template(), u, order: ti.template(),
                       odd: ti.template()):
     """L2, L3, L4 of one body for the unit vector ``u`` in that body's frame, and their free
@@ -100,17 +120,7 @@ def single_body_terms(p: ti.template(), i, off: ti.template(), u, order: ti.temp
     py = _powers(u[1])
     pz = _powers(u[2])
     if ti.static(order >= 3 and odd):
-        q3 = 0.0
-        dq3 = vec3(0.0)
-        for o, c, k in ti.static([(m[0], m[1], m[2]) for m in _MONO3]):
-            t = c * p[i, off + o]
-            q3 += t * px[k[0]] * py[k[1]] * pz[k[2]]
-            if ti.static(k[0] > 0):
-                dq3[0] += t * k[0] * px[k[0] - 1] * py[k[1]] * pz[k[2]]
-            if ti.static(k[1] > 0):
-                dq3[1] += t * k[1] * px[k[0]] * py[k[1] - 1] * pz[k[2]]
-            if ti.static(k[2] > 0):
-                dq3[2] += t * k[2] * px[k[0]] * py[k[1]] * pz[k[2] - 1]
+        q3, dq3 = _monomials(p, i, off, _MONO3, px, py, pz, True)
         v3 = vec3(0.0)
         for pat, terms, _even in ti.static(_CONTRACT3):
             axis = ti.static(0 if pat[0] else (1 if pat[1] else 2))
@@ -118,18 +128,7 @@ def single_body_terms(p: ti.template(), i, off: ti.template(), u, order: ti.temp
         L3 = 2.5 * q3 - 1.5 * v3.dot(u)
         g3 = 2.5 * dq3 - 1.5 * v3
     if ti.static(order >= 4):
-        q4 = 0.0
-        dq4 = vec3(0.0)
-        for o, c, k, even in ti.static(_MONO4):
-            if ti.static(odd or even):
-                t = c * p[i, off + o]
-                q4 += t * px[k[0]] * py[k[1]] * pz[k[2]]
-                if ti.static(k[0] > 0):
-                    dq4[0] += t * k[0] * px[k[0] - 1] * py[k[1]] * pz[k[2]]
-                if ti.static(k[1] > 0):
-                    dq4[1] += t * k[1] * px[k[0]] * py[k[1] - 1] * pz[k[2]]
-                if ti.static(k[2] > 0):
-                    dq4[2] += t * k[2] * px[k[0]] * py[k[1]] * pz[k[2] - 1]
+        q4, dq4 = _monomials(p, i, off, _MONO4, px, py, pz, odd)
         # K_ij = S4_ijkk (symmetric); Q2 = u.K.u, Q0 = tr K
         K = mat3(0.0)
         for pat, terms, even in ti.static(_CONTRACT4):
