@@ -86,3 +86,11 @@ def section_starts(name):
     default spread over 0.5-2.5 where the paper shows none."""
     values = _data()[_resolve(name)].get("section_thetadot_p")
     return list(values) if values else [0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5]
+
+
+def heliocentric_orbit(name):
+    """(a in AU, e) of the system's heliocentric orbit where catalogued, else None."""
+    d = _data()[_resolve(name)]
+    if "heliocentric_a_au" not in d:
+        return None
+    return d["heliocentric_a_au"], d["heliocentric_e"]

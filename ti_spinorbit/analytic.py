@@ -1,0 +1,429 @@
+"""Analytic spin-orbit theory of the decoupled problem, the yardstick for the simulations.
+
+The secondary is a rigid body on a fixed Keplerian orbit about a point mass, spinning about
+its short axis in the orbit plane (physics-derivations.md §4.1):
+
+    θ̈ + (ω0² n²/2) (a/r)³ sin 2(θ − f) = 0,     ω0² = 3 (B − A) / C,
+
+θ the long axis from the pericentre direction, f the true anomaly, M the mean anomaly, n the
+mean motion. Everything here is pure NumPy and closed form (or a spectrally converged
+quadrature); frequencies and spin rates are in units of n, angles in radians, energies in J.
+
+* ω0 of an ellipsoid and its inverse, and the coupled-problem correction
+  ω0,eff² = ω0² m1/(m1 + m2) (physics.md §8, physics-derivations.md §4.7).
+* Forced libration in synchronous rotation, ψ_A = 2e/(ω0² − 1) (Murray & Dermott 1999 §5;
+  physics-derivations.md §4.2).
+* Cayley's coefficients H(p, e) (Cayley 1859 via Murray & Dermott 1999 §5.4, Table 5.1;
+  physics-derivations.md §4.3), resonance half-widths ω0 √|H(p, e)| (Wisdom, Peale & Mignard
+  1984; Murray & Dermott 1999 §5.4; derivations §4.4).
+* Resonance overlap ω0_RO = 1/(2 + √(14 e)) and the chaotic separatrix layer
+  ΔE/E0 ≈ (14π e/ω0³) exp(−π/(2ω0)) (Wisdom, Peale & Mignard 1984, as used by Naidu &
+  Margot 2015; derivations §4.5–4.6).
+* Energy budgets per orbit that compete with chaotic spin-energy changes (physics.md §8):
+  tides (Murray & Dermott 1999 ch. 4–5; k2 of rubble piles from Goldreich & Sari 2009 or
+  Jacobson & Scheeres 2011) and YORP (Naidu & Margot 2015), normalised by the separatrix
+  energy E0 = n² ω0² C/4.
+
+Reference paper: Naidu & Margot 2015, AJ 149:80.
+"""
+
+import math
+
+import numpy as np
+
+from ._validate import require_count, require_finite, require_positive, require_range
+from .systems import G
+
+#: Nominal solar luminosity, W (IAU 2015 Resolution B3).
+L_SUN = 3.828e26
+#: Speed of light, m/s.
+C_LIGHT = 299792458.0
+#: Astronomical unit, m (IAU 2012).
+AU = 1.495978707e11
+
+#: Chaotic-layer coefficient as quoted by Naidu & Margot 2015 from Wisdom, Peale & Mignard 1984.
+CHAOTIC_LAYER_COEFFICIENT_QUOTED = 14.0 * math.pi
+#: Melnikov/Chirikov coefficient for the circulation-side border with E0 = n²ω0²C/4
+#: (physics-derivations.md §4.5).
+CHAOTIC_LAYER_COEFFICIENT_MELNIKOV = 28.0 * math.pi
+
+#: Default tidal quality factor (physics.md §8).
+DEFAULT_Q = 100.0
+#: Default YORP efficiency f_Y (physics.md §8).
+DEFAULT_F_YORP = 5e-4
+
+#: Rubble-pile Love numbers k2(R_s) with R_s in km.
+K2_MODELS = {
+    "goldreich-sari": lambda radius_km: 1e-5 * radius_km,         # Goldreich & Sari 2009
+    "jacobson-scheeres": lambda radius_km: 2.5e-5 / radius_km,    # Jacobson & Scheeres 2011
+}
+
+# Cayley series H(p, e) = Σ c_k e^k (physics-derivations.md §4.3, re-derived with sympy),
+# keyed by 2p so that half-integer p are exact dictionary keys.
+_CAYLEY_SERIES = {
+    -1: {3: 1 / 48, 5: 11 / 768},
+    0: {},
+    1: {1: -1 / 2, 3: 1 / 16, 5: -5 / 384},
+    2: {0: 1.0, 2: -5 / 2, 4: 13 / 16, 6: -35 / 288},
+    3: {1: 7 / 2, 3: -123 / 16, 5: 489 / 128},
+    4: {2: 17 / 2, 4: -115 / 6, 6: 601 / 48},
+    5: {3: 845 / 48, 5: -32525 / 768},
+    6: {4: 533 / 16, 6: -13827 / 160},
+}
+
+
+def _result(x):
+    """0-d arrays come back as Python floats, others as float64 arrays."""
+    x = np.asarray(x, dtype=np.float64)
+    return float(x) if x.ndim == 0 else x
+
+
+def _eccentricity(e):
+    require_range("e", e, 0.0, 1.0)
+    return np.asarray(e, dtype=np.float64)
+
+
+def _omega0(omega0):
+    require_positive("omega0", omega0)
+    return np.asarray(omega0, dtype=np.float64)
+
+
+# ---- the libration frequency ω0 -------------------------------------------------------------
+def omega0(a_over_b):
+    """ω0 = sqrt(3 (q² − 1)/(q² + 1)) of a uniform ellipsoid spinning about its short axis.
+
+    Parameters
+    ----------
+    a_over_b : float or array
+        Elongation q = a/b >= 1 (dimensionless).
+
+    Returns
+    -------
+    Free libration frequency in units of the mean motion n, in [0, sqrt(3)).
+    """
+    require_range("a_over_b", a_over_b, 1.0, np.inf)
+    q2 = np.asarray(a_over_b, dtype=np.float64) ** 2
+    return _result(np.sqrt(3.0 * (q2 - 1.0) / (q2 + 1.0)))
+
+
+def omega0_from_moments(A, B, C):
+    """ω0 = sqrt(3 (B − A)/C) from principal moments A <= B <= C (kg m², any common unit).
+
+    C is the moment about the spin axis (the short axis); the result is in units of n."""
+    for label, value in (("A", A), ("B", B), ("C", C)):
+        require_positive(label, value)
+    A, B, C = (np.asarray(v, dtype=np.float64) for v in (A, B, C))
+    if np.any(A > B) or np.any(B > C):
+        raise ValueError(f"principal moments must satisfy A <= B <= C (got A={A}, B={B}, C={C})")
+    return _result(np.sqrt(3.0 * (B - A) / C))
+
+
+def omega0_effective(system):
+    """ω0 of the coupled problem: sqrt(3 (B − A)/C · m1/(m1 + m2)), in units of n.
+
+    The torque on the secondary scales with G m1 while n² a³ = G (m1 + m2), so written with the
+    true mean motion the decoupled equation carries the primary's mass fraction (physics.md §8,
+    physics-derivations.md §4.7). ``system`` is a :class:`~ti_spinorbit.systems.BinarySystem`;
+    A, B, C are its secondary's moments about x, y, z."""
+    fraction = system.primary.mass / system.total_mass
+    return omega0_from_moments(*system.secondary.moments) * math.sqrt(fraction)
+
+
+def elongation_from_omega0(omega0):
+    """Inverse of :func:`omega0`: a/b = sqrt((3 + ω0²)/(3 − ω0²)) for 0 <= ω0 < sqrt(3)."""
+    require_range("omega0", omega0, 0.0, math.sqrt(3.0))
+    w2 = np.asarray(omega0, dtype=np.float64) ** 2
+    return _result(np.sqrt((3.0 + w2) / (3.0 - w2)))
+
+
+# ---- forced libration -----------------------------------------------------------------------
+def psi_A(omega0, e):
+    """Forced libration amplitude ψ_A = 2e/(ω0² − 1), radians (first order in e).
+
+    ψ = θ − f is the angle of the long axis from the line of centres; physics.md §7 calls it α
+    with the opposite sign (θ + α = f), which leaves the amplitude unchanged. In synchronous
+    rotation ψ = ψ_A sin M. For ω0 < 1 the value is negative (the response is in antiphase):
+    the amplitude is |ψ_A|, larger than 2e. It diverges at the forced resonance ω0 = 1, which
+    is rejected.
+
+    Parameters
+    ----------
+    omega0 : float or array
+        Free libration frequency in units of n, > 0 and != 1.
+    e : float or array
+        Orbital eccentricity in [0, 1).
+    """
+    w2 = _omega0(omega0) ** 2
+    e = _eccentricity(e)
+    if np.any(w2 == 1.0):
+        raise ValueError("omega0 = 1 is the forced resonance: psi_A = 2e/(omega0^2 - 1) diverges")
+    return _result(2.0 * e / (w2 - 1.0))
+
+
+def forced_amplitude_mean_direction(omega0, e):
+    """Amplitude of θ − M, the long axis from the uniformly rotating mean direction:
+    2e ω0²/(ω0² − 1), radians. Same conventions and validity as :func:`psi_A`; it equals
+    ψ_A + 2e, the optical libration 2e sin M of the line of centres added back."""
+    return _result(np.asarray(psi_A(omega0, e)) * np.asarray(omega0, dtype=np.float64) ** 2)
+
+
+# ---- Cayley coefficients and resonance widths -----------------------------------------------
+def _two_p(p):
+    p = np.asarray(p, dtype=np.float64)
+    require_finite("p", p)
+    two_p = np.round(2.0 * p)
+    if np.any(np.abs(2.0 * p - two_p) > 1e-12):
+        raise ValueError(f"p must be an integer or half-integer (spin rate p n), got {p!r}")
+    return two_p
+
+
+def cayley_H(p, e, n=4096):
+    """Cayley's coefficient H(p, e), the Fourier coefficients of (a/r)³ exp(2if) in M:
+
+        (a/r)³ e^{2if} = Σ_p H(p, e) e^{2ipM},
+        H(p, e) = (1/2π) ∮ (a/r)³ cos(2f − 2pM) dM.
+
+    Evaluated by the trapezoid rule in the true anomaly f (dM = (r/a)² df / sqrt(1 − e²)),
+    which converges exponentially for this smooth periodic integrand (physics-derivations.md
+    §4.3). n = 4096 points give ~1e-15 for e <= 0.5; raise n as e approaches 1.
+
+    Parameters
+    ----------
+    p : float or array
+        Resonance p (spin rate p n), an integer or half-integer.
+    e : float or array
+        Eccentricity in [0, 1); broadcasts against p.
+    n : int
+        Number of quadrature nodes in f (>= 16).
+
+    Returns
+    -------
+    H(p, e), dimensionless; H(1, 0) = 1 and H(p != 1, 0) = 0.
+    """
+    two_p = _two_p(p)
+    e = _eccentricity(e)
+    n = require_count("n", n, minimum=16)
+    two_p, e = np.broadcast_arrays(two_p, e)
+    two_p, e = two_p[..., None], e[..., None]
+    f = 2.0 * np.pi * np.arange(n) / n
+    E = 2.0 * np.arctan2(np.sqrt(1.0 - e) * np.sin(f / 2), np.sqrt(1.0 + e) * np.cos(f / 2))
+    M = E - e * np.sin(E)
+    # (a/r)³ dM = (a/r) df / sqrt(1 − e²), with a/r = (1 + e cos f)/(1 − e²)
+    weight = (1.0 + e * np.cos(f)) / (1.0 - e**2) ** 1.5
+    return _result(np.mean(weight * np.cos(2.0 * f - two_p * M), axis=-1))
+
+
+def cayley_H_series(p, e):
+    """Cayley's H(p, e) from its series in e (physics-derivations.md §4.3, Murray & Dermott 1999
+    Table 5.1), for p in {−1/2, 0, 1/2, 1, 3/2, 2, 5/2, 3} (scalar) and e in [0, 1) (array ok).
+
+    The series stop at e⁵ or e⁶ (the next term is O(e⁷) or O(e⁸)); use :func:`cayley_H` for
+    anything beyond small e."""
+    two_p = _two_p(p)
+    if two_p.ndim != 0 or int(two_p) not in _CAYLEY_SERIES:
+        raise ValueError(f"p must be one of -1/2, 0, 1/2, 1, 3/2, 2, 5/2, 3 for the series "
+                         f"(got {p!r}); use cayley_H for other p")
+    e = _eccentricity(e)
+    terms = _CAYLEY_SERIES[int(two_p)]
+    return _result(sum((c * e**k for k, c in terms.items()), np.zeros_like(e)))
+
+
+def resonance_half_width(p, omega0, e):
+    """Half-width of the p n spin-orbit resonance, ω0 sqrt(|H(p, e)|), in units of n.
+
+    From averaging near θ̇ = p n: γ = θ − pM obeys the pendulum γ̈ = −(ω0²/2) H(p, e) sin 2γ,
+    whose separatrix reaches |θ̇ − p n| = ω0 sqrt(|H|) (Wisdom, Peale & Mignard 1984; Murray &
+    Dermott 1999 §5.4; physics-derivations.md §4.4). H is the quadrature :func:`cayley_H`.
+    ``p`` (integer or half-integer), ``omega0`` (> 0) and ``e`` (in [0, 1)) broadcast."""
+    w = _omega0(omega0)
+    return _result(w * np.sqrt(np.abs(cayley_H(p, e))))
+
+
+# ---- resonance overlap and the chaotic layer ------------------------------------------------
+def omega0_overlap(e):
+    """ω0_RO = 1/(2 + sqrt(14 e)): the synchronous (half-width ≈ ω0) and 3:2 (half-width
+    ω0 sqrt(7e/2)) islands touch when ω0 (1 + sqrt(7e/2)) = 1/2 (Chirikov criterion as used by
+    Wisdom, Peale & Mignard 1984; physics-derivations.md §4.6). Units of n; e in [0, 1)."""
+    e = _eccentricity(e)
+    return _result(1.0 / (2.0 + np.sqrt(14.0 * e)))
+
+
+def overlap_elongation(e, primary_mass_fraction=1.0):
+    """Elongation a/b at which the 1:1 and 3:2 resonances overlap, from :func:`omega0_overlap`.
+
+    With ``primary_mass_fraction`` = m1/(m1 + m2) < 1 the threshold is on the coupled
+    problem's ω0,eff = ω0 sqrt(m1/(m1 + m2)) (see :func:`omega0_effective`), i.e. the ellipsoid
+    must reach ω0 = ω0_RO / sqrt(m1/(m1 + m2)); the default 1 is the decoupled theory."""
+    require_range("primary_mass_fraction", primary_mass_fraction, 0.0, 1.0,
+                  low_open=True, high_open=False)
+    threshold = np.asarray(omega0_overlap(e)) / np.sqrt(primary_mass_fraction)
+    return elongation_from_omega0(threshold)
+
+
+def chaotic_layer_half_width(omega0, e, coefficient=CHAOTIC_LAYER_COEFFICIENT_QUOTED):
+    """Half-width of the chaotic layer about the synchronous separatrix, as ΔE/E0:
+
+        ΔE/E0 ≈ (coefficient · e / ω0³) exp(−π/(2 ω0)),   E0 = n² ω0² C/4.
+
+    The default coefficient 14π is the formula as quoted by Naidu & Margot 2015 from Wisdom,
+    Peale & Mignard 1984; it is what the paper plots, so reproductions should use it, as an
+    order-of-magnitude estimate.
+
+    Caveat (physics-derivations.md §4.5): a Melnikov/Chirikov derivation for the dominant
+    p = 3/2 perturbation gives a kick W = 28π e ω0⁻² exp(−π/(2ω0)) per separatrix passage in
+    units of E0 = n²ω0²C/4, and a layer border λW = 28π e ω0⁻³ exp(−π/(2ω0)) (λ = 1/ω0) on the
+    circulation side, about twice that on the libration side. 14π is λW/2, which is what the
+    same estimate gives if E0 is the full well depth n²ω0²C/2. Layers measured numerically are
+    1.2–1.4 × the 28π form (circulation side) and ~2 × it (libration side): the 14π form
+    underestimates by a factor 2.5–4. Pass ``coefficient=CHAOTIC_LAYER_COEFFICIENT_MELNIKOV``
+    (28π) for the Melnikov estimate; measure the layer with ensembles for quantitative work.
+
+    Parameters
+    ----------
+    omega0 : float or array
+        Free libration frequency in units of n, > 0.
+    e : float or array
+        Eccentricity in [0, 1).
+    coefficient : float
+        Prefactor, > 0 (default 14π).
+
+    Returns
+    -------
+    ΔE/E0, dimensionless (broadcast of omega0 and e).
+    """
+    w = _omega0(omega0)
+    e = _eccentricity(e)
+    require_positive("coefficient", coefficient)
+    return _result(coefficient * e / w**3 * np.exp(-np.pi / (2.0 * w)))
+
+
+# ---- energy budgets per orbit ---------------------------------------------------------------
+def separatrix_energy(system, omega0=None):
+    """E0 = n² ω0² C / 4, J: the energy scale of the synchronous separatrix.
+
+    n is the system's mean motion (rad/s), C the secondary's largest principal moment
+    (kg m²) and ω0 (units of n) the system's ``omega0`` unless given, e.g.
+    ``omega0_effective(system)`` for the coupled-problem value."""
+    w = system.omega0 if omega0 is None else omega0
+    require_positive("omega0", w)
+    C = float(np.max(system.secondary.moments))
+    return system.mean_motion**2 * w**2 * C / 4.0
+
+
+def secondary_radius(system):
+    """R_s = sqrt(a_s b_s), m: the secondary's mean equatorial radius (physics.md §9, ab = R_s²)."""
+    axes = getattr(system.secondary, "semi_axes", None)
+    if axes is None:
+        raise ValueError("the secondary has no semi_axes (not an Ellipsoid): R_s = sqrt(a b) "
+                         "is undefined; pass radius= (m) explicitly")
+    return math.sqrt(axes[0] * axes[1])
+
+
+def love_number_k2(radius, model="goldreich-sari"):
+    """Rubble-pile Love number k2 of a body of radius ``radius`` (m), dimensionless.
+
+    ``model``: "goldreich-sari", k2 = 1e-5 R[km] (Goldreich & Sari 2009), or
+    "jacobson-scheeres", k2 = 2.5e-5 / R[km] (Jacobson & Scheeres 2011)."""
+    require_positive("radius", radius)
+    if model not in K2_MODELS:
+        raise ValueError(f"k2_model must be one of {', '.join(K2_MODELS)} or a number > 0 "
+                         f"(got {model!r})")
+    return _result(K2_MODELS[model](np.asarray(radius, dtype=np.float64) / 1e3))
+
+
+def tidal_energy_per_orbit(system, k2_model="goldreich-sari", Q=DEFAULT_Q, radius=None):
+    """Tidal energy dissipated in the secondary per orbit, J (Murray & Dermott 1999; physics.md §8):
+
+        δE_tides = π (3/2) (k2/Q) (n⁴/G) R_s⁵.
+
+    n⁴ R⁵/G has units s⁻⁴ m⁵ / (m³ kg⁻¹ s⁻²) = kg m² s⁻² = J. With n² a³ ≈ G m1 this is π times
+    the tidal torque (3/2)(k2/Q) G m1² R_s⁵/a⁶; n here is the system's mean motion,
+    n² a³ = G (m1 + m2).
+
+    Parameters
+    ----------
+    system : BinarySystem
+        Supplies n (rad/s) and, unless ``radius`` is given, R_s = sqrt(a_s b_s) of its
+        ellipsoidal secondary.
+    k2_model : str or float
+        "goldreich-sari", "jacobson-scheeres" (see :func:`love_number_k2`) or k2 itself (> 0).
+    Q : float
+        Tidal quality factor, > 0 (default 100).
+    radius : float, optional
+        R_s in m, overriding the secondary's sqrt(a b).
+    """
+    R = secondary_radius(system) if radius is None else radius
+    require_positive("radius", R)
+    require_positive("Q", Q)
+    if isinstance(k2_model, str):
+        k2 = love_number_k2(R, k2_model)
+    else:
+        require_positive("k2_model", k2_model)
+        k2 = float(k2_model)
+    return math.pi * 1.5 * (k2 / Q) * system.mean_motion**4 / G * R**5
+
+
+def yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e, f_yorp=DEFAULT_F_YORP,
+                          radius=None):
+    """YORP energy input per orbit, J (Naidu & Margot 2015; physics.md §8):
+
+        δE_YORP = 2π R_s³ L_⊙ f_Y / (3 c d² sqrt(1 − e_⊙²)).
+
+    Units: m³ W / (m s⁻¹ m²) = W s = J. 1/(d² sqrt(1 − e_⊙²)) is the time average of 1/r² over
+    the heliocentric orbit, and the 2π makes it the work of the YORP torque
+    R_s³ L_⊙ f_Y/(3 c d² sqrt(1 − e_⊙²)) over one 2π turn: "per orbit" in the sense of the
+    paper, i.e. per mutual orbit for a secondary near synchronous rotation.
+
+    Parameters
+    ----------
+    system : BinarySystem
+        Supplies R_s = sqrt(a_s b_s) of its ellipsoidal secondary unless ``radius`` is given.
+    heliocentric_a_au : float
+        Heliocentric semimajor axis d of the binary, AU (> 0).
+    heliocentric_e : float
+        Heliocentric eccentricity e_⊙ in [0, 1).
+    f_yorp : float
+        YORP efficiency f_Y, > 0 (default 5e-4).
+    radius : float, optional
+        R_s in m, overriding the secondary's sqrt(a b).
+    """
+    R = secondary_radius(system) if radius is None else radius
+    require_positive("radius", R)
+    require_positive("heliocentric_a_au", heliocentric_a_au)
+    require_range("heliocentric_e", heliocentric_e, 0.0, 1.0)
+    require_positive("f_yorp", f_yorp)
+    d = heliocentric_a_au * AU
+    return (2.0 * math.pi * R**3 * L_SUN * f_yorp
+            / (3.0 * C_LIGHT * d**2 * math.sqrt(1.0 - heliocentric_e**2)))
+
+
+def energy_budget(system, heliocentric_a_au, heliocentric_e, Q=DEFAULT_Q, f_yorp=DEFAULT_F_YORP,
+                  omega0=None):
+    """Chaotic, tidal and YORP energy changes per orbit for one system, normalised by E0.
+
+    ω0 is the system's ``omega0`` unless given (e.g. ``omega0_effective(system)``); e is the
+    system's mutual-orbit eccentricity. Returns a dict of floats:
+
+    * ``omega0``, ``E0_J`` (:func:`separatrix_energy`);
+    * ``chaotic_dE_over_E0``: the 14π layer half-width (:func:`chaotic_layer_half_width`),
+      ``chaotic_dE_over_E0_melnikov``: the 28π one;
+    * ``tidal_dE_over_E0_goldreich_sari``, ``tidal_dE_over_E0_jacobson_scheeres`` and the
+      matching ``k2_goldreich_sari``, ``k2_jacobson_scheeres``;
+    * ``yorp_dE_over_E0``;
+    * ``R_s_m``, ``Q``, ``f_yorp``, ``heliocentric_a_au``, ``heliocentric_e`` (the inputs).
+    """
+    w = system.omega0 if omega0 is None else omega0
+    E0 = separatrix_energy(system, w)
+    R = secondary_radius(system)
+    out = {"omega0": float(w), "E0_J": E0, "R_s_m": R, "Q": float(Q), "f_yorp": float(f_yorp),
+           "heliocentric_a_au": float(heliocentric_a_au), "heliocentric_e": float(heliocentric_e),
+           "chaotic_dE_over_E0": chaotic_layer_half_width(w, system.e),
+           "chaotic_dE_over_E0_melnikov": chaotic_layer_half_width(
+               w, system.e, CHAOTIC_LAYER_COEFFICIENT_MELNIKOV)}
+    for model in K2_MODELS:
+        key = model.replace("-", "_")
+        out[f"k2_{key}"] = love_number_k2(R, model)
+        out[f"tidal_dE_over_E0_{key}"] = tidal_energy_per_orbit(system, model, Q) / E0
+    out["yorp_dE_over_E0"] = yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e,
+                                                   f_yorp) / E0
+    return out

@@ -1,0 +1,300 @@
+"""Relaxed-mode libration: the centre of the synchronous island and its libration amplitude.
+
+Physics (physics.md §7; Naidu & Margot 2015 §3). Let α be the angle between the secondary's
+long axis and the line of centres (θ + α = f). A synchronous (1:1) secondary librates in two
+modes: the *relaxed* mode at the orbital frequency, forced by the eccentric orbit, and the
+*excited* mode at the free, shape-dependent frequency. On the pericentre surface of section
+(θ_p, θ̇_p/n) the excited mode is the island's horizontal half extent; the relaxed mode is what
+is left at the island's centre, where the section trace shrinks to a point. Following Naidu &
+Margot, start at θ_p = 0 and vary θ̇_p(0)/n until the horizontal extent of the trace is ~0; the
+relaxed-mode amplitude is then max |α| over the whole trajectory, sampled densely (not only at
+pericentre, where the forced libration passes through zero).
+
+For a massless secondary on a fixed Keplerian orbit (physics-derivations.md §4.2) the forced
+solution is α = −ψ_A sin M with ψ_A = 2e/(ω0² − 1), ω0² = 3(B − A)/C; spin-orbit coupling
+changes this by an amount that depends on the mass ratio (§4.7 gives the first correction,
+ω0,eff² = ω0² m1/(m1 + m2)). Both values are reported next to the measured amplitude.
+
+Method of :func:`relaxed_libration`. Near the island centre c the trace of a start (0, θ̇0) is a
+small closed curve through that start and symmetric about θ_p = 0 (time-reversal symmetry), so
+its horizontal half extent E(θ̇0) = max |θ_p| (θ_p in (−90°, 90°]) is V-shaped,
+E ≈ k |θ̇0 − c|. The search
+
+1. launches a coarse bracket of candidates (default 45 over 0.2-1.3: coupling can move the
+   centre far from 1, e.g. to ≈ 0.45 for 1991 VH) once for the section and once densely, and
+   keeps the candidates whose α librates (the period-180° unwrapped α stays inside ±90°: this
+   rejects circulating and chaotic starts and the 1:2 and 3:2 islands, which also sit on
+   θ_p = 0 in the 180°-periodic section);
+2. takes the librating candidate with the smallest E and fits a straight line to each arm of
+   the V (the points on either side of the minimum, the minimum itself excluded); the arms'
+   intersection estimates c far more precisely than the grid spacing;
+3. zooms: a window of ``zoom_candidates`` around the estimate, one launch, refit on the whole
+   window; the first half-width is the coarse spacing, each next one two grid spacings of the
+   previous window (a factor 8 narrower for 33 candidates); until the half-width is below
+   ``xtol`` (the window moves without shrinking when the minimum lies on its edge);
+4. measures the extent at the final centre (one section launch) and the amplitude (one dense
+   time series, ``samples_per_orbit`` samples per orbit).
+"""
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import List
+
+import numpy as np
+
+from . import analytic
+from ._validate import require_count, require_finite, require_positive
+from .section import SystemLike, surface_of_section, time_series
+from .systems import BinarySystem
+
+#: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
+DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
+
+#: Samples per orbit of the coarse scan's libration check (α changes by < 90° per sample).
+CLASSIFY_SAMPLES_PER_ORBIT = 32
+
+#: A section trace that reaches beyond this |θ_p| (deg) is not treated as librating.
+LIBRATION_LIMIT_DEG = 85.0
+
+
+def wrap_half_turn(angle_deg):
+    """Map angles (deg) to (−90°, 90°]: the secondary's long axis is symmetric under 180°."""
+    return 90.0 - np.mod(90.0 - np.asarray(angle_deg, dtype=np.float64), 180.0)
+
+
+def section_extent(section):
+    """Horizontal half extent of each member's section trace, deg: max |θ_p| with θ_p in
+    (−90°, 90°]; NaN where the member stopped early (collision, escape, ...) or has no point."""
+    from .kernels.ensemble import DONE
+
+    theta = wrap_half_turn(section.theta_p)
+    extent = np.full(len(section.count), np.nan)
+    ok = (section.status == DONE) & (section.count > 0)
+    extent[ok] = np.nanmax(np.abs(theta[ok]), axis=1)
+    return extent
+
+
+def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
+                        rtol=1e-12):
+    """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
+
+    α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
+    inside ±90°. All starts run in one kernel launch.
+
+    Parameters
+    ----------
+    system : BinarySystem or list of BinarySystem
+        Broadcast against ``thetadot_p`` as in :func:`~ti_spinorbit.surface_of_section`.
+    thetadot_p : float or array
+        Initial spin rate of the secondary, units of n.
+    orbits : float
+        Integration time in initial orbital periods.
+    samples_per_orbit : int
+        Samples of α per orbital period (α's maximum falls between pericentres).
+    rtol : float
+        Integrator tolerance.
+
+    Returns
+    -------
+    float or ndarray
+        Amplitude in degrees, one per member (a float for a single member); NaN where α
+        circulates or the integration stopped early (collision, escape, ...).
+    """
+    from .kernels.ensemble import DONE
+
+    ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
+                     rtol=rtol)
+    amplitude = np.full(len(ts.status), np.nan)
+    for i, alpha in enumerate(ts.alpha):
+        alpha = alpha[np.isfinite(alpha)]
+        if ts.status[i] != DONE or not len(alpha):
+            continue
+        excursion = np.max(np.abs(np.unwrap(alpha, period=180.0)))
+        if excursion < 90.0:
+            amplitude[i] = excursion
+    return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
+
+
+def _psi_A_deg(omega0, e):
+    """ψ_A = 2e/(ω0² − 1) in degrees; inf at the forced resonance ω0 = 1 (0 for e = 0)."""
+    if omega0 == 1.0:
+        return math.inf if e else 0.0
+    return math.degrees(analytic.psi_A(omega0, e))
+
+
+@dataclass
+class RelaxedLibration:
+    """Centre of the synchronous island and the relaxed-mode libration amplitude.
+
+    ``center_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
+    max |α| of that trajectory; ``extent`` deg, its section's horizontal half extent (the
+    excited mode left over); ``psi_A`` and ``psi_A_effective`` deg, the decoupled estimates
+    2e/(ω0² − 1) with ω0 and with ω0,eff² = ω0² m1/(m1+m2); ``iterations`` zoom launches;
+    ``candidates`` and ``extents`` the θ̇_p/n tried and their extents (deg), one array per
+    launch, the coarse bracket first (extent NaN where the start does not librate);
+    ``converged`` whether the final window is narrower than ``xtol``; ``seconds`` wall time."""
+
+    center_thetadot_p: float
+    amplitude: float
+    extent: float
+    psi_A: float
+    psi_A_effective: float
+    omega0: float
+    omega0_effective: float
+    iterations: int
+    converged: bool
+    candidates: List[np.ndarray] = field(repr=False)
+    extents: List[np.ndarray] = field(repr=False)
+    orbits: float = 0.0
+    rtol: float = 1e-12
+    samples_per_orbit: int = 256
+    xtol: float = 1e-6
+    seconds: float = 0.0
+    system: BinarySystem = field(default=None, repr=False)
+
+
+def _fit_v(x, extent, best):
+    """Centre of the V from straight lines fitted to its arms (points left and right of the
+    minimum ``best``, which itself may sit on either arm). Returns None when an arm has
+    fewer than two points or the lines do not cross between the minimum's neighbours."""
+    left = np.arange(best)
+    right = np.arange(best + 1, len(x))
+    left = left[np.isfinite(extent[left])]
+    right = right[np.isfinite(extent[right])]
+    if len(left) < 2 or len(right) < 2:
+        return None
+    sl, bl = np.polyfit(x[left], extent[left], 1)
+    sr, br = np.polyfit(x[right], extent[right], 1)
+    if not (sl < 0 < sr):
+        return None
+    center = (bl - br) / (sr - sl)
+    if not x[best - 1] <= center <= x[best + 1]:
+        return None
+    return float(center)
+
+
+def _arm_window(x, extent, best, points):
+    """Indices of up to ``points`` finite neighbours on each side of ``best`` (plus best)."""
+    finite = np.flatnonzero(np.isfinite(extent))
+    left = finite[finite < best][-points:]
+    right = finite[finite > best][:points]
+    return np.concatenate([left, [best], right])
+
+
+def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=None,
+                      zoom_candidates=33, xtol=1e-6, max_iterations=10,
+                      samples_per_orbit=256, coarse_arm_points=3) -> RelaxedLibration:
+    """Find the centre of the synchronous island and measure the relaxed libration amplitude.
+
+    Parameters
+    ----------
+    system : BinarySystem
+    orbits : float
+        Integration time of every trajectory, initial orbital periods (the section of each
+        candidate has about this many points).
+    rtol : float
+        Integrator tolerance.
+    candidates : array, optional
+        Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending; default
+        45 values over 0.2-1.3.
+    zoom_candidates : int
+        Candidates per zoom launch (odd, so the window's centre is one of them).
+    xtol : float
+        Stop zooming when the window's half-width is below this (units of n).
+    max_iterations : int
+        Most zoom launches.
+    samples_per_orbit : int
+        Samples per orbit of the final time series that measures the amplitude.
+    coarse_arm_points : int
+        Points per arm of the V fitted on the coarse bracket (its arms bend away from the
+        centre, so only the nearest few are used).
+
+    Returns
+    -------
+    RelaxedLibration
+
+    Raises
+    ------
+    ValueError
+        Bad input.
+    RuntimeError
+        No coarse candidate librates, or the trajectory at the centre found does not.
+    """
+    if not isinstance(system, BinarySystem):
+        raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
+    if not system.omega0 > 0:
+        raise ValueError("the secondary must be elongated (B > A, omega0 > 0) to have a "
+                         "synchronous island")
+    require_positive("orbits", orbits)
+    require_positive("rtol", rtol)
+    require_positive("xtol", xtol)
+    zoom_candidates = require_count("zoom_candidates", zoom_candidates, 5, 100001)
+    if zoom_candidates % 2 == 0:
+        raise ValueError(f"zoom_candidates must be odd (got {zoom_candidates})")
+    max_iterations = require_count("max_iterations", max_iterations, 0, 1000)
+    samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
+    coarse_arm_points = require_count("coarse_arm_points", coarse_arm_points, 2, 100000)
+    x = DEFAULT_CANDIDATES.copy() if candidates is None else \
+        np.asarray(candidates, dtype=np.float64).ravel()
+    require_finite("candidates", x)
+    if len(x) < 5 or np.any(np.diff(x) <= 0):
+        raise ValueError(f"candidates must hold at least 5 ascending values (got {candidates!r})")
+
+    start = time.perf_counter()
+    # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
+    extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol))
+    librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol,
+                                               samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT))
+    extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
+    tried, extents = [x], [extent]
+    if not np.any(np.isfinite(extent)):
+        raise RuntimeError(f"no candidate in [{x[0]:.6g}, {x[-1]:.6g}] librates about the "
+                           f"synchronous state over {orbits} orbits; pass other candidates")
+    best = int(np.nanargmin(extent))
+    near = _arm_window(x, extent, best, coarse_arm_points)
+    center = _fit_v(x[near], extent[near], int(np.flatnonzero(near == best)[0]))
+    half_width = float(np.max(np.diff(x)))
+    if center is None:
+        center = float(x[best])
+
+    # 2-3. zoom: each launch one window, the V refitted on all of it
+    iterations = 0
+    while half_width > xtol and iterations < max_iterations:
+        x = center + np.linspace(-half_width, half_width, zoom_candidates)
+        extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol))
+        extent[extent >= LIBRATION_LIMIT_DEG] = np.nan
+        tried.append(x)
+        extents.append(extent)
+        iterations += 1
+        if not np.any(np.isfinite(extent)):
+            raise RuntimeError(f"no start librates near θ̇_p/n = {center:.9g}")
+        best = int(np.nanargmin(extent))
+        if best in (0, len(x) - 1):            # centre outside the window: move, keep width
+            center = float(x[best])
+            continue
+        fitted = _fit_v(x, extent, best)
+        center = float(x[best]) if fitted is None else fitted
+        half_width *= 4.0 / (zoom_candidates - 1)
+    converged = half_width <= xtol
+    if not converged:
+        warnings.warn(f"relaxed_libration: window half-width {half_width:.3g} after "
+                      f"{iterations} launches is above xtol = {xtol:.3g}", RuntimeWarning,
+                      stacklevel=2)
+
+    # 4. the centre itself
+    final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
+                                                           rtol=rtol))[0])
+    amplitude = libration_amplitude(system, center, orbits, samples_per_orbit=samples_per_orbit,
+                                    rtol=rtol)
+    if not np.isfinite(amplitude):
+        raise RuntimeError(f"the trajectory from θ̇_p/n = {center:.9g} does not librate")
+    omega0_effective = analytic.omega0_effective(system)
+    return RelaxedLibration(
+        center_thetadot_p=center, amplitude=float(amplitude), extent=final_extent,
+        psi_A=_psi_A_deg(system.omega0, system.e), psi_A_effective=_psi_A_deg(omega0_effective, system.e),
+        omega0=system.omega0, omega0_effective=omega0_effective,
+        iterations=iterations, converged=converged, candidates=tried, extents=extents,
+        orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
+        seconds=time.perf_counter() - start, system=system)
