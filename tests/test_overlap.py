@@ -1,0 +1,41 @@
+"""Resonance-overlap scans: decisions at clearly separated and clearly overlapping
+elongations, monotonic in a/b, and the analytic threshold."""
+
+import numpy as np
+import pytest
+
+from ti_spinorbit import analytic
+from ti_spinorbit.overlap import overlap_threshold
+
+
+@pytest.fixture(scope="module")
+def vh_scan():
+    return overlap_threshold("1991 VH", elongations=[1.01, 1.03, 1.08], orbits=300,
+                             center_starts=32, separatrix_starts=16)
+
+
+def test_overlap_decision_and_monotonic(vh_scan):
+    """At a/b = 1.01 (ω0 = 0.17, far below ω0^RO = 0.35) the resonances are separate; at 1.08
+    (ω0 = 0.48) they overlap; the decision switches once."""
+    assert vh_scan.overlaps.tolist()[0] is False and vh_scan.overlaps.tolist()[-1] is True
+    assert vh_scan.monotonic
+    d = vh_scan.decisions[-1]
+    lo, hi = d.connecting_range
+    assert lo <= d.center_1 and hi >= d.center_3_2          # the evidence says what it claims
+    assert 0.9 < d.center_1 < 1.1 and 1.4 < d.center_3_2 < 1.7
+    sep = vh_scan.decisions[0]
+    assert sep.connecting_start is None and sep.widest_range[1] < sep.center_3_2
+
+
+def test_analytic_threshold_reported(vh_scan):
+    assert vh_scan.omega0_ro == pytest.approx(1 / (2 + np.sqrt(14 * 0.05)))
+    assert analytic.omega0(vh_scan.elongation_ro) == pytest.approx(vh_scan.omega0_ro)
+    # the numerical threshold lies between the separated and overlapping samples
+    assert 1.01 < vh_scan.first_overlap <= 1.08
+
+
+def test_bad_inputs():
+    with pytest.raises(ValueError, match="unknown system"):
+        overlap_threshold("1991 XX", elongations=[1.1])
+    with pytest.raises(ValueError, match="elongations"):
+        overlap_threshold("1991 VH", elongations=[0.9])

@@ -1,0 +1,200 @@
+"""Numerical overlap of the 1:1 and 3:2 spin-orbit resonances (physics.md §8; Naidu & Margot
+2015 §4, their Fig. 7).
+
+Decoupled theory (Wisdom, Peale & Mignard 1984; Chirikov): the synchronous and 3:2 islands
+touch when ω0 exceeds ω0^RO = 1/(2 + sqrt(14 e)). Numerically, the two resonances overlap
+when no invariant curve separates them, i.e. a single chaotic trajectory travels from the 1:1
+zone to the 3:2 zone. :func:`overlap_threshold` scans the elongation a/b (steps of 0.01 by
+default) and finds the first elongation where that happens.
+
+Decision rule (geometric, from the pericentre section; documented choices):
+
+1. *Island centres.* A column of starts at θ_p = 0 spanning both resonances. Starts whose
+   trace librates (horizontal extent max |θ_p| below ``libration_limit``, θ_p taken in
+   (−90°, 90°]) belong to an island. Among the librating starts closest to each nominal
+   rate, the one with the smallest extent is that island's centre c_1 (nearest 1) or c_3/2
+   (nearest 1.5). Coupling shifts island centres (relaxed-mode libration); at the small
+   elongations where overlap sets in the shift is small, but the rule does not assume it.
+   If no 3:2 island survives, c_3/2 = c_1 + 0.5.
+2. *Connection.* A column of starts at θ_p = 90° (where both resonances have their unstable
+   point at pericentre) spanning c_1 ... c_3/2. The resonances overlap when at least one of
+   these trajectories reaches below c_1 **and** above c_3/2 within ``orbits`` orbits: it has
+   crossed both islands' levels, which no trajectory can do while an invariant curve
+   separates them.
+
+Finite integration time can only miss a slow connection, never invent one, so the measured
+threshold is an upper bound that converges as ``orbits`` grows. Chaos indicators (MEGNO)
+will add evidence per trajectory when they exist in the kernels.
+
+All elongations of a scan run in one ensemble launch (each member carries its own system).
+"""
+
+from dataclasses import dataclass, field
+from typing import Callable, List, Optional, Union
+
+import numpy as np
+
+from . import analytic, catalog
+from ._validate import require_range
+from .libration import section_extent, wrap_half_turn
+from .section import surface_of_section
+from .systems import BinarySystem
+
+#: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
+LIBRATION_LIMIT_DEG = 80.0
+
+
+@dataclass
+class OverlapDecision:
+    """Evidence for one elongation: island centres (units of n), and the trajectory that
+    connects them (index into the separatrix column, its start and its θ̇_p range) or None."""
+
+    elongation: float
+    omega0: float
+    overlap: bool
+    center_1: float
+    center_3_2: float
+    center_3_2_found: bool
+    connecting_start: Optional[float]
+    connecting_range: Optional[tuple]
+    widest_range: tuple
+
+
+@dataclass
+class OverlapScan:
+    """Result of :func:`overlap_threshold`.
+
+    ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
+    none in the scan); ``elongation_ro``: the analytic a/b at ω0^RO(e); ``omega0_ro``: ω0^RO;
+    ``elongations``, ``overlaps``: the scan; ``decisions``: per-elongation evidence."""
+
+    name: str
+    eccentricity: float
+    elongations: np.ndarray
+    overlaps: np.ndarray
+    decisions: List[OverlapDecision]
+    first_overlap: Optional[float]
+    omega0_ro: float
+    elongation_ro: float
+    orbits: float
+    seconds: float = 0.0
+    sections: object = field(default=None, repr=False)
+
+    @property
+    def monotonic(self) -> bool:
+        """True when the decisions switch from 'separate' to 'overlap' once and stay."""
+        o = self.overlaps.astype(int)
+        return bool(np.all(np.diff(o) >= 0))
+
+
+SystemFactory = Callable[[float], BinarySystem]
+
+
+def _factory(system_name_or_factory, eccentricity):
+    if callable(system_name_or_factory):
+        return system_name_or_factory, "custom"
+    name = system_name_or_factory
+    catalog.entry(name)  # raises for unknown names, listing the known ones
+    return (lambda q: catalog.system(name, elongation=q, eccentricity=eccentricity)), name
+
+
+def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongations=None,
+                      eccentricity=None, orbits=1000, rtol=1e-10, center_starts=48,
+                      separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
+                      progress=None) -> OverlapScan:
+    """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
+    overlap (see the module docstring for the rule).
+
+    Parameters
+    ----------
+    system_name_or_factory : str or callable
+        A catalogued name, or ``f(elongation) -> BinarySystem``.
+    elongations : array, optional
+        a/b values (default 1.01 ... 1.15 in steps of 0.01).
+    eccentricity : float, optional
+        Override the catalogue eccentricity (names only).
+    orbits : float
+        Orbits integrated per trajectory (longer finds slower connections).
+    rtol : float
+        Integrator tolerance (chaos detection needs no more than ~1e-10).
+    center_starts, separatrix_starts : int
+        Starts per elongation in the θ_p = 0 and θ_p = 90° columns.
+    """
+    import time
+
+    make, name = _factory(system_name_or_factory, eccentricity)
+    q = np.round(np.arange(1.01, 1.155, 0.01), 10) if elongations is None else \
+        np.asarray(elongations, dtype=np.float64).ravel()
+    require_range("elongations", q, 1.0, 10.0, low_open=True, high_open=False)
+    systems = [make(float(x)) for x in q]
+    e = systems[0].e
+    # θ_p = 0 column for the centres; θ_p = 90° column for the connection
+    centre_rates = np.linspace(0.6, 2.0, int(center_starts))
+    sep_rates = np.linspace(0.8, 1.8, int(separatrix_starts))
+    members, theta0, rates = [], [], []
+    for s in systems:
+        members += [s] * (len(centre_rates) + len(sep_rates))
+        theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
+        rates += list(centre_rates) + list(sep_rates)
+    t0 = time.perf_counter()
+    sec = surface_of_section(members, np.array(theta0), np.array(rates), orbits=orbits,
+                             rtol=rtol, progress=progress)
+    per = len(centre_rates) + len(sep_rates)
+    decisions = []
+    for k, s in enumerate(systems):
+        block = slice(k * per, (k + 1) * per)
+        decisions.append(_decide(float(q[k]), s, sec, block, centre_rates, sep_rates,
+                                 libration_limit))
+    overlaps = np.array([d.overlap for d in decisions])
+    first = next((float(x) for x, o in zip(q, overlaps) if o), None)
+    w_ro = float(analytic.omega0_overlap(e))
+    return OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
+                       decisions=decisions, first_overlap=first, omega0_ro=w_ro,
+                       elongation_ro=float(analytic.elongation_from_omega0(w_ro)), orbits=orbits,
+                       seconds=time.perf_counter() - t0, sections=sec)
+
+
+def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
+    idx = np.arange(sec.count.size)[block]
+    nc = len(centre_rates)
+    centre_idx, sep_idx = idx[:nc], idx[nc:]
+    extent = section_extent(_subset(sec, centre_idx))
+    librating = np.isfinite(extent) & (extent < libration_limit)
+
+    def centre_near(nominal, window):
+        near = librating & (np.abs(centre_rates - nominal) <= window)
+        if not near.any():
+            return None
+        k = np.nanargmin(np.where(near, extent, np.inf))
+        return float(centre_rates[k])
+
+    c1 = centre_near(1.0, 0.35)
+    if c1 is None:   # no synchronous island at all: nothing to overlap with
+        c1 = 1.0
+    c32 = centre_near(c1 + 0.5, 0.2)
+    found = c32 is not None
+    if not found:
+        c32 = c1 + 0.5
+    lo = np.nanmin(sec.thetadot_p[sep_idx], axis=1)
+    hi = np.nanmax(sec.thetadot_p[sep_idx], axis=1)
+    connects = (lo <= c1) & (hi >= c32)
+    widest = int(np.nanargmax(hi - lo))
+    k = int(np.argmax(connects)) if connects.any() else None
+    return OverlapDecision(
+        elongation=q, omega0=system.omega0, overlap=bool(connects.any()), center_1=c1,
+        center_3_2=c32, center_3_2_found=found,
+        connecting_start=None if k is None else float(sep_rates[k]),
+        connecting_range=None if k is None else (float(lo[k]), float(hi[k])),
+        widest_range=(float(lo[widest]), float(hi[widest])))
+
+
+class _subset:
+    """A view of some members of a SectionResult (the attributes section_extent reads)."""
+
+    def __init__(self, sec, idx):
+        self.theta_p = sec.theta_p[idx]
+        self.status = sec.status[idx]
+        self.count = sec.count[idx]
+
+
+__all__ = ["overlap_threshold", "OverlapScan", "OverlapDecision", "wrap_half_turn"]
