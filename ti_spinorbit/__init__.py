@@ -14,10 +14,14 @@ from .potential import mutual_potential
 from .runtime import init
 from .section import SectionResult, TimeSeriesResult, surface_of_section, time_series
 from .systems import G, BinarySystem
-from . import catalog
+from . import analytic, catalog
+from .classify import classify_section
+from .libration import libration_amplitude, relaxed_libration
+from .overlap import overlap_threshold
 
 __version__ = "0.1.0"
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
-           "__version__"]
+           "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
+           "overlap_threshold", "__version__"]

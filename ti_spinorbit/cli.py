@@ -4,6 +4,8 @@ Subcommands
 -----------
 systems   list the catalogued systems, or show one
 section   surface of section of a catalogued system, written as PNG + .npz
+figures   run the experiment scripts that reproduce the paper's studies (needs a source
+          checkout: the scripts live in experiments/)
 
 Errors in the inputs print one line and exit with status 2 (no traceback)."""
 
@@ -43,7 +45,54 @@ def _parser():
     s.add_argument("--out", default=None, help="PNG path (default sos_<system>.png)")
     s.add_argument("--data", default=None, help=".npz path (default: PNG path with .npz)")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+    s = sub.add_parser("figures", help="reproduce the paper's studies (experiments/study*.py)")
+    s.add_argument("--quick", action="store_true", help="small runs (minutes in all)")
+    s.add_argument("--out", default="out", help="output folder (default out/)")
+    s.add_argument("--only", nargs="+", metavar="N", type=int, help="study numbers, e.g. 4 6")
+    s.add_argument("--experiments", default=None,
+                   help="folder holding the study scripts (default: ./experiments or the "
+                        "checkout this package was installed from)")
     return p
+
+
+def _experiments_dir(given):
+    import os
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    for d in ([given] if given else [os.path.join(os.getcwd(), "experiments"),
+                                    os.path.join(os.path.dirname(here), "experiments")]):
+        if d and os.path.isfile(os.path.join(d, "_common.py")):
+            return d
+    raise ValueError("experiments folder not found: run from a source checkout or pass "
+                     "--experiments PATH")
+
+
+def _cmd_figures(args):
+    import glob
+    import os
+    import subprocess
+    import time
+
+    folder = _experiments_dir(args.experiments)
+    scripts = sorted(glob.glob(os.path.join(folder, "study[0-9][0-9]_*.py")))
+    if args.only:
+        scripts = [s for s in scripts if int(os.path.basename(s)[5:7]) in args.only]
+    if not scripts:
+        raise ValueError(f"no study scripts selected in {folder}")
+    out = os.path.abspath(args.out)
+    failed = []
+    for script in scripts:
+        t0 = time.perf_counter()
+        cmd = [sys.executable, script, "--out", out] + (["--quick"] if args.quick else [])
+        rc = subprocess.call(cmd, cwd=folder)
+        print(f"{os.path.basename(script)}: {'ok' if rc == 0 else f'FAILED ({rc})'} "
+              f"in {time.perf_counter() - t0:.0f} s", flush=True)
+        if rc:
+            failed.append(os.path.basename(script))
+    if failed:
+        raise RuntimeError(f"{len(failed)} studies failed: {', '.join(failed)}")
+    return 0
 
 
 def _cmd_systems(args):
@@ -95,7 +144,8 @@ def _cmd_section(args):
 
 def main(argv=None):
     args = _parser().parse_args(argv)
-    handler = {"systems": _cmd_systems, "section": _cmd_section}[args.command]
+    handler = {"systems": _cmd_systems, "section": _cmd_section,
+               "figures": _cmd_figures}[args.command]
     try:
         return handler(args)
     except (ValueError, TypeError, RuntimeError) as exc:

@@ -45,6 +45,7 @@ from typing import List
 import numpy as np
 
 from . import analytic
+from .classify import horizontal_extent, wrap_half_turn  # noqa: F401 (re-exported)
 from ._validate import require_count, require_finite, require_positive
 from .section import SystemLike, surface_of_section, time_series
 from .systems import BinarySystem
@@ -59,21 +60,13 @@ CLASSIFY_SAMPLES_PER_ORBIT = 32
 LIBRATION_LIMIT_DEG = 85.0
 
 
-def wrap_half_turn(angle_deg):
-    """Map angles (deg) to (−90°, 90°]: the secondary's long axis is symmetric under 180°."""
-    return 90.0 - np.mod(90.0 - np.asarray(angle_deg, dtype=np.float64), 180.0)
-
-
 def section_extent(section):
     """Horizontal half extent of each member's section trace, deg: max |θ_p| with θ_p in
     (−90°, 90°]; NaN where the member stopped early (collision, escape, ...) or has no point."""
     from .kernels.ensemble import DONE
 
-    theta = wrap_half_turn(section.theta_p)
-    extent = np.full(len(section.count), np.nan)
-    ok = (section.status == DONE) & (section.count > 0)
-    extent[ok] = np.nanmax(np.abs(theta[ok]), axis=1)
-    return extent
+    extent = np.atleast_1d(horizontal_extent(section.theta_p))
+    return np.where((section.status == DONE) & (section.count > 0), extent, np.nan)
 
 
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,

@@ -36,7 +36,8 @@ import numpy as np
 
 from . import analytic, catalog
 from ._validate import require_range
-from .libration import section_extent, wrap_half_turn
+from .classify import horizontal_extent
+from .kernels.ensemble import DONE
 from .section import surface_of_section
 from .systems import BinarySystem
 
@@ -158,7 +159,8 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
     idx = np.arange(sec.count.size)[block]
     nc = len(centre_rates)
     centre_idx, sep_idx = idx[:nc], idx[nc:]
-    extent = section_extent(_subset(sec, centre_idx))
+    extent = np.where((sec.status[centre_idx] == DONE) & (sec.count[centre_idx] > 0),
+                      np.atleast_1d(horizontal_extent(sec.theta_p[centre_idx])), np.nan)
     librating = np.isfinite(extent) & (extent < libration_limit)
 
     def centre_near(nominal, window):
@@ -188,13 +190,4 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
         widest_range=(float(lo[widest]), float(hi[widest])))
 
 
-class _subset:
-    """A view of some members of a SectionResult (the attributes section_extent reads)."""
-
-    def __init__(self, sec, idx):
-        self.theta_p = sec.theta_p[idx]
-        self.status = sec.status[idx]
-        self.count = sec.count[idx]
-
-
-__all__ = ["overlap_threshold", "OverlapScan", "OverlapDecision", "wrap_half_turn"]
+__all__ = ["overlap_threshold", "OverlapScan", "OverlapDecision"]

@@ -6,7 +6,7 @@ quasi-periodic green)."""
 
 import numpy as np
 
-CLASS_COLORS = {"resonant": "tab:red", "chaotic": "tab:blue", "quasi-periodic": "tab:green"}
+from .classify import COLORS as CLASS_COLORS  # the paper's red / blue / green
 
 
 def _pyplot():
