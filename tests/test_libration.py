@@ -162,3 +162,19 @@ def test_libration_amplitude_bad_input(decoupled):
         libration_amplitude(decoupled, 1.0, orbits=0)
     with pytest.raises(ValueError, match="samples_per_orbit"):
         libration_amplitude(decoupled, 1.0, orbits=1, samples_per_orbit=0)
+
+
+def test_chaotic_zone_is_not_reported_as_a_centre():
+    """1996 FG3 at a/b = 1.1: the free libration (~2 orbits) resonates with the e = 0.07
+    forcing and θ_p = 0 holds no stable centre; the zoom window still narrows, but the trace
+    at the 'centre' stays wide, so the search must say it did not converge."""
+    import warnings
+
+    import ti_spinorbit as tso
+    from ti_spinorbit.libration import relaxed_libration
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        lib = relaxed_libration(tso.catalog.system("1996 FG3", elongation=1.1), orbits=120)
+    assert not lib.converged and lib.extent > 1.0
+    assert any("not converged" in str(w.message) for w in caught)

@@ -56,6 +56,9 @@ DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
 #: Samples per orbit of the coarse scan's libration check (α changes by < 90° per sample).
 CLASSIFY_SAMPLES_PER_ORBIT = 32
 
+#: Largest section extent (deg) at a found centre for the search to count as converged.
+MAX_CENTER_EXTENT_DEG = 1.0
+
 #: A section trace that reaches beyond this |θ_p| (deg) is not treated as librating.
 LIBRATION_LIMIT_DEG = 85.0
 
@@ -127,7 +130,8 @@ class RelaxedLibration:
     2e/(ω0² − 1) with ω0 and with ω0,eff² = ω0² m1/(m1+m2); ``iterations`` zoom launches;
     ``candidates`` and ``extents`` the θ̇_p/n tried and their extents (deg), one array per
     launch, the coarse bracket first (extent NaN where the start does not librate);
-    ``converged`` whether the final window is narrower than ``xtol``; ``seconds`` wall time."""
+    ``converged`` whether the final window is narrower than ``xtol`` and the extent at the
+    centre is below ``max_extent``; ``seconds`` wall time."""
 
     center_thetadot_p: float
     amplitude: float
@@ -178,7 +182,8 @@ def _arm_window(x, extent, best, points):
 
 def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=None,
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
-                      samples_per_orbit=256, coarse_arm_points=3) -> RelaxedLibration:
+                      samples_per_orbit=256, coarse_arm_points=3,
+                      max_extent=MAX_CENTER_EXTENT_DEG) -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
     Parameters
@@ -203,6 +208,9 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     coarse_arm_points : int
         Points per arm of the V fitted on the coarse bracket (its arms bend away from the
         centre, so only the nearest few are used).
+    max_extent : float
+        Largest section extent (deg) allowed at the centre found; above it the search is
+        reported as not converged (a chaotic zone can also narrow the zoom window).
 
     Returns
     -------
@@ -270,15 +278,17 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         fitted = _fit_v(x, extent, best)
         center = float(x[best]) if fitted is None else fitted
         half_width *= 4.0 / (zoom_candidates - 1)
-    converged = half_width <= xtol
-    if not converged:
-        warnings.warn(f"relaxed_libration: window half-width {half_width:.3g} after "
-                      f"{iterations} launches is above xtol = {xtol:.3g}", RuntimeWarning,
-                      stacklevel=2)
-
     # 4. the centre itself
     final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
                                                            rtol=rtol))[0])
+    # a narrow window is not enough: at a true centre the trace shrinks to a point (a chaotic
+    # zone, e.g. 1996 FG3 at a/b = 1.1, also narrows the window but leaves a wide trace)
+    converged = half_width <= xtol and final_extent <= max_extent
+    if not converged:
+        warnings.warn(f"relaxed_libration: not converged (window half-width {half_width:.3g}, "
+                      f"xtol {xtol:.3g}; extent at the centre {final_extent:.3g} deg, allowed "
+                      f"{max_extent:g} deg) after {iterations} launches", RuntimeWarning,
+                      stacklevel=2)
     amplitude = libration_amplitude(system, center, orbits, samples_per_orbit=samples_per_orbit,
                                     rtol=rtol)
     if not np.isfinite(amplitude):
