@@ -10,8 +10,9 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import ti_spinorbit as tso
+from ti_spinorbit.classify import wrap_half_turn
 from ti_spinorbit.libration import (RelaxedLibration, _fit_v, libration_amplitude,
-                                    relaxed_libration, wrap_half_turn)
+                                    relaxed_libration)
 
 ORBITS = 60
 

@@ -7,8 +7,6 @@ import sys
 import zipfile
 from pathlib import Path
 
-import pytest
-
 import ti_spinorbit as tso
 
 ROOT = Path(__file__).resolve().parents[1]

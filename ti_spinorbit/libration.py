@@ -45,7 +45,7 @@ from typing import List
 import numpy as np
 
 from . import analytic
-from .classify import horizontal_extent, wrap_half_turn  # noqa: F401 (re-exported)
+from .classify import horizontal_extent
 from ._validate import require_count, require_finite, require_positive
 from .section import SystemLike, surface_of_section, time_series
 from .systems import BinarySystem

@@ -4,8 +4,6 @@ Surface of section: θ_p (deg) in [0°, 180°) horizontally, θ̇_p/n vertically
 trajectory unless a classification gives the paper's colours (resonant red, chaotic blue,
 quasi-periodic green)."""
 
-import numpy as np
-
 from .classify import COLORS as CLASS_COLORS  # the paper's red / blue / green
 
 
