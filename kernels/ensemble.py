@@ -89,8 +89,10 @@ def _record(buf: ti.template(), i, slot, t, y):
 def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: nd1f,
             h_nd: nd1f, t_end: nd1f, t_stop: nd1f, status: nd1i, counters: nd2l,
             events: nd3f, n_events: nd1i, samples: nd3f, n_samples: nd1i, next_sample: nd1f,
-            rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64,
-            order: ti.template(), odd: ti.template(), sampling: ti.template()):
+            shadow_nd: nd2f, shadow_f_nd: nd2f, ind: nd2f,
+            rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64, d0: ti.f64,
+            order: ti.template(), odd: ti.template(), sampling: ti.template(),
+            indicators: ti.template()):
     """Advance every running member (see the module docstring)."""
     cap = events.shape[1]
     scap = samples.shape[1]
@@ -114,6 +116,21 @@ def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: n
             K = kmat(0.0)
             for c in ti.static(range(NSTATE)):
                 K[0, c] = f0[c]
+            # shadow trajectory (chaos indicators): same steps, its own stages in K2
+            y_s = state(0.0)
+            ys_try = state(0.0)
+            f_s1 = state(0.0)
+            K2 = kmat(0.0)
+            ell = 0.0
+            s_weighted = 0.0
+            ybar_int = 0.0
+            if ti.static(indicators):
+                y_s = _load(shadow_nd, i)
+                for c in ti.static(range(NSTATE)):
+                    K2[0, c] = shadow_f_nd[i, c]
+                ell = ind[i, 0]
+                s_weighted = ind[i, 1]
+                ybar_int = ind[i, 2]
             # trial-step and event-location state
             new_attempt = 1
             mode = _STEP
@@ -148,11 +165,29 @@ def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: n
                                 hit_end = 1
                     stage = 1
                     new_attempt = 0
-                ys = y_try
-                if stage < _STAGES:
-                    ys = stage_point(y, K, hs, stage)
-                fy = eom.rhs(par, i, ys, order, odd)       # the only RHS call site
-                calls += 1
+                copies = 1
+                if ti.static(indicators):
+                    if mode == _STEP:
+                        copies = 2                          # the shadow rides along
+                fy = state(0.0)
+                for copy in range(copies):                  # runtime loop: one call site
+                    pt = y_try
+                    if copy == 0:
+                        if stage < _STAGES:
+                            pt = stage_point(y, K, hs, stage)
+                    else:
+                        pt = ys_try
+                        if stage < _STAGES:
+                            pt = stage_point(y_s, K2, hs, stage)
+                    fc = eom.rhs(par, i, pt, order, odd)    # the only RHS call site
+                    calls += 1
+                    if copy == 0:
+                        fy = fc
+                    elif stage < _STAGES:
+                        for c in ti.static(range(NSTATE)):
+                            K2[stage, c] = fc[c]
+                    else:
+                        f_s1 = fc
                 do_accept = 0
                 if stage < _STAGES:
                     for c in ti.static(range(NSTATE)):
@@ -161,6 +196,10 @@ def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: n
                     if stage == _STAGES:
                         dy, err = combine(K, hs)
                         y_try = y + dy
+                        if ti.static(indicators):
+                            if mode == _STEP:
+                                dy_s, err_s = combine(K2, hs)
+                                ys_try = y_s + dy_s
                         en = error_norm(y, y_try, err, rtol, atol, NSTATE)
                         if mode == _STEP and en > 1.0:
                             rej += 1
@@ -206,6 +245,7 @@ def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: n
                         hs = tau
                         stage = 1
                 if do_accept == 1:
+                    t_mid = t + 0.5 * hs
                     yk = dy - yc                            # Kahan-compensated y += dy
                     ysum = y + yk
                     yc = (ysum - y) - yk
@@ -220,6 +260,20 @@ def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: n
                     f0 = fy
                     for c in ti.static(range(NSTATE)):
                         K[0, c] = fy[c]
+                    if ti.static(indicators):
+                        # separation growth over the step, then renormalise to d0 (the
+                        # shadow's derivative is rescaled linearly: exact to O(d0²))
+                        delta = ys_try - y
+                        d = delta.norm()
+                        if d > 0.0:
+                            dl = ti.log(d / d0)
+                            ell += dl
+                            s_weighted += t_mid * dl
+                            ybar_int += 2.0 * s_weighted / t * hs
+                            scale = d0 / d
+                            y_s = y + delta * scale
+                            for c in ti.static(range(NSTATE)):
+                                K2[0, c] = fy[c] + (f_s1[c] - fy[c]) * scale
                     acc += 1
                     fac = step_factor(en, after_reject, _EXPONENT)
                     if not ((hit_end == 1 or hit_sample == 1) and hs < h and fac >= 1.0):
@@ -245,6 +299,13 @@ def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: n
             _store(y_nd, i, y)
             _store(yc_nd, i, yc)
             _store(f_nd, i, f0)
+            if ti.static(indicators):
+                _store(shadow_nd, i, y_s)
+                for c in ti.static(range(NSTATE)):
+                    shadow_f_nd[i, c] = K2[0, c]
+                ind[i, 0] = ell
+                ind[i, 1] = s_weighted
+                ind[i, 2] = ybar_int
             t_nd[i] = t
             tc_nd[i] = tc
             h_nd[i] = h

@@ -518,7 +518,8 @@ def classify_section(result, megno=None, island_shift=True, **thresholds):
     result : SectionResult
         From :func:`~ti_spinorbit.surface_of_section`.
     megno : array (N,) or None
-        MEGNO ⟨Y⟩ per member, NaN where unknown (see :func:`classify_points`).
+        MEGNO ⟨Y⟩ per member, NaN where unknown (see :func:`classify_points`); by default the
+        result's own ``megno`` (a run with ``indicators=True``), if any.
     island_shift : bool
         Assign p against the decoupled island centres of each member's system (default) rather
         than against the nominal centres p.
@@ -533,6 +534,8 @@ def classify_section(result, megno=None, island_shift=True, **thresholds):
     """
     failed = np.array([name != "done" for name in result.status_names])
     systems = result.systems if island_shift else None
+    if megno is None:
+        megno = getattr(result, "megno", None)
     return classify_points(result.theta_p, result.thetadot_p, systems=systems, megno=megno,
                            failed=failed, **thresholds)
 

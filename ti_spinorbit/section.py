@@ -66,7 +66,9 @@ class SectionResult:
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
     ``t`` s; ``r`` pericentre distance m; ``a``, ``e`` osculating elements (m, -); ``count``
     crossings per member; ``energy_drift``, ``angmom_drift`` relative drifts over the run;
-    ``status`` codes with ``status_names``; ``accepted``, ``rejected``, ``rhs_calls``."""
+    ``status`` codes with ``status_names``; ``accepted``, ``rejected``, ``rhs_calls``;
+    with ``indicators=True``: ``megno`` (MEGNO ⟨Y⟩ at the end: → 2 quasi-periodic, ≫ 2
+    chaotic) and ``lyapunov`` (finite-time maximal Lyapunov exponent, 1/orbit), else NaN."""
 
     theta_p: np.ndarray
     thetadot_p: np.ndarray
@@ -89,6 +91,8 @@ class SectionResult:
     order: int = 4
     orbits: float = 0.0
     seconds: float = 0.0
+    megno: np.ndarray = None
+    lyapunov: np.ndarray = None
 
     @property
     def status_names(self) -> List[str]:
@@ -107,7 +111,8 @@ class SectionResult:
 
 def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-12,
                        atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
-                       escape_distance=ESCAPE_DISTANCE, progress=None) -> SectionResult:
+                       escape_distance=ESCAPE_DISTANCE, indicators=False,
+                       progress=None) -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -128,6 +133,9 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
         Orbits per kernel launch (affects speed only).
     escape_distance : float
         Stop a member as "escape" beyond this distance, units of a.
+    indicators : bool
+        Also integrate a shadow trajectory per member (same steps, about 2x the cost) for
+        MEGNO and the maximal Lyapunov exponent; the main trajectory is unchanged.
     progress : callable, optional
         ``progress(fraction)`` after every window.
 
@@ -140,7 +148,8 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
         raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
-    out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, progress=progress)
+    out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
+                  progress=progress)
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"))
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
@@ -152,7 +161,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
         angmom_drift=angmom_drift, status=out.status, accepted=out.counters[:, 0],
         rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
-        orbits=orbits, seconds=out.seconds)
+        orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov)
 
 
 def _derived_columns(par, records, names, ensemble=None):
