@@ -22,6 +22,7 @@ def test_overlap_decision_and_monotonic(vh_scan):
     d = vh_scan.decisions[-1]
     lo, hi = d.connecting_range
     assert lo <= d.center_1 and hi >= d.center_3_2          # the evidence says what it claims
+    assert d.connecting_megno > 4 and d.connecting_lyapunov > 0.05   # and it is chaotic
     assert 0.9 < d.center_1 < 1.1 and 1.4 < d.center_3_2 < 1.7
     sep = vh_scan.decisions[0]
     assert sep.connecting_start is None and sep.widest_range[1] < sep.center_3_2
@@ -39,3 +40,14 @@ def test_bad_inputs():
         overlap_threshold("1991 XX", elongations=[1.1])
     with pytest.raises(ValueError, match="elongations"):
         overlap_threshold("1991 VH", elongations=[0.9])
+
+
+def test_overlap_vs_eccentricity_reports_per_e():
+    from ti_spinorbit.overlap import overlap_vs_eccentricity
+    ecc, first, analytic_ab, scans = overlap_vs_eccentricity(
+        "2004 DC", [0.1, 0.3], elongations=[1.01, 1.06], orbits=150, center_starts=24,
+        separatrix_starts=12)
+    assert len(scans) == 2 and ecc.tolist() == [0.1, 0.3]
+    assert analytic_ab[1] < analytic_ab[0]                   # overlap comes earlier at higher e
+    assert all(s.monotonic for s in scans)
+    assert scans[1].overlaps[-1]                             # a/b = 1.06 at e = 0.3: overlap

@@ -4,6 +4,8 @@ Subcommands
 -----------
 systems   list the catalogued systems, or show one
 section   surface of section of a catalogued system, written as PNG + .npz
+map       chaos map (MEGNO, Lyapunov, classification) over a (θ_p, θ̇_p/n) grid, PNG + .npz
+overlap   1:1 / 3:2 resonance-overlap scan over the elongation a/b, PNG + .npz
 figures   run the experiment scripts that reproduce the paper's studies (needs a source
           checkout: the scripts live in experiments/)
 
@@ -17,6 +19,8 @@ EXAMPLES = """examples:
   ti-spinorbit systems --show "2004 DC"
   ti-spinorbit section --system "1991 VH" --out sos_1991VH.png
   ti-spinorbit section --system "1991 VH" --elongation 1.06 --thetadot 1.13 1.63 1.70 1.78 --orbits 1000
+  ti-spinorbit map --system "2004 DC" --grid 32 32 --orbits 300 --out dc_map.png
+  ti-spinorbit overlap --system "1991 VH" --elongations 1.01 1.10 0.01 --orbits 500
 """
 
 
@@ -46,6 +50,31 @@ def _parser():
     s.add_argument("--data", default=None, help=".npz path (default: PNG path with .npz)")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
+    def system_flags(s):
+        s.add_argument("--system", default="1991 VH", help="catalogued system name (default: 1991 VH)")
+        s.add_argument("--eccentricity", type=float, help="initial osculating eccentricity")
+        s.add_argument("--orbits", type=float, default=300, help="orbits per trajectory (default 300)")
+        s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
+        s.add_argument("--arch", default=None, help="cpu (default) or cuda, vulkan, ...")
+        s.add_argument("--out", default=None, help="PNG path (the .npz is written beside it)")
+        s.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+    s = sub.add_parser("map", help="chaos map over (theta_p, thetadot_p/n): MEGNO, Lyapunov, classes",
+                       epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    system_flags(s)
+    s.add_argument("--elongation", type=float, help="secondary a/b (default: catalogue value)")
+    s.add_argument("--density", type=float, help="secondary density, kg/m^3")
+    s.add_argument("--grid", type=int, nargs=2, default=[32, 32], metavar=("NTHETA", "NTHETADOT"),
+                   help="grid size (default 32 32)")
+    s.add_argument("--thetadot-range", type=float, nargs=2, default=[0.2, 3.0], metavar=("LO", "HI"),
+                   help="θ̇_p/n range (default 0.2 3.0)")
+
+    s = sub.add_parser("overlap", help="resonance-overlap scan over a/b (1:1 and 3:2)",
+                       epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    system_flags(s)
+    s.add_argument("--elongations", type=float, nargs=3, default=[1.01, 1.15, 0.01],
+                   metavar=("START", "STOP", "STEP"), help="a/b scan (default 1.01 1.15 0.01)")
+
     s = sub.add_parser("figures", help="reproduce the paper's studies (experiments/study*.py)")
     s.add_argument("--quick", action="store_true", help="small runs (minutes in all)")
     s.add_argument("--out", default="out", help="output folder (default out/)")
@@ -54,6 +83,109 @@ def _parser():
                    help="folder holding the study scripts (default: ./experiments or the "
                         "checkout this package was installed from)")
     return p
+
+
+def _write_npz(path, arrays, meta):
+    import json
+
+    import numpy as np
+
+    np.savez_compressed(path, metadata=np.array(json.dumps(meta, indent=1, default=str)),
+                        **{k: np.asarray(v) for k, v in arrays.items()})
+
+
+def _base_meta(args, system):
+    import datetime
+
+    from . import __version__, runtime
+
+    return {"package": "ti_spinorbit", "version": __version__, "arch": runtime.current_arch(),
+            "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(),
+            "command": args.command, "orbits": args.orbits, "rtol": args.rtol,
+            "system": system.describe()}
+
+
+def _cmd_map(args):
+    import os
+
+    import numpy as np
+
+    from . import catalog, init
+    from .chaosmap import chaos_map
+    from .plotting import save_figure
+
+    system = catalog.system(args.system, elongation=args.elongation,
+                            secondary_density=args.density, eccentricity=args.eccentricity)
+    nt, nd = args.grid
+    if not (1 <= nt <= 1024 and 1 <= nd <= 1024):
+        raise ValueError(f"--grid sizes must lie in [1, 1024] (got {nt} {nd})")
+    lo, hi = args.thetadot_range
+    if not hi > lo:
+        raise ValueError(f"--thetadot-range needs LO < HI (got {lo} {hi})")
+    init(arch=args.arch)
+    theta = (np.arange(nt) + 0.5) * 180.0 / nt
+    cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits, rtol=args.rtol)
+    out = args.out or f"map_{system.name.replace(' ', '')}.png"
+    save_figure(cmap.plot(), out)
+    meta = _base_meta(args, system)
+    meta.update(chaotic_fraction=cmap.chaotic_fraction, units={"theta_p": "deg", "thetadot_p": "n",
+                "lyapunov": "1/orbit", "megno": "1"})
+    _write_npz(os.path.splitext(out)[0] + ".npz",
+               {"theta_p": cmap.theta_p, "thetadot_p": cmap.thetadot_p, "megno": cmap.megno,
+                "lyapunov": cmap.lyapunov, "classification": cmap.classification,
+                "mean_spin": cmap.mean_spin, "status": cmap.status}, meta)
+    if not args.quiet:
+        print(f"{system.name}: {nt} x {nd} map, {args.orbits:g} orbits: chaotic fraction "
+              f"{cmap.chaotic_fraction:.3f} in {cmap.seconds:.1f} s; wrote {out}")
+    return 0
+
+
+def _cmd_overlap(args):
+    import os
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from . import catalog, init
+    from .overlap import overlap_threshold
+
+    start, stop, step = args.elongations
+    if not (step > 0 and stop >= start > 1.0):
+        raise ValueError(f"--elongations needs 1 < START <= STOP and STEP > 0 (got {start} {stop} {step})")
+    catalog.system(args.system, eccentricity=args.eccentricity)       # validates the name and e
+    init(arch=args.arch)
+    q = np.round(np.arange(start, stop + step / 2, step), 10)
+    scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
+                             orbits=args.orbits, rtol=args.rtol)
+    fig, ax = plt.subplots(figsize=(6.4, 3.2))
+    ax.scatter(scan.elongations, scan.overlaps.astype(int),
+               c=["tab:blue" if o else "tab:green" for o in scan.overlaps])
+    ax.axvline(scan.elongation_ro, color="k", ls="--", lw=0.8, label="analytic ω0^RO")
+    if scan.first_overlap is not None:
+        ax.axvline(scan.first_overlap, color="tab:red", label="numerical")
+    ax.set_yticks([0, 1], ["separate", "overlap"])
+    ax.set_xlabel("a/b")
+    ax.set_title(f"{scan.name}, e = {scan.eccentricity}: 1:1 / 3:2 overlap", fontsize=9)
+    ax.legend(fontsize=7)
+    out = args.out or f"overlap_{scan.name.replace(' ', '')}.png"
+    fig.tight_layout()
+    fig.savefig(out, dpi=150)
+    plt.close(fig)
+    system = catalog.system(args.system, eccentricity=args.eccentricity)
+    meta = _base_meta(args, system)
+    meta.update(first_overlap=scan.first_overlap, elongation_ro=scan.elongation_ro,
+                omega0_ro=scan.omega0_ro, decisions=[vars(d) for d in scan.decisions])
+    _write_npz(os.path.splitext(out)[0] + ".npz",
+               {"elongations": scan.elongations, "overlaps": scan.overlaps}, meta)
+    if not args.quiet:
+        print(f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
+              f"(analytic {scan.elongation_ro:.4f}) in {scan.seconds:.1f} s; wrote {out}")
+        for d in scan.decisions:
+            extra = f", connecting <Y> = {d.connecting_megno:.1f}" if d.overlap else ""
+            print(f"  a/b = {d.elongation:.2f}: {'overlap' if d.overlap else 'separate'}{extra}")
+    return 0
 
 
 def _experiments_dir(given):
@@ -144,8 +276,8 @@ def _cmd_section(args):
 
 def main(argv=None):
     args = _parser().parse_args(argv)
-    handler = {"systems": _cmd_systems, "section": _cmd_section,
-               "figures": _cmd_figures}[args.command]
+    handler = {"systems": _cmd_systems, "section": _cmd_section, "map": _cmd_map,
+               "overlap": _cmd_overlap, "figures": _cmd_figures}[args.command]
     try:
         return handler(args)
     except (ValueError, TypeError, RuntimeError) as exc:

@@ -23,8 +23,9 @@ Decision rule (geometric, from the pericentre section; documented choices):
    separates them.
 
 Finite integration time can only miss a slow connection, never invent one, so the measured
-threshold is an upper bound that converges as ``orbits`` grows. Chaos indicators (MEGNO)
-will add evidence per trajectory when they exist in the kernels.
+threshold is an upper bound that converges as ``orbits`` grows. With ``indicators=True``
+(default) every trajectory also carries MEGNO ⟨Y⟩ and its Lyapunov exponent: the evidence
+records them for the connecting trajectory, which should be clearly chaotic (⟨Y⟩ ≫ 2).
 
 All elongations of a scan run in one ensemble launch (each member carries its own system).
 """
@@ -36,7 +37,7 @@ import numpy as np
 
 from . import analytic, catalog
 from ._validate import require_range
-from .classify import horizontal_extent
+from .classify import MEGNO_CHAOTIC, horizontal_extent
 from .kernels.ensemble import DONE
 from .section import surface_of_section
 from .systems import BinarySystem
@@ -59,6 +60,9 @@ class OverlapDecision:
     connecting_start: Optional[float]
     connecting_range: Optional[tuple]
     widest_range: tuple
+    connecting_megno: float = float("nan")
+    connecting_lyapunov: float = float("nan")
+    separatrix_chaotic_fraction: float = float("nan")
 
 
 @dataclass
@@ -102,7 +106,7 @@ def _factory(system_name_or_factory, eccentricity):
 def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongations=None,
                       eccentricity=None, orbits=1000, rtol=1e-10, center_starts=48,
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
-                      progress=None) -> OverlapScan:
+                      indicators=True, progress=None) -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -120,6 +124,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         Integrator tolerance (chaos detection needs no more than ~1e-10).
     center_starts, separatrix_starts : int
         Starts per elongation in the θ_p = 0 and θ_p = 90° columns.
+    indicators : bool
+        Integrate MEGNO / Lyapunov shadows too (about twice the cost) for the evidence.
     """
     import time
 
@@ -139,7 +145,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         rates += list(centre_rates) + list(sep_rates)
     t0 = time.perf_counter()
     sec = surface_of_section(members, np.array(theta0), np.array(rates), orbits=orbits,
-                             rtol=rtol, progress=progress)
+                             rtol=rtol, indicators=indicators, progress=progress)
     per = len(centre_rates) + len(sep_rates)
     decisions = []
     for k, s in enumerate(systems):
@@ -182,12 +188,29 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
     connects = (lo <= c1) & (hi >= c32)
     widest = int(np.nanargmax(hi - lo))
     k = int(np.argmax(connects)) if connects.any() else None
+    megno = sec.megno[sep_idx]
     return OverlapDecision(
         elongation=q, omega0=system.omega0, overlap=bool(connects.any()), center_1=c1,
         center_3_2=c32, center_3_2_found=found,
         connecting_start=None if k is None else float(sep_rates[k]),
         connecting_range=None if k is None else (float(lo[k]), float(hi[k])),
-        widest_range=(float(lo[widest]), float(hi[widest])))
+        widest_range=(float(lo[widest]), float(hi[widest])),
+        connecting_megno=float("nan") if k is None else float(megno[k]),
+        connecting_lyapunov=float("nan") if k is None else float(sec.lyapunov[sep_idx][k]),
+        separatrix_chaotic_fraction=float(np.mean(megno > MEGNO_CHAOTIC)) if np.isfinite(megno).all()
+        else float("nan"))
 
 
-__all__ = ["overlap_threshold", "OverlapScan", "OverlapDecision"]
+def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
+    """Overlap scans of a catalogued system at several eccentricities (same kwargs as
+    :func:`overlap_threshold`). Returns (eccentricities, numerical first_overlap (NaN if
+    none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
+    ecc = np.asarray(eccentricities, dtype=np.float64).ravel()
+    require_range("eccentricities", ecc, 0.0, 1.0)
+    scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
+             for e in ecc]
+    first = np.array([np.nan if s.first_overlap is None else s.first_overlap for s in scans])
+    return ecc, first, np.array([s.elongation_ro for s in scans]), scans
+
+
+__all__ = ["overlap_threshold", "overlap_vs_eccentricity", "OverlapScan", "OverlapDecision"]
