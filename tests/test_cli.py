@@ -50,3 +50,32 @@ def test_bad_input_prints_one_line_and_exits_nonzero(tmp_path, args, message):
     assert p.returncode == 2
     assert message in p.stderr and "Traceback" not in p.stderr
     assert len(p.stderr.strip().splitlines()) == 1
+
+
+def test_overlap_scan_command(tmp_path):
+    p = run_cli("overlap", "--system", "2004 DC", "--elongations", "1.01", "1.03", "0.02",
+                "--orbits", "120", "--out", "ov.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "ov.png").read_bytes()[:4] == b"\x89PNG"
+    meta = read_metadata(tmp_path / "ov.npz")
+    assert meta["system"]["name"] == "2004 DC" and len(meta["decisions"]) == 2
+    assert "first overlap" in p.stdout
+
+
+def test_map_command(tmp_path):
+    p = run_cli("map", "--system", "1991 VH", "--grid", "3", "4", "--orbits", "40",
+                "--out", "m.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    with np.load(tmp_path / "m.npz") as d:
+        assert d["megno"].shape == (3, 4) and np.all(np.isfinite(d["megno"]))
+    assert 0.0 <= read_metadata(tmp_path / "m.npz")["chaotic_fraction"] <= 1.0
+
+
+@pytest.mark.parametrize("args, message", [
+    (("map", "--grid", "0", "4"), "--grid"),
+    (("map", "--thetadot-range", "2", "1"), "thetadot-range"),
+    (("overlap", "--elongations", "0.9", "1.1", "0.01"), "elongations"),
+])
+def test_bad_map_and_overlap_flags(tmp_path, args, message):
+    p = run_cli(*args, cwd=tmp_path)
+    assert p.returncode == 2 and message in p.stderr and "Traceback" not in p.stderr

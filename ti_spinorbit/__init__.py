@@ -15,6 +15,7 @@ from .runtime import init
 from .section import SectionResult, TimeSeriesResult, surface_of_section, time_series
 from .systems import G, BinarySystem
 from . import analytic, catalog
+from .chaosmap import chaos_map, parameter_map
 from .classify import classify_section
 from .libration import libration_amplitude, relaxed_libration
 from .overlap import overlap_threshold
@@ -24,4 +25,4 @@ __version__ = "0.1.0"
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
-           "overlap_threshold", "__version__"]
+           "overlap_threshold", "chaos_map", "parameter_map", "__version__"]

@@ -1,0 +1,351 @@
+"""Chaos maps: MEGNO and chaotic fraction over grids of initial conditions (physics.md §8).
+
+A *chaos map* integrates every start of a (θ_p, θ̇_p/n) grid, with a shadow trajectory per
+member, in ONE ensemble launch (:func:`~ti_spinorbit.section.surface_of_section` with
+``indicators=True``), and turns the per-member indicators into 2-D maps:
+
+* MEGNO ⟨Y⟩ (Cincotta & Simó 2000, A&AS 147:205; implementation modelled on REBOUND's,
+  Rein & Tamayo 2015): ⟨Y⟩ → 2 on a torus (quasi-periodic or resonant), → 0 at a stable
+  periodic orbit, and grows ∝ t for a chaotic orbit (⟨Y⟩ ≈ λt/2);
+* the finite-time maximal Lyapunov exponent λ, in 1/orbit;
+* the label from :func:`~ti_spinorbit.classify.classify_section` (MEGNO ≥ 4 chaotic, ≤ 2.5
+  regular, the section geometry in between).
+
+The *chaotic fraction* is the share of finished members labelled chaotic. A *parameter map*
+does the same over the secondary's elongation a/b and the eccentricity e: a few starts in the
+band of the 1:1 and 3:2 resonances per (a/b, e), again all in one launch (one system per
+member), to compare with the analytic overlap criterion ω0 > ω0^RO = 1/(2 + sqrt(14e)) and the
+chaotic-layer estimate ΔE/E0 (Wisdom, Peale & Mignard 1984; physics.md §8).
+"""
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Union
+
+import numpy as np
+
+from . import analytic, catalog
+from ._validate import require_positive
+from .classify import MIN_POINTS, classify_section
+from .section import SectionResult, surface_of_section
+from .systems import BinarySystem
+from .kernels.ensemble import DONE
+
+#: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
+MEGNO_COLOR_RANGE = (0.0, 8.0)
+#: Default starts per (a/b, e) of a parameter map: θ_p ∈ {0°, 90°} × θ̇_p/n in the 1:1-3:2 band.
+PARAMETER_MAP_THETA_P = (0.0, 90.0)
+PARAMETER_MAP_THETADOT_P = tuple(np.linspace(0.6, 2.0, 12))
+
+
+def _axis(name, values):
+    """A 1-D float array of finite values with at least one element, or ValueError."""
+    arr = np.asarray(values, dtype=np.float64)
+    if arr.ndim == 0:
+        arr = arr.reshape(1)
+    if arr.ndim != 1 or arr.size < 1:
+        raise ValueError(f"{name} must be a non-empty 1-D array (got shape {arr.shape})")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite (got {values!r})")
+    return arr
+
+
+def _chaotic_fraction(labels, status):
+    """Fraction of finished members ("done") labelled chaotic; NaN if none finished."""
+    done = np.asarray(status) == DONE
+    return float(np.mean(labels[done] == "chaotic")) if done.any() else float("nan")
+
+
+def _labels(section, megno_chaotic, orbits):
+    """classify_section labels. MEGNO settles chaos on its own, so short runs (fewer than the
+    classifier's 64 points) still get labels: the point minimum is relaxed to ~0.8 per orbit
+    (at least 8), which only affects the geometric rule used in the 2.5 < ⟨Y⟩ < 4 gap and for
+    resonant vs quasi-periodic."""
+    min_points = int(min(MIN_POINTS, max(8, np.floor(0.8 * orbits))))
+    return classify_section(section, megno_chaotic=megno_chaotic, min_points=min_points).label
+
+
+def _mean_spin(section):
+    with np.errstate(invalid="ignore"):
+        counts = section.count
+        total = np.nansum(section.thetadot_p, axis=1)
+        return np.where(counts > 0, total / np.maximum(counts, 1), np.nan)
+
+
+@dataclass
+class ChaosMap:
+    """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
+    (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
+
+    ``theta_p`` initial θ_p, deg; ``thetadot_p`` initial θ̇_p/n; ``megno`` MEGNO ⟨Y⟩;
+    ``lyapunov`` finite-time maximal Lyapunov exponent, 1/orbit; ``classification`` labels
+    ("resonant", "quasi-periodic", "chaotic", "undetermined"); ``mean_spin`` mean θ̇_p/n over
+    the section points; ``status`` integrator status codes (``SectionResult.status_names``); ``chaotic_fraction``
+    share of finished members labelled chaotic; ``section`` the underlying SectionResult (flat
+    members in the same C order); ``seconds`` wall time of the launch."""
+
+    theta_p: np.ndarray
+    thetadot_p: np.ndarray
+    megno: np.ndarray
+    lyapunov: np.ndarray
+    classification: np.ndarray
+    mean_spin: np.ndarray
+    status: np.ndarray
+    chaotic_fraction: float
+    orbits: float
+    rtol: float
+    seconds: float
+    megno_chaotic: float = 4.0
+    section: SectionResult = field(default=None, repr=False)
+
+    @property
+    def shape(self):
+        return self.megno.shape
+
+    @property
+    def member_orbits_per_second(self) -> float:
+        return float(self.orbits * self.megno.size / self.seconds) if self.seconds else float("nan")
+
+    def plot(self, ax=None, quantity="megno", overlay=False, overlay_members=64, colorbar=True,
+             title=None):
+        """pcolormesh of MEGNO (clipped to 0-8; 2 = regular), the Lyapunov exponent
+        (``quantity="lyapunov"``, 1/orbit) or the labels (``"classification"``) over θ_p (x,
+        deg) and θ̇_p/n (y). ``overlay=True`` adds the section points of up to
+        ``overlay_members`` evenly spaced members as small black dots. Returns the Axes."""
+        import matplotlib.pyplot as plt
+        from matplotlib.colors import ListedColormap
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6.4, 4.8), dpi=150)
+        x, y = _edges(self.theta_p, 0.0, 180.0), _edges(self.thetadot_p)
+        if quantity == "megno":
+            z, kw, label = self.megno, dict(cmap="magma", vmin=MEGNO_COLOR_RANGE[0],
+                                            vmax=MEGNO_COLOR_RANGE[1]), r"MEGNO $\langle Y\rangle$"
+            z = np.clip(z, *MEGNO_COLOR_RANGE)
+        elif quantity == "lyapunov":
+            z, kw, label = self.lyapunov, dict(cmap="magma", vmin=0.0), r"$\lambda$ (1/orbit)"
+        elif quantity == "classification":
+            from .classify import COLORS
+            order = ["resonant", "quasi-periodic", "chaotic", "undetermined"]
+            z = np.vectorize(order.index)(self.classification).astype(float)
+            kw = dict(cmap=ListedColormap([COLORS.get(k, "0.7") for k in order]), vmin=-0.5,
+                      vmax=3.5)
+            label = "class"
+        else:
+            raise ValueError(f"quantity must be 'megno', 'lyapunov' or 'classification' "
+                             f"(got {quantity!r})")
+        mesh = ax.pcolormesh(x, y, z.T, shading="flat", **kw)
+        if colorbar:
+            cb = ax.figure.colorbar(mesh, ax=ax, pad=0.01)
+            cb.set_label(label)
+            if quantity == "classification":
+                cb.set_ticks(range(4))
+                cb.set_ticklabels(order)
+        if overlay and self.section is not None:
+            sec = self.section
+            pick = np.unique(np.linspace(0, len(sec.count) - 1,
+                                         min(overlay_members, len(sec.count))).astype(int))
+            ax.plot(sec.theta_p[pick].ravel(), sec.thetadot_p[pick].ravel(), ".", ms=0.6,
+                    color="k", alpha=0.6, rasterized=True)
+        ax.set_xlim(0, 180)
+        ax.set_ylim(y[0], y[-1])
+        ax.set_xticks(range(0, 181, 30))
+        ax.set_xlabel(r"$\theta_p$ (deg)")
+        ax.set_ylabel(r"$\dot\theta_p / n$")
+        if title is None and self.section is not None:
+            s = self.section.systems[0]
+            title = (f"{s.name}, {self.orbits:g} orbits, chaotic fraction "
+                     f"{self.chaotic_fraction:.2f}")
+        if title:
+            ax.set_title(title, fontsize=9)
+        return ax
+
+
+def _edges(centres, low=None, high=None):
+    """Cell edges for pcolormesh from cell centres (midpoints; outer cells mirrored)."""
+    c = np.asarray(centres, dtype=np.float64)
+    if c.size == 1:
+        half = 0.5 if low is None else 0.5 * (high - low)
+        e = np.array([c[0] - half, c[0] + half])
+    else:
+        mid = 0.5 * (c[1:] + c[:-1])
+        e = np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
+    return e
+
+
+def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
+              progress: Optional[Callable[[float], None]] = None) -> ChaosMap:
+    """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
+
+    Parameters
+    ----------
+    system : BinarySystem
+    theta_p : 1-D array
+        Initial θ_p values, deg (x axis of the map).
+    thetadot_p : 1-D array
+        Initial θ̇_p/n values, units of n (y axis).
+    orbits : float
+        Integration time in orbital periods, > 0. ⟨Y⟩ of a chaotic orbit grows ≈ λ t / 2, so
+        with λ ≈ 0.5/orbit a few tens of orbits separate the classes; weak chaos needs more.
+    rtol : float
+        Integrator tolerance (also atol).
+    megno_chaotic : float
+        ⟨Y⟩ at and above which a member is chaotic (default 4; ⟨Y⟩ → 2 when regular).
+    progress : callable, optional
+        ``progress(fraction)`` after every window.
+
+    Returns
+    -------
+    ChaosMap
+    """
+    if not isinstance(system, BinarySystem):
+        raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
+    theta_p = _axis("theta_p", theta_p)
+    thetadot_p = _axis("thetadot_p", thetadot_p)
+    require_positive("orbits", orbits)
+    require_positive("rtol", rtol)
+    require_positive("megno_chaotic", megno_chaotic)
+    tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
+    started = time.perf_counter()
+    section = surface_of_section(system, tp, td, orbits, rtol=rtol, indicators=True,
+                                 progress=progress)
+    seconds = time.perf_counter() - started
+    labels = _labels(section, megno_chaotic, orbits)
+    shape = tp.shape
+    return ChaosMap(
+        theta_p=theta_p, thetadot_p=thetadot_p, megno=section.megno.reshape(shape),
+        lyapunov=section.lyapunov.reshape(shape), classification=labels.reshape(shape),
+        mean_spin=_mean_spin(section).reshape(shape), status=section.status.reshape(shape),
+        chaotic_fraction=_chaotic_fraction(labels, section.status), orbits=float(orbits),
+        rtol=float(rtol), seconds=seconds, megno_chaotic=float(megno_chaotic), section=section)
+
+
+@dataclass
+class ParameterMap:
+    """Chaotic fraction over elongation a/b × eccentricity e.
+
+    ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
+    (len(elongations), len(eccentricities)); ``megno``, ``labels``, ``status`` per start,
+    shape (len(elongations), len(eccentricities), starts); ``theta_p`` (deg) and
+    ``thetadot_p`` (units of n) the starts used at every grid point; ``omega0`` ω0(a/b) of the
+    ellipsoid; ``seconds`` wall time of the one launch."""
+
+    elongations: np.ndarray
+    eccentricities: np.ndarray
+    chaotic_fraction: np.ndarray
+    megno: np.ndarray
+    labels: np.ndarray
+    status: np.ndarray
+    theta_p: np.ndarray
+    thetadot_p: np.ndarray
+    omega0: np.ndarray
+    orbits: float
+    rtol: float
+    seconds: float
+    name: str = ""
+
+    @property
+    def member_orbits_per_second(self) -> float:
+        return float(self.orbits * self.megno.size / self.seconds) if self.seconds else float("nan")
+
+    def plot(self, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=True, title=None):
+        """pcolormesh of the chaotic fraction over (e, a/b), with the analytic overlap line
+        a/b(ω0^RO(e)) and contours of the chaotic-layer half-width ΔE/E0(ω0(a/b), e)
+        (14π form as quoted). Returns the Axes."""
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots(figsize=(6.4, 4.8), dpi=150)
+        x = np.clip(_edges(self.eccentricities), 0.0, 0.999)  # physical ranges only
+        y = np.maximum(_edges(self.elongations), 1.0)
+        mesh = ax.pcolormesh(x, y, self.chaotic_fraction, shading="flat", cmap="viridis",
+                             vmin=0.0, vmax=1.0)
+        if colorbar:
+            ax.figure.colorbar(mesh, ax=ax, pad=0.01).set_label("chaotic fraction")
+        e_fine = np.linspace(max(x[0], 0.0), min(x[-1], 0.99), 200)
+        ax.plot(e_fine, analytic.overlap_elongation(e_fine), "w--", lw=1.5,
+                label=r"$\omega_0 = \omega_0^{RO}(e)$")
+        q_fine = np.linspace(max(y[0], 1.001), y[-1], 200)  # ω0(1) = 0: no layer
+        ee, qq = np.meshgrid(e_fine, q_fine)
+        with np.errstate(all="ignore"):
+            width = analytic.chaotic_layer_half_width(analytic.omega0(qq), np.maximum(ee, 1e-12))
+        if contours:
+            cs = ax.contour(ee, qq, width, levels=sorted(contours), colors="w", linewidths=0.7,
+                            alpha=0.8)
+            ax.clabel(cs, fmt=lambda v: f"ΔE/E0={v:g}", fontsize=6)
+        ax.set_xlim(x[0], x[-1])
+        ax.set_ylim(y[0], y[-1])
+        ax.set_xlabel("e")
+        ax.set_ylabel("a/b")
+        ax.legend(fontsize=7, loc="lower right", framealpha=0.5)
+        if title is None:
+            title = (f"{self.name}: chaotic fraction of {self.megno.shape[-1]} starts, "
+                     f"{self.orbits:g} orbits")
+        ax.set_title(title, fontsize=9)
+        return ax
+
+
+def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySystem]],
+                  elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
+                  theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
+                  progress=None) -> ParameterMap:
+    """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
+
+    Parameters
+    ----------
+    factory_or_name : str or callable
+        A catalogue name (``catalog.system(name, elongation=q, eccentricity=e)``) or a
+        function ``(q, e) -> BinarySystem``.
+    elongations, eccentricities : 1-D arrays
+        The a/b (≥ 1) and e (0 ≤ e < 1) axes.
+    orbits : float
+        Integration time in orbital periods, > 0.
+    thetadot_p, theta_p : 1-D arrays
+        Starts per grid point: the product θ_p (deg) × θ̇_p/n. Default {0°, 90°} × 12 rates
+        from 0.6 to 2.0 n, the band of the 1:1 and 3:2 resonances whose overlap is at issue.
+    rtol : float
+        Integrator tolerance.
+    megno_chaotic : float
+        ⟨Y⟩ at and above which a member is chaotic.
+
+    Returns
+    -------
+    ParameterMap
+    """
+    elongations = _axis("elongations", elongations)
+    eccentricities = _axis("eccentricities", eccentricities)
+    theta_p = _axis("theta_p", theta_p)
+    thetadot_p = _axis("thetadot_p", thetadot_p)
+    require_positive("orbits", orbits)
+    require_positive("rtol", rtol)
+    if np.any(elongations < 1.0):
+        raise ValueError(f"elongations must be >= 1 (got {elongations!r})")
+    if np.any((eccentricities < 0.0) | (eccentricities >= 1.0)):
+        raise ValueError(f"eccentricities must lie in [0, 1) (got {eccentricities!r})")
+    if isinstance(factory_or_name, str):
+        name = factory_or_name
+        factory = lambda q, e: catalog.system(name, elongation=q, eccentricity=e)  # noqa: E731
+    elif callable(factory_or_name):
+        factory, name = factory_or_name, ""
+    else:
+        raise TypeError("factory_or_name must be a catalogue name or a callable (q, e) -> system")
+    tp, td = (x.ravel() for x in np.meshgrid(theta_p, thetadot_p, indexing="ij"))
+    starts = tp.size
+    grid = [factory(float(q), float(e)) for q in elongations for e in eccentricities]
+    if not name:
+        name = grid[0].name
+    members = [s for s in grid for _ in range(starts)]
+    started = time.perf_counter()
+    section = surface_of_section(members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
+                                 orbits, rtol=rtol, indicators=True, progress=progress)
+    seconds = time.perf_counter() - started
+    labels = _labels(section, megno_chaotic, orbits)
+    shape = (elongations.size, eccentricities.size, starts)
+    labels, status = labels.reshape(shape), section.status.reshape(shape)
+    fraction = np.array([[_chaotic_fraction(labels[i, j], status[i, j])
+                          for j in range(shape[1])] for i in range(shape[0])])
+    return ParameterMap(
+        elongations=elongations, eccentricities=eccentricities, chaotic_fraction=fraction,
+        megno=section.megno.reshape(shape), labels=labels, status=status, theta_p=tp,
+        thetadot_p=td, omega0=np.asarray(analytic.omega0(elongations)), orbits=float(orbits),
+        rtol=float(rtol), seconds=seconds, name=name)
