@@ -7,11 +7,9 @@ ti_spinorbit.io conventions) and ``<out>/<name>.png``, and prints the numbers it
 
 import argparse
 import datetime
-import json
 import os
 import time
 
-import numpy as np
 
 
 def parse(description, extra=None):
@@ -35,6 +33,7 @@ def save(args, name, fig, arrays, parameters, numbers, started):
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
+    from ti_spinorbit.io import write_archive
 
     png = os.path.join(args.out, f"{name}.png")
     npz = os.path.join(args.out, f"{name}.npz")
@@ -46,19 +45,10 @@ def save(args, name, fig, arrays, parameters, numbers, started):
             "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(),
             "seconds": time.perf_counter() - started, "parameters": parameters,
             "numbers": numbers}
-    np.savez_compressed(npz, metadata=np.array(json.dumps(meta, indent=1, default=_plain)),
-                        **{k: np.asarray(v) for k, v in arrays.items()})
+    write_archive(npz, arrays, meta)
     print(f"[{name}] " + ", ".join(f"{k} = {_fmt(v)}" for k, v in numbers.items()))
     print(f"[{name}] wrote {png} and {npz} in {meta['seconds']:.1f} s")
     return png, npz
-
-
-def _plain(x):
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, np.ndarray):
-        return x.tolist()
-    return str(x)
 
 
 def _fmt(v):

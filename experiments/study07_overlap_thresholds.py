@@ -30,16 +30,7 @@ def main():
     numbers, arrays = {}, {}
     for col, name in enumerate(SYSTEMS):
         scan = overlap_threshold(name, elongations=elong, orbits=orbits, **kw)
-        ax = axes[0, col]
-        ax.scatter(scan.elongations, scan.overlaps.astype(int),
-                   c=["tab:blue" if o else "tab:green" for o in scan.overlaps], s=25)
-        ax.axvline(scan.elongation_ro, color="k", ls="--", lw=0.8, label="analytic ω0^RO")
-        if scan.first_overlap is not None:
-            ax.axvline(scan.first_overlap, color="tab:red", lw=1.0, label="numerical")
-        ax.set_yticks([0, 1], ["separate", "overlap"])
-        ax.set_xlabel("a/b")
-        ax.set_title(f"{name} (e = {scan.eccentricity})", fontsize=9)
-        ax.legend(fontsize=7)
+        scan.plot(axes[0, col], title=f"{name} (e = {scan.eccentricity})")
         # the connecting trajectory at the first overlap (or the widest one at the last a/b)
         k = (list(scan.elongations).index(scan.first_overlap) if scan.first_overlap is not None
              else len(scan.elongations) - 1)

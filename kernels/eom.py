@@ -63,13 +63,6 @@ def put3(y: ti.template(), o: ti.template(), v):
 
 
 @ti.func
-def put33(y: ti.template(), o: ti.template(), m):
-    for r in ti.static(range(3)):
-        for c in ti.static(range(3)):
-            y[o + 3 * r + c] = m[r, c]
-
-
-@ti.func
 def angular_velocities(p: ti.template(), i, y):
     """Ω1 (primary frame = its body frame) and Ω2 (secondary's, primary-frame components)."""
     w1 = get3(y, Y_W1)

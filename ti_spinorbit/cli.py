@@ -85,23 +85,10 @@ def _parser():
     return p
 
 
-def _write_npz(path, arrays, meta):
-    import json
-
-    import numpy as np
-
-    np.savez_compressed(path, metadata=np.array(json.dumps(meta, indent=1, default=str)),
-                        **{k: np.asarray(v) for k, v in arrays.items()})
-
-
 def _base_meta(args, system):
-    import datetime
+    from .io import provenance
 
-    from . import __version__, runtime
-
-    return {"package": "ti_spinorbit", "version": __version__, "arch": runtime.current_arch(),
-            "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(),
-            "command": args.command, "orbits": args.orbits, "rtol": args.rtol,
+    return {**provenance(), "command": args.command, "orbits": args.orbits, "rtol": args.rtol,
             "system": system.describe()}
 
 
@@ -112,6 +99,7 @@ def _cmd_map(args):
 
     from . import catalog, init
     from .chaosmap import chaos_map
+    from .io import write_archive
     from .plotting import save_figure
 
     system = catalog.system(args.system, elongation=args.elongation,
@@ -130,7 +118,7 @@ def _cmd_map(args):
     meta = _base_meta(args, system)
     meta.update(chaotic_fraction=cmap.chaotic_fraction, units={"theta_p": "deg", "thetadot_p": "n",
                 "lyapunov": "1/orbit", "megno": "1"})
-    _write_npz(os.path.splitext(out)[0] + ".npz",
+    write_archive(os.path.splitext(out)[0] + ".npz",
                {"theta_p": cmap.theta_p, "thetadot_p": cmap.thetadot_p, "megno": cmap.megno,
                 "lyapunov": cmap.lyapunov, "classification": cmap.classification,
                 "mean_spin": cmap.mean_spin, "status": cmap.status}, meta)
@@ -143,13 +131,12 @@ def _cmd_map(args):
 def _cmd_overlap(args):
     import os
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import numpy as np
 
     from . import catalog, init
+    from .io import write_archive
     from .overlap import overlap_threshold
+    from .plotting import save_figure
 
     start, stop, step = args.elongations
     if not (step > 0 and stop >= start > 1.0):
@@ -159,25 +146,13 @@ def _cmd_overlap(args):
     q = np.round(np.arange(start, stop + step / 2, step), 10)
     scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
                              orbits=args.orbits, rtol=args.rtol)
-    fig, ax = plt.subplots(figsize=(6.4, 3.2))
-    ax.scatter(scan.elongations, scan.overlaps.astype(int),
-               c=["tab:blue" if o else "tab:green" for o in scan.overlaps])
-    ax.axvline(scan.elongation_ro, color="k", ls="--", lw=0.8, label="analytic ω0^RO")
-    if scan.first_overlap is not None:
-        ax.axvline(scan.first_overlap, color="tab:red", label="numerical")
-    ax.set_yticks([0, 1], ["separate", "overlap"])
-    ax.set_xlabel("a/b")
-    ax.set_title(f"{scan.name}, e = {scan.eccentricity}: 1:1 / 3:2 overlap", fontsize=9)
-    ax.legend(fontsize=7)
     out = args.out or f"overlap_{scan.name.replace(' ', '')}.png"
-    fig.tight_layout()
-    fig.savefig(out, dpi=150)
-    plt.close(fig)
+    save_figure(scan.plot(), out)
     system = catalog.system(args.system, eccentricity=args.eccentricity)
     meta = _base_meta(args, system)
     meta.update(first_overlap=scan.first_overlap, elongation_ro=scan.elongation_ro,
                 omega0_ro=scan.omega0_ro, decisions=[vars(d) for d in scan.decisions])
-    _write_npz(os.path.splitext(out)[0] + ".npz",
+    write_archive(os.path.splitext(out)[0] + ".npz",
                {"elongations": scan.elongations, "overlaps": scan.overlaps}, meta)
     if not args.quiet:
         print(f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "

@@ -12,15 +12,34 @@ import numpy as np
 from . import runtime
 
 
-def _metadata(result, kind, extra=None):
+def provenance():
+    """Package, version, Taichi arch and UTC timestamp: the common head of every metadata."""
     from . import __version__
 
+    return {"package": "ti_spinorbit", "version": __version__, "arch": runtime.current_arch(),
+            "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat()}
+
+
+def _json_default(x):
+    """JSON for what json does not know: numpy scalars and arrays, anything else as text."""
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    return str(x)
+
+
+def write_archive(path, arrays, metadata):
+    """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``."""
+    np.savez_compressed(path, metadata=np.array(json.dumps(metadata, indent=1, default=_json_default)),
+                        **{k: np.asarray(v) for k, v in arrays.items()})
+    return path
+
+
+def _metadata(result, kind, extra=None):
     meta = {
         "kind": kind,
-        "package": "ti_spinorbit",
-        "version": __version__,
-        "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(),
-        "arch": runtime.current_arch(),
+        **provenance(),
         "rtol": getattr(result, "rtol", None),
         "atol": getattr(result, "atol", None),
         "order": getattr(result, "order", None),
@@ -41,9 +60,7 @@ def save_result(result, path, kind="section", extra=None):
               if isinstance(v, np.ndarray)}
     if hasattr(result, "status_names"):
         arrays["status_names"] = np.array(result.status_names)
-    meta = json.dumps(_metadata(result, kind, extra), indent=1, default=float)
-    np.savez_compressed(path, metadata=np.array(meta), **arrays)
-    return path
+    return write_archive(path, arrays, _metadata(result, kind, extra))
 
 
 def read_metadata(path):

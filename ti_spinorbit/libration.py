@@ -63,13 +63,15 @@ MAX_CENTER_EXTENT_DEG = 1.0
 LIBRATION_LIMIT_DEG = 85.0
 
 
-def section_extent(section):
+def section_extent(section, members=None):
     """Horizontal half extent of each member's section trace, deg: max |θ_p| with θ_p in
-    (−90°, 90°]; NaN where the member stopped early (collision, escape, ...) or has no point."""
+    (−90°, 90°]; NaN where the member stopped early (collision, escape, ...) or has no point.
+    ``members`` (index array) restricts it to some members of the section."""
     from .kernels.ensemble import DONE
 
-    extent = np.atleast_1d(horizontal_extent(section.theta_p))
-    return np.where((section.status == DONE) & (section.count > 0), extent, np.nan)
+    idx = slice(None) if members is None else members
+    extent = np.atleast_1d(horizontal_extent(section.theta_p[idx]))
+    return np.where((section.status[idx] == DONE) & (section.count[idx] > 0), extent, np.nan)
 
 
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,

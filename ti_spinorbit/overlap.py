@@ -37,8 +37,8 @@ import numpy as np
 
 from . import analytic, catalog
 from ._validate import require_range
-from .classify import MEGNO_CHAOTIC, horizontal_extent
-from .kernels.ensemble import DONE
+from .classify import MEGNO_CHAOTIC
+from .libration import section_extent
 from .section import surface_of_section
 from .systems import BinarySystem
 
@@ -84,6 +84,23 @@ class OverlapScan:
     orbits: float
     seconds: float = 0.0
     sections: object = field(default=None, repr=False)
+
+    def plot(self, ax=None, title=None):
+        """Decision per elongation (overlap blue, separate green) with the numerical and the
+        analytic thresholds; returns the matplotlib Axes."""
+        if ax is None:
+            from .plotting import _pyplot
+            _, ax = _pyplot().subplots(figsize=(6.4, 3.2), dpi=150)
+        ax.scatter(self.elongations, self.overlaps.astype(int),
+                   c=["tab:blue" if o else "tab:green" for o in self.overlaps], s=25)
+        ax.axvline(self.elongation_ro, color="k", ls="--", lw=0.8, label="analytic ω0^RO")
+        if self.first_overlap is not None:
+            ax.axvline(self.first_overlap, color="tab:red", lw=1.0, label="numerical")
+        ax.set_yticks([0, 1], ["separate", "overlap"])
+        ax.set_xlabel("a/b")
+        ax.set_title(title or f"{self.name}, e = {self.eccentricity}: 1:1 / 3:2 overlap", fontsize=9)
+        ax.legend(fontsize=7)
+        return ax
 
     @property
     def monotonic(self) -> bool:
@@ -165,8 +182,7 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
     idx = np.arange(sec.count.size)[block]
     nc = len(centre_rates)
     centre_idx, sep_idx = idx[:nc], idx[nc:]
-    extent = np.where((sec.status[centre_idx] == DONE) & (sec.count[centre_idx] > 0),
-                      np.atleast_1d(horizontal_extent(sec.theta_p[centre_idx])), np.nan)
+    extent = section_extent(sec, centre_idx)
     librating = np.isfinite(extent) & (extent < libration_limit)
 
     def centre_near(nominal, window):

@@ -165,30 +165,31 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
 
 
 def _derived_columns(par, records, names, ensemble=None):
-    """Observables of per-member record lists, padded to (N, max count); adds "t" and, with
-    an ``ensemble``, the total "energy" (scaled)."""
+    """Observables of per-member record lists, padded with NaN to (N, max count): "t" and
+    ``names`` (observables.derive); with an ``ensemble`` also the energy and angular-momentum
+    split (scaled). All records are derived together: one NumPy pass, one kernel launch."""
+    from .kernels.ensemble import RECORD_WIDTH
     from .observables import derive
 
-    width = max([len(r) for r in records] + [1])
-    cols = {k: np.full((len(records), width), np.nan) for k in ("t",) + tuple(names)}
+    counts = np.array([len(r) for r in records])
+    width = max(int(counts.max(initial=0)), 1)
+    member = np.repeat(np.arange(len(records)), counts)
+    slot = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    flat = np.concatenate([np.zeros((0, RECORD_WIDTH))] + list(records))
+
+    def padded(values):
+        out = np.full((len(records), width) + values.shape[1:], np.nan)
+        out[member, slot] = values
+        return out
+
+    d = derive(par[member], flat[:, 1:])
+    cols = {"t": padded(flat[:, 0]), **{k: padded(d[k]) for k in names}}
     if ensemble is not None:
-        for k in ("energy_orbit", "energy_primary", "energy_secondary"):
-            cols[k] = np.full((len(records), width), np.nan)
-        for k in ("angmom_orbit", "angmom_primary", "angmom_secondary"):
-            cols[k] = np.full((len(records), width, 3), np.nan)
-    for i, rec in enumerate(records):
-        if not len(rec):
-            continue
-        d = derive(par[i][None], rec[:, 1:])
-        cols["t"][i, :len(rec)] = rec[:, 0]
-        for k in names:
-            cols[k][i, :len(rec)] = d[k]
-        if ensemble is not None:
-            diag = ensemble.diagnostics(rec[:, 1:], np.full(len(rec), i))
-            for c, k in enumerate(("energy_orbit", "energy_primary", "energy_secondary")):
-                cols[k][i, :len(rec)] = diag[:, c]
-            for c, k in enumerate(("angmom_orbit", "angmom_primary", "angmom_secondary")):
-                cols[k][i, :len(rec)] = diag[:, 3 + 3 * c:6 + 3 * c]
+        diag = ensemble.diagnostics(flat[:, 1:], member)
+        for c, k in enumerate(("energy_orbit", "energy_primary", "energy_secondary")):
+            cols[k] = padded(diag[:, c])
+        for c, k in enumerate(("angmom_orbit", "angmom_primary", "angmom_secondary")):
+            cols[k] = padded(diag[:, 3 + 3 * c:6 + 3 * c])
     return cols
 
 
