@@ -28,10 +28,12 @@ derivative are stored), so nothing is lost and nothing changes. A member that fa
 stopped with a status code and keeps everything recorded so far.
 """
 
+from types import SimpleNamespace
+
 import taichi as ti
 
-from . import eom
-from .eom import NSTATE, P_CONTACT, P_ESCAPE, Y_R, get3, state
+from . import eom, planar
+from .eom import NSTATE, state
 from .integrator import (NONFINITE_ERROR, error_norm, make_primitives, stage_matrix_type,
                          step_factor)
 from .potential import mutual, vec3
@@ -40,7 +42,8 @@ from .tableau import CASH_KARP
 RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE = range(6)
 STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite")
 
-#: Columns of event and sample records: time (scaled) then the 30-element scaled state.
+#: Columns of 3-D event and sample records: time (scaled) then the 30-element scaled state
+#: (planar records are converted to this layout on the host).
 RECORD_WIDTH = 1 + NSTATE
 DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
                "L_orbit_x", "L_orbit_y", "L_orbit_z", "L_primary_x", "L_primary_y",
@@ -60,261 +63,289 @@ nd3f = ti.types.ndarray(dtype=ti.f64, ndim=3)
 nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd2l = ti.types.ndarray(dtype=ti.i64, ndim=2)
 
-stage_point, combine = make_primitives(CASH_KARP, NSTATE)
-kmat = stage_matrix_type(CASH_KARP, NSTATE)
 
+def make_kernels(model):
+    """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion.
 
-@ti.func
-def _load(a: ti.template(), i):
-    y = state(0.0)
-    for k in ti.static(range(NSTATE)):
-        y[k] = a[i, k]
-    return y
+    ``model`` is a module (``eom`` for the 3-D model, ``planar`` for the planar one) that
+    provides NSTATE, state, rhs, pericentre_function, pericentre_rate, osculating_elements,
+    distance, P_CONTACT and P_ESCAPE. Kernels compile on first call, per model and variant.
+    """
+    NSTATE = model.NSTATE
+    state = model.state
+    stage_point, combine, put_stage = make_primitives(CASH_KARP, NSTATE)
+    kmat = stage_matrix_type(CASH_KARP, NSTATE)
 
+    @ti.func
+    def _load(a: ti.template(), i):
+        y = state(0.0)
+        for k in ti.static(range(NSTATE)):
+            y[k] = a[i, k]
+        return y
 
-@ti.func
-def _store(a: ti.template(), i, y):
-    for k in ti.static(range(NSTATE)):
-        a[i, k] = y[k]
+    @ti.func
+    def _store(a: ti.template(), i, y):
+        for k in ti.static(range(NSTATE)):
+            a[i, k] = y[k]
 
+    @ti.func
+    def _record(buf: ti.template(), i, slot, t, y):
+        buf[i, slot, 0] = t
+        for k in ti.static(range(NSTATE)):
+            buf[i, slot, 1 + k] = y[k]
 
-@ti.func
-def _record(buf: ti.template(), i, slot, t, y):
-    buf[i, slot, 0] = t
-    for k in ti.static(range(NSTATE)):
-        buf[i, slot, 1 + k] = y[k]
-
-
-@ti.kernel
-def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: nd1f,
-            h_nd: nd1f, t_end: nd1f, t_stop: nd1f, status: nd1i, counters: nd2l,
-            events: nd3f, n_events: nd1i, samples: nd3f, n_samples: nd1i, next_sample: nd1f,
-            shadow_nd: nd2f, shadow_f_nd: nd2f, ind: nd2f,
-            rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64, d0: ti.f64,
-            order: ti.template(), odd: ti.template(), sampling: ti.template(),
-            indicators: ti.template()):
-    """Advance every running member (see the module docstring)."""
-    cap = events.shape[1]
-    scap = samples.shape[1]
-    for i in range(y_nd.shape[0]):
-        if status[i] == RUNNING:
-            y = _load(y_nd, i)
-            yc = _load(yc_nd, i)            # Kahan compensation of y
-            f0 = _load(f_nd, i)             # dy/dt at (t, y): first stage of the next step
-            t = t_nd[i]
-            tc = tc_nd[i]                   # Kahan compensation of t
-            h = h_nd[i]                     # step proposal
-            te = t_end[i]
-            ts = t_stop[i]
-            st = RUNNING
-            nev = n_events[i]
-            nsm = n_samples[i]
-            acc = 0
-            rej = 0
-            calls = 0
-            after_reject = 0
-            K = kmat(0.0)
-            for c in ti.static(range(NSTATE)):
-                K[0, c] = f0[c]
-            # shadow trajectory (chaos indicators): same steps, its own stages in K2
-            y_s = state(0.0)
-            ys_try = state(0.0)
-            f_s1 = state(0.0)
-            K2 = kmat(0.0)
-            ell = 0.0
-            s_weighted = 0.0
-            ybar_int = 0.0
-            if ti.static(indicators):
-                y_s = _load(shadow_nd, i)
+    @ti.kernel
+    def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: nd1f,
+                h_nd: nd1f, t_end: nd1f, t_stop: nd1f, status: nd1i, counters: nd2l,
+                events: nd3f, n_events: nd1i, samples: nd3f, n_samples: nd1i, next_sample: nd1f,
+                shadow_nd: nd2f, shadow_f_nd: nd2f, ind: nd2f,
+                rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64, d0: ti.f64,
+                order: ti.template(), odd: ti.template(), sampling: ti.template(),
+                indicators: ti.template()):
+        """Advance every running member (see the module docstring)."""
+        cap = events.shape[1]
+        scap = samples.shape[1]
+        for i in range(y_nd.shape[0]):
+            if status[i] == RUNNING:
+                y = _load(y_nd, i)
+                yc = _load(yc_nd, i)            # Kahan compensation of y
+                f0 = _load(f_nd, i)             # dy/dt at (t, y): first stage of the next step
+                t = t_nd[i]
+                tc = tc_nd[i]                   # Kahan compensation of t
+                h = h_nd[i]                     # step proposal
+                te = t_end[i]
+                ts = t_stop[i]
+                st = RUNNING
+                nev = n_events[i]
+                nsm = n_samples[i]
+                acc = 0
+                rej = 0
+                calls = 0
+                after_reject = 0
+                K = kmat(0.0)
                 for c in ti.static(range(NSTATE)):
-                    K2[0, c] = shadow_f_nd[i, c]
-                ell = ind[i, 0]
-                s_weighted = ind[i, 1]
-                ybar_int = ind[i, 2]
-            # trial-step and event-location state
-            new_attempt = 1
-            mode = _STEP
-            stage = 1
-            hs = h
-            hit_end = 0
-            hit_sample = 0
-            dy = state(0.0)
-            y_try = y
-            en = 0.0
-            dy_acc = state(0.0)
-            f_acc = state(0.0)
-            hs_acc = 0.0
-            en_acc = 0.0
-            g0 = 0.0
-            tau = 0.0
-            it = 0
-            while st == RUNNING and t < te and nev < cap and nsm < scap:
-                if new_attempt == 1:         # a new trial step from (t, y) with proposal h
-                    hs = h
-                    hit_end = 0
-                    hit_sample = 0
-                    if ts - t <= hs:
-                        hs = ts - t
-                        hit_end = 1
-                    if ti.static(sampling):
-                        if next_sample[i] - t <= hs:
-                            hs = next_sample[i] - t
-                            hit_sample = 1
-                            hit_end = 0
-                            if ts - t <= hs:
-                                hit_end = 1
-                    stage = 1
-                    new_attempt = 0
-                copies = 1
+                    K[0, c] = f0[c]
+                # shadow trajectory (chaos indicators): same steps, its own stages in K2
+                y_s = state(0.0)
+                ys_try = state(0.0)
+                f_s1 = state(0.0)
+                K2 = kmat(0.0)
+                ell = 0.0
+                s_weighted = 0.0
+                ybar_int = 0.0
                 if ti.static(indicators):
-                    if mode == _STEP:
-                        copies = 2                          # the shadow rides along
-                fy = state(0.0)
-                for copy in range(copies):                  # runtime loop: one call site
-                    pt = y_try
-                    if copy == 0:
-                        if stage < _STAGES:
-                            pt = stage_point(y, K, hs, stage)
-                    else:
-                        pt = ys_try
-                        if stage < _STAGES:
-                            pt = stage_point(y_s, K2, hs, stage)
-                    fc = eom.rhs(par, i, pt, order, odd)    # the only RHS call site
-                    calls += 1
-                    if copy == 0:
-                        fy = fc
-                    elif stage < _STAGES:
-                        for c in ti.static(range(NSTATE)):
-                            K2[stage, c] = fc[c]
-                    else:
-                        f_s1 = fc
-                do_accept = 0
-                if stage < _STAGES:
+                    y_s = _load(shadow_nd, i)
                     for c in ti.static(range(NSTATE)):
-                        K[stage, c] = fy[c]
-                    stage += 1
-                    if stage == _STAGES:
-                        dy, err = combine(K, hs)
-                        y_try = y + dy
-                        if ti.static(indicators):
-                            if mode == _STEP:
-                                dy_s, err_s = combine(K2, hs)
-                                ys_try = y_s + dy_s
-                        en = error_norm(y, y_try, err, rtol, atol, NSTATE)
-                        if mode == _STEP and en > 1.0:
-                            rej += 1
-                            if en >= NONFINITE_ERROR:
-                                h = hs * 0.2
-                            else:
-                                h = hs * step_factor(en, 1, _EXPONENT)
-                            after_reject = 1
-                            new_attempt = 1
-                            if h < min_step:
-                                st = ti.select(en >= NONFINITE_ERROR, NONFINITE, STEP_UNDERFLOW)
-                elif mode == _STEP:                         # fy = f(y_try) of an accepted step
-                    g0 = eom.pericentre_function(y)
-                    g1 = eom.pericentre_function(y_try)
-                    if g0 < 0.0 and g1 >= 0.0:
-                        dy_acc = dy
-                        f_acc = fy
-                        hs_acc = hs
-                        en_acc = en
-                        tau = hs * g0 / (g0 - g1)           # secant guess, then Newton
-                        it = 0
-                        mode = _LOCATE
-                        hs = tau
+                        K2[0, c] = shadow_f_nd[i, c]
+                    ell = ind[i, 0]
+                    s_weighted = ind[i, 1]
+                    ybar_int = ind[i, 2]
+                # trial-step and event-location state
+                new_attempt = 1
+                mode = _STEP
+                stage = 1
+                hs = h
+                hit_end = 0
+                hit_sample = 0
+                dy = state(0.0)
+                y_try = y
+                en = 0.0
+                dy_acc = state(0.0)
+                f_acc = state(0.0)
+                hs_acc = 0.0
+                en_acc = 0.0
+                g0 = 0.0
+                tau = 0.0
+                it = 0
+                while st == RUNNING and t < te and nev < cap and nsm < scap:
+                    if new_attempt == 1:         # a new trial step from (t, y) with proposal h
+                        hs = h
+                        hit_end = 0
+                        hit_sample = 0
+                        if ts - t <= hs:
+                            hs = ts - t
+                            hit_end = 1
+                        if ti.static(sampling):
+                            if next_sample[i] - t <= hs:
+                                hs = next_sample[i] - t
+                                hit_sample = 1
+                                hit_end = 0
+                                if ts - t <= hs:
+                                    hit_end = 1
                         stage = 1
-                    else:
-                        do_accept = 1
-                else:                                       # Newton iterate at y_try = y(τ)
-                    g = eom.pericentre_function(y_try)
-                    gp = eom.pericentre_rate(y_try, fy)
-                    new_tau = ti.min(hs_acc, ti.max(0.0, tau - g / gp))
-                    it += 1
-                    if ti.abs(new_tau - tau) <= 4e-16 * hs_acc or it >= NEWTON_MAX_ITER:
-                        _record(events, i, nev, t - tc + tau, y_try)   # Kahan: true t = t - tc
-                        nev += 1
-                        mode = _STEP
-                        dy = dy_acc
-                        fy = f_acc
-                        hs = hs_acc
-                        en = en_acc
-                        do_accept = 1
-                    else:
-                        tau = new_tau
-                        hs = tau
-                        stage = 1
-                if do_accept == 1:
-                    t_mid = t + 0.5 * hs
-                    yk = dy - yc                            # Kahan-compensated y += dy
-                    ysum = y + yk
-                    yc = (ysum - y) - yk
-                    y = ysum
-                    tk = hs - tc                            # and t += hs
-                    tsum = t + tk
-                    tc = (tsum - t) - tk
-                    t = tsum
-                    if hit_sample == 1 or hit_end == 1:     # landed on a grid time: exact
-                        tc = 0.0
-                        t = ti.select(hit_end == 1, ts, next_sample[i])
-                    f0 = fy
-                    for c in ti.static(range(NSTATE)):
-                        K[0, c] = fy[c]
+                        new_attempt = 0
+                    copies = 1
                     if ti.static(indicators):
-                        # separation growth over the step, then renormalise to d0 (the
-                        # shadow's derivative is rescaled linearly: exact to O(d0²))
-                        delta = ys_try - y
-                        d = delta.norm()
-                        if d > 0.0:
-                            dl = ti.log(d / d0)
-                            ell += dl
-                            s_weighted += t_mid * dl
-                            ybar_int += 2.0 * s_weighted / t * hs
-                            scale = d0 / d
-                            y_s = y + delta * scale
-                            for c in ti.static(range(NSTATE)):
-                                K2[0, c] = fy[c] + (f_s1[c] - fy[c]) * scale
-                    acc += 1
-                    fac = step_factor(en, after_reject, _EXPONENT)
-                    if not ((hit_end == 1 or hit_sample == 1) and hs < h and fac >= 1.0):
-                        h = hs * fac                        # (a shortened step that did well keeps h)
-                    after_reject = 0
-                    new_attempt = 1
-                    if ti.static(sampling):
-                        if hit_sample == 1:
-                            _record(samples, i, nsm, t, y)
-                            nsm += 1
-                            next_sample[i] += sample_dt
-                    r = get3(y, Y_R).norm()
-                    if not (r == r):
-                        st = NONFINITE
-                    elif r <= par[i, P_CONTACT]:
-                        st = COLLISION
-                    elif r >= par[i, P_ESCAPE]:
-                        st = ESCAPE
-                    else:
-                        a_osc, e_osc = eom.osculating_elements(y)
-                        if a_osc < 0.0 and eom.pericentre_function(y) > 0.0:
-                            st = ESCAPE                     # unbound and receding
-            _store(y_nd, i, y)
-            _store(yc_nd, i, yc)
-            _store(f_nd, i, f0)
-            if ti.static(indicators):
-                _store(shadow_nd, i, y_s)
-                for c in ti.static(range(NSTATE)):
-                    shadow_f_nd[i, c] = K2[0, c]
-                ind[i, 0] = ell
-                ind[i, 1] = s_weighted
-                ind[i, 2] = ybar_int
-            t_nd[i] = t
-            tc_nd[i] = tc
-            h_nd[i] = h
-            status[i] = st
-            n_events[i] = nev
-            n_samples[i] = nsm
-            counters[i, C_ACCEPTED] += acc
-            counters[i, C_REJECTED] += rej
-            counters[i, C_RHS] += calls
+                        if mode == _STEP:
+                            copies = 2                          # the shadow rides along
+                    fy = state(0.0)
+                    for copy in range(copies):                  # runtime loop: one call site
+                        pt = y_try
+                        if copy == 0:
+                            if stage < _STAGES:
+                                pt = stage_point(y, K, hs, stage)
+                        else:
+                            pt = ys_try
+                            if stage < _STAGES:
+                                pt = stage_point(y_s, K2, hs, stage)
+                        fc = model.rhs(par, i, pt, order, odd)    # the only RHS call site
+                        calls += 1
+                        if copy == 0:
+                            fy = fc
+                        elif stage < _STAGES:
+                            put_stage(K2, stage, fc)
+                        else:
+                            f_s1 = fc
+                    do_accept = 0
+                    if stage < _STAGES:
+                        put_stage(K, stage, fy)
+                        stage += 1
+                        if stage == _STAGES:
+                            dy, err = combine(K, hs)
+                            y_try = y + dy
+                            if ti.static(indicators):
+                                if mode == _STEP:
+                                    dy_s, err_s = combine(K2, hs)
+                                    ys_try = y_s + dy_s
+                            en = error_norm(y, y_try, err, rtol, atol, NSTATE)
+                            if mode == _STEP and en > 1.0:
+                                rej += 1
+                                if en >= NONFINITE_ERROR:
+                                    h = hs * 0.2
+                                else:
+                                    h = hs * step_factor(en, 1, _EXPONENT)
+                                after_reject = 1
+                                new_attempt = 1
+                                if h < min_step:
+                                    st = ti.select(en >= NONFINITE_ERROR, NONFINITE, STEP_UNDERFLOW)
+                    elif mode == _STEP:                         # fy = f(y_try) of an accepted step
+                        g0 = model.pericentre_function(y)
+                        g1 = model.pericentre_function(y_try)
+                        if g0 < 0.0 and g1 >= 0.0:
+                            dy_acc = dy
+                            f_acc = fy
+                            hs_acc = hs
+                            en_acc = en
+                            tau = hs * g0 / (g0 - g1)           # secant guess, then Newton
+                            it = 0
+                            mode = _LOCATE
+                            hs = tau
+                            stage = 1
+                        else:
+                            do_accept = 1
+                    else:                                       # Newton iterate at y_try = y(τ)
+                        g = model.pericentre_function(y_try)
+                        gp = model.pericentre_rate(y_try, fy)
+                        new_tau = ti.min(hs_acc, ti.max(0.0, tau - g / gp))
+                        it += 1
+                        if ti.abs(new_tau - tau) <= 4e-16 * hs_acc or it >= NEWTON_MAX_ITER:
+                            _record(events, i, nev, t - tc + tau, y_try)   # Kahan: true t = t - tc
+                            nev += 1
+                            mode = _STEP
+                            dy = dy_acc
+                            fy = f_acc
+                            hs = hs_acc
+                            en = en_acc
+                            do_accept = 1
+                        else:
+                            tau = new_tau
+                            hs = tau
+                            stage = 1
+                    if do_accept == 1:
+                        t_mid = t + 0.5 * hs
+                        yk = dy - yc                            # Kahan-compensated y += dy
+                        ysum = y + yk
+                        yc = (ysum - y) - yk
+                        y = ysum
+                        tk = hs - tc                            # and t += hs
+                        tsum = t + tk
+                        tc = (tsum - t) - tk
+                        t = tsum
+                        if hit_sample == 1 or hit_end == 1:     # landed on a grid time: exact
+                            tc = 0.0
+                            t = ti.select(hit_end == 1, ts, next_sample[i])
+                        f0 = fy
+                        for c in ti.static(range(NSTATE)):
+                            K[0, c] = fy[c]
+                        if ti.static(indicators):
+                            # separation growth over the step, then renormalise to d0 (the
+                            # shadow's derivative is rescaled linearly: exact to O(d0²))
+                            delta = ys_try - y
+                            d = delta.norm()
+                            if d > 0.0:
+                                dl = ti.log(d / d0)
+                                ell += dl
+                                s_weighted += t_mid * dl
+                                ybar_int += 2.0 * s_weighted / t * hs
+                                scale = d0 / d
+                                y_s = y + delta * scale
+                                for c in ti.static(range(NSTATE)):
+                                    K2[0, c] = fy[c] + (f_s1[c] - fy[c]) * scale
+                        acc += 1
+                        fac = step_factor(en, after_reject, _EXPONENT)
+                        if not ((hit_end == 1 or hit_sample == 1) and hs < h and fac >= 1.0):
+                            h = hs * fac                        # (a shortened step that did well keeps h)
+                        after_reject = 0
+                        new_attempt = 1
+                        if ti.static(sampling):
+                            if hit_sample == 1:
+                                _record(samples, i, nsm, t, y)
+                                nsm += 1
+                                next_sample[i] += sample_dt
+                        r = model.distance(y)
+                        if not (r == r):
+                            st = NONFINITE
+                        elif r <= par[i, model.P_CONTACT]:
+                            st = COLLISION
+                        elif r >= par[i, model.P_ESCAPE]:
+                            st = ESCAPE
+                        else:
+                            a_osc, e_osc = model.osculating_elements(y)
+                            if a_osc < 0.0 and model.pericentre_function(y) > 0.0:
+                                st = ESCAPE                     # unbound and receding
+                _store(y_nd, i, y)
+                _store(yc_nd, i, yc)
+                _store(f_nd, i, f0)
+                if ti.static(indicators):
+                    _store(shadow_nd, i, y_s)
+                    for c in ti.static(range(NSTATE)):
+                        shadow_f_nd[i, c] = K2[0, c]
+                    ind[i, 0] = ell
+                    ind[i, 1] = s_weighted
+                    ind[i, 2] = ybar_int
+                t_nd[i] = t
+                tc_nd[i] = tc
+                h_nd[i] = h
+                status[i] = st
+                n_events[i] = nev
+                n_samples[i] = nsm
+                counters[i, C_ACCEPTED] += acc
+                counters[i, C_REJECTED] += rej
+                counters[i, C_RHS] += calls
+
+    @ti.kernel
+    def evaluate_rhs(par: nd2f, y_nd: nd2f, out: nd2f, order: ti.template(), odd: ti.template()):
+        """dy/dt for each row of y (also the first stage of every member's first step)."""
+        for i in range(y_nd.shape[0]):
+            _store(out, i, model.rhs(par, i, _load(y_nd, i), order, odd))
+
+    return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, NSTATE=NSTATE,
+                           RECORD_WIDTH=1 + NSTATE, model=model)
+
+
+#: The 3-D model's kernels (30-number state) and the planar model's (10 numbers).
+SPATIAL = make_kernels(eom)
+PLANAR = make_kernels(planar)
+advance = SPATIAL.advance
+evaluate_rhs = SPATIAL.evaluate_rhs
+
+
+@ti.func
+def _load_spatial(a: ti.template(), k):
+    y = state(0.0)
+    for c in ti.static(range(NSTATE)):
+        y[c] = a[k, c]
+    return y
 
 
 @ti.kernel
@@ -324,7 +355,7 @@ def diagnostics(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, order: ti.templa
     states y_nd[k] belonging to members member[k]."""
     for k in range(y_nd.shape[0]):
         i = member[k]
-        y = _load(y_nd, k)
+        y = _load_spatial(y_nd, k)
         e_orb, e1, e2 = eom.energy_split(par, i, y, order, odd)
         l_orb, l1, l2 = eom.angular_momentum_split(par, i, y)
         o, o1 = eom.orthonormality_error(y)
@@ -337,13 +368,6 @@ def diagnostics(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, order: ti.templa
             out[k, 9 + c] = l2[c]
         out[k, 12] = o
         out[k, 13] = o1
-
-
-@ti.kernel
-def evaluate_rhs(par: nd2f, y_nd: nd2f, out: nd2f, order: ti.template(), odd: ti.template()):
-    """dy/dt for each row of y (also the first stage of every member's first step)."""
-    for i in range(y_nd.shape[0]):
-        _store(out, i, eom.rhs(par, i, _load(y_nd, i), order, odd))
 
 
 @ti.kernel

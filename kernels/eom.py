@@ -112,6 +112,11 @@ def pericentre_rate(y, dy):
 
 
 @ti.func
+def distance(y):
+    return get3(y, Y_R).norm()
+
+
+@ti.func
 def osculating_elements(y):
     """Osculating semimajor axis and eccentricity (scaled units, μ = G(m1+m2) = 1)."""
     R = get3(y, Y_R)

@@ -36,10 +36,16 @@ def stage_matrix_type(tableau, n):
 
 
 def make_primitives(tableau, n):
-    """``(stage_point, combine)`` funcs for ``tableau`` on n-component states.
+    """``(stage_point, combine, put_stage)`` funcs for ``tableau`` on n-component states.
 
     * ``stage_point(y, K, h, s)``: y + h Σ_{j<s} a_sj K[j]  (s is a runtime index >= 1)
     * ``combine(K, h)``: (dy, err) = (h Σ b_s K[s], h Σ (b_s − b̂_s) K[s])
+    * ``put_stage(K, s, v)``: K[s] = v for a runtime s
+
+    The runtime stage index is dispatched to compile-time branches, so every access to K has
+    a constant index: K then lives in registers and the a_sj are immediates (indexing a
+    local matrix with a runtime index forces it, and a copy of the tableau, into memory on
+    every call; this alone cost about a third of the planar model's time per stage).
     """
     A = _padded_a(tableau)
     B, E = tableau.b, tableau.e
@@ -47,13 +53,22 @@ def make_primitives(tableau, n):
 
     @ti.func
     def stage_point(y, K, h, s):
-        a_mat = ti.Matrix(A, ti.f64)
         ys = y
-        for j in range(s):
-            w = a_mat[s, j] * h
-            for c in ti.static(range(n)):
-                ys[c] += w * K[j, c]
+        for st in ti.static(range(1, stages)):
+            if s == st:
+                for j in ti.static(range(st)):
+                    if ti.static(A[st][j] != 0.0):
+                        w = A[st][j] * h
+                        for c in ti.static(range(n)):
+                            ys[c] += w * K[j, c]
         return ys
+
+    @ti.func
+    def put_stage(K: ti.template(), s, v):
+        for st in ti.static(range(stages)):
+            if s == st:
+                for c in ti.static(range(n)):
+                    K[st, c] = v[c]
 
     @ti.func
     def combine(K, h):
@@ -67,7 +82,7 @@ def make_primitives(tableau, n):
                     err[c] += E[s] * K[s, c]
         return dy * h, err * h
 
-    return stage_point, combine
+    return stage_point, combine, put_stage
 
 
 def make_step(f, n, tableau=CASH_KARP):
@@ -76,7 +91,7 @@ def make_step(f, n, tableau=CASH_KARP):
 
     ``dy`` is the increment h Σ b_i k_i of the propagated solution, ``err`` the embedded
     error estimate h Σ (b_i − b̂_i) k_i."""
-    stage_point, combine = make_primitives(tableau, n)
+    stage_point, combine, put_stage = make_primitives(tableau, n)
     kmat = stage_matrix_type(tableau, n)
     stages = tableau.stages
 
@@ -86,9 +101,7 @@ def make_step(f, n, tableau=CASH_KARP):
         for c in ti.static(range(n)):
             K[0, c] = k1[c]
         for s in range(1, stages):
-            fs = f(p, i, stage_point(y, K, h, s), order, odd)
-            for c in ti.static(range(n)):
-                K[s, c] = fs[c]
+            put_stage(K, s, f(p, i, stage_point(y, K, h, s), order, odd))
         return combine(K, h)
 
     return rk_step

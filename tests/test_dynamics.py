@@ -188,17 +188,21 @@ def test_catalogue_1991_vh_matches_the_table(vh):
     assert vh.omega0 == pytest.approx(np.sqrt(3 * (1.5**2 - 1) / (1.5**2 + 1)), rel=1e-14)
 
 
-def test_time_series_energy_split_exchanges_but_total_is_conserved():
+@pytest.mark.parametrize("model", ["planar", "3d"])
+def test_time_series_energy_split_exchanges_but_total_is_conserved(model):
     """Energy-test case over one orbit: the orbit and secondary-spin energies trade by far
-    more than the total drifts; the angular momenta likewise (SI units)."""
+    more than the total drifts; the angular momenta likewise (SI units). Measured drifts at
+    rtol 1e-12: energy 1.2e-11 planar, 3.4e-12 3-D (the primary spins at 15 n, and the planar
+    model's stored angles turn at ω − n), angular momentum 4.4e-11 and 1.4e-11."""
     system = tso.catalog.system("test")
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
-    ts = tso.time_series(system, 0.0, spin2, orbits=1, samples_per_orbit=40, rtol=1e-12)
+    ts = tso.time_series(system, 0.0, spin2, orbits=1, samples_per_orbit=40, rtol=1e-12,
+                         model=model)
     e_tot = ts.energy_orbit[0] + ts.energy_primary[0] + ts.energy_secondary[0]
     np.testing.assert_allclose(ts.energy[0], e_tot)
     drift = np.abs(e_tot - e_tot[0]).max() / abs(e_tot[0])
     swing = np.ptp(ts.energy_secondary[0]) / abs(e_tot[0])
-    assert drift < 1e-11 and swing > 1e4 * drift
+    assert drift < 2e-11 and swing > 1e4 * drift
     l_tot = ts.angmom_orbit[0] + ts.angmom_primary[0] + ts.angmom_secondary[0]
     ldrift = np.linalg.norm(l_tot - l_tot[0], axis=1).max() / np.linalg.norm(l_tot[0])
     assert ldrift < 1e-10 and np.ptp(ts.angmom_secondary[0][:, 2]) > 1e4 * ldrift * np.linalg.norm(l_tot[0])

@@ -18,8 +18,8 @@ from typing import Callable, List, Optional
 
 import numpy as np
 
-from . import runtime
-from ._validate import require_count, require_positive, require_range
+from . import planar, runtime
+from ._validate import require_count, require_memory, require_positive, require_range
 
 #: Default tolerance floor: atol = rtol unless given (the scaled state is O(1)).
 DEFAULT_WINDOW_ORBITS = 16
@@ -78,16 +78,22 @@ class Ensemble:
         Truncation order of the mutual potential.
     rtol, atol : float
         Tolerances on the scaled state (error in tolerance units, max norm).
+    model : {"auto", "planar", "3d"}
+        Equations of motion: "planar" integrates the reduced planar state
+        (``kernels/planar.py``, about 3x cheaper per step), "3d" the general one; "auto"
+        (default) takes the planar model when every member qualifies
+        (``ti_spinorbit.planar.qualifies``). Inputs and outputs are 3-D states either way.
     """
 
     def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,
-                 min_step=MIN_STEP):
+                 min_step=MIN_STEP, model="auto"):
         from .bodies import ROW_LENGTH
         from .kernels import eom
 
         runtime.ensure_init()
         self.par = np.ascontiguousarray(par, dtype=np.float64)
         self.y = np.ascontiguousarray(y0, dtype=np.float64).copy()
+        self._y_start = self.y.copy()
         if self.par.ndim != 2 or self.par.shape[1] != eom.NPAR or self.y.shape != (len(self.par), eom.NSTATE):
             raise ValueError("par must be (N, NPAR) and y0 (N, 30) with the same N")
         if order not in (0, 2, 3, 4):
@@ -98,6 +104,12 @@ class Ensemble:
             odd = bool(np.any(self.par[:, _odd_columns(ROW_LENGTH)] != 0.0))
         self.odd = bool(odd)
         self.min_step = float(min_step)
+        self.model = _choose_model(model, self.par, self.y)
+        if self.model == "planar":
+            self.kpar = planar.parameter_rows(self.par)
+            self.y = planar.to_planar(self.y)
+        else:
+            self.kpar = self.par
         n = len(self.par)
         self.n = n
         self.t = np.zeros(n)
@@ -105,12 +117,23 @@ class Ensemble:
         self.status = np.zeros(n, dtype=np.int32)
         self.counters = np.zeros((n, 3), dtype=np.int64)
 
+    @property
+    def kernels(self):
+        """The kernel set of this ensemble's model (kernels.ensemble.SPATIAL or PLANAR)."""
+        from .kernels import ensemble as K
+        return K.PLANAR if self.model == "planar" else K.SPATIAL
+
+    def spatial(self, y):
+        """Kernel states of this model -> 3-D scaled states (a copy)."""
+        return planar.to_spatial(y) if self.model == "planar" else np.array(y, dtype=np.float64)
+
     def diagnostics(self, y=None, member=None) -> np.ndarray:
-        """DIAG_FIELDS (energies, angular momenta, orthonormality) of states y (default: the
-        current ones) belonging to members ``member`` (default 0..N-1), scaled units."""
+        """DIAG_FIELDS (energies, angular momenta, orthonormality) of 3-D states y (default:
+        the current ones) belonging to members ``member`` (default 0..N-1), scaled units."""
         from .kernels import ensemble as K
 
-        y = self.y if y is None else np.ascontiguousarray(y, dtype=np.float64).reshape(-1, 30)
+        y = self.spatial(self.y) if y is None else \
+            np.ascontiguousarray(y, dtype=np.float64).reshape(-1, 30)
         member = np.arange(len(y), dtype=np.int32) if member is None else \
             np.ascontiguousarray(member, dtype=np.int32)
         out = np.zeros((len(y), len(K.DIAG_FIELDS)))
@@ -120,7 +143,8 @@ class Ensemble:
 
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
             indicators=False, separation=SHADOW_SEPARATION,
-            progress: Optional[Callable[[float], None]] = None) -> RunOutput:
+            progress: Optional[Callable[[float], None]] = None, checkpoint=None,
+            resume=False) -> RunOutput:
         """Integrate every member to ``t_stop`` (scaled; scalar or per member).
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
@@ -130,11 +154,19 @@ class Ensemble:
         ``indicators`` integrates a shadow trajectory with the same steps, started
         ``separation`` away (scaled-state Euclidean norm) along a fixed planar direction and
         renormalised to that separation after every accepted step; it yields the finite-time
-        maximal Lyapunov exponent and MEGNO ⟨Y⟩ (``RunOutput.lyapunov``, ``.megno``)."""
+        maximal Lyapunov exponent and MEGNO ⟨Y⟩ (``RunOutput.lyapunov``, ``.megno``).
+
+        ``checkpoint`` (a path) saves everything needed to resume after every window, with an
+        atomic replace (``ti_spinorbit.checkpoint``); with ``resume=True`` a run continues
+        from that file when it exists and gives the same results as an uninterrupted run. A
+        checkpoint written for other inputs or settings, or a damaged one, raises ValueError.
+        """
         import time
 
+        from . import checkpoint as ckpt
         from .kernels import ensemble as K
 
+        kern = self.kernels
         n = self.n
         t_stop = np.broadcast_to(np.asarray(t_stop, dtype=np.float64), (n,)).copy()
         require_positive("t_stop", t_stop)
@@ -144,44 +176,38 @@ class Ensemble:
         sampling = sample_dt is not None
         if sampling:
             require_positive("sample_dt", sample_dt)
-            scap = int(np.ceil(window / sample_dt)) + 4
-            next_sample = np.full(n, float(sample_dt))
-        else:
-            scap = 1
-            next_sample = np.zeros(n)
-        events_buf = np.zeros((n, cap, K.RECORD_WIDTH))
-        samples_buf = np.zeros((n, scap, K.RECORD_WIDTH))
-        n_events = np.zeros(n, dtype=np.int32)
-        n_samples = np.zeros(n, dtype=np.int32)
-        yc = np.zeros_like(self.y)
-        tc = np.zeros(n)
-        f = np.zeros_like(self.y)
-        K.evaluate_rhs(self.par, self.y, f, self.order, self.odd)
-        self.counters[:, K.C_RHS] += 1
         if indicators:
             require_range("separation", separation, 1e-14, 1e-3)
-            shadow = self.y + separation * _shadow_direction()
-            shadow_f = np.zeros_like(shadow)
-            K.evaluate_rhs(self.par, shadow, shadow_f, self.order, self.odd)
-            ind = np.zeros((n, 3))
-        else:  # unused by the kernel variant without indicators
-            shadow, shadow_f, ind = np.zeros((1, 30)), np.zeros((1, 30)), np.zeros((1, 3))
-        events = [[] for _ in range(n)]
-        samples = [[] for _ in range(n)]
-        if sampling:  # the first sample is the initial state
-            for i in range(n):
-                samples[i].append(np.concatenate([[0.0], self.y[i]])[None])
-        diag_start = self.diagnostics()
-        launches = 0
-        t0 = time.perf_counter()
+        require_memory("the recorded crossings and samples",
+                       _record_bytes(t_stop, sample_dt, kern.RECORD_WIDTH, cap),
+                       "integrate fewer members or orbits per call, or sample less densely")
+        settings = {"model": self.model, "order": self.order, "odd": self.odd,
+                    "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
+                    "window_orbits": window_orbits, "sample_dt": sample_dt,
+                    "indicators": bool(indicators), "separation": float(separation)}
+        st = None
+        if checkpoint is not None and resume:
+            st = ckpt.load(checkpoint, settings, self._fingerprint(t_stop))
+        if st is None:
+            st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
+        else:
+            for name in ("y", "t", "h", "status", "counters"):
+                setattr(self, name, st.pop(name))
+        scap = int(np.ceil(window / sample_dt)) + 4 if sampling else 1
+        events_buf = np.zeros((n, cap, kern.RECORD_WIDTH))
+        samples_buf = np.zeros((n, scap, kern.RECORD_WIDTH))
+        n_events = np.zeros(n, dtype=np.int32)
+        n_samples = np.zeros(n, dtype=np.int32)
+        events, samples = st["events"], st["samples"]
+        t0 = time.perf_counter() - st["seconds"]
         while np.any(self.status == K.RUNNING):
             t_end = np.minimum(t_stop, self.t + window)
-            K.advance(self.par, self.y, yc, f, self.t, tc, self.h, t_end, t_stop, self.status,
-                      self.counters, events_buf, n_events, samples_buf, n_samples, next_sample,
-                      shadow, shadow_f, ind,
-                      self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
-                      float(separation), self.order, self.odd, sampling, bool(indicators))
-            launches += 1
+            kern.advance(self.kpar, self.y, st["yc"], st["f"], self.t, st["tc"], self.h, t_end,
+                         t_stop, self.status, self.counters, events_buf, n_events, samples_buf,
+                         n_samples, st["next_sample"], st["shadow"], st["shadow_f"], st["ind"],
+                         self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
+                         float(separation), self.order, self.odd, sampling, bool(indicators))
+            st["launches"] += 1
             for i in np.nonzero(n_events)[0]:
                 events[i].append(events_buf[i, :n_events[i]].copy())
             for i in np.nonzero(n_samples)[0]:
@@ -190,21 +216,98 @@ class Ensemble:
             n_samples[:] = 0
             finished = (self.status == K.RUNNING) & (self.t >= t_stop)
             self.status[finished] = K.DONE
+            st["seconds"] = time.perf_counter() - t0
+            if checkpoint is not None:
+                ckpt.save(checkpoint, settings, self._fingerprint(t_stop),
+                          dict(st, y=self.y, t=self.t, h=self.h, status=self.status,
+                               counters=self.counters))
             if progress is not None:
                 progress(float(np.mean(np.minimum(self.t, t_stop)) / np.mean(t_stop)))
-        seconds = time.perf_counter() - t0
-        empty = np.zeros((0, K.RECORD_WIDTH))
         megno = lyapunov = np.full(n, np.nan)
         if indicators:
+            ind = st["ind"]
             with np.errstate(divide="ignore", invalid="ignore"):
                 megno = ind[:, 2] / self.t
                 lyapunov = ind[:, 0] / self.t * 2.0 * np.pi   # per orbit (2π scaled time)
         return RunOutput(
-            events=[np.concatenate(e) if e else empty for e in events],
-            samples=[np.concatenate(s) if s else empty for s in samples],
-            diag_start=diag_start, diag_end=self.diagnostics(), t=self.t.copy(), y=self.y.copy(),
-            status=self.status.copy(), counters=self.counters.copy(), launches=launches,
-            seconds=seconds, megno=megno, lyapunov=lyapunov)
+            events=[self._spatial_records(e) for e in events],
+            samples=[self._spatial_records(s) for s in samples],
+            diag_start=st["diag_start"], diag_end=self.diagnostics(), t=self.t.copy(),
+            y=self.spatial(self.y), status=self.status.copy(), counters=self.counters.copy(),
+            launches=st["launches"], seconds=st["seconds"], megno=megno, lyapunov=lyapunov)
+
+    def _fresh_run_state(self, sampling, sample_dt, indicators, separation):
+        """Everything a run carries between windows besides y, t, h, status, counters."""
+        from .kernels import ensemble as K
+
+        kern = self.kernels
+        n = self.n
+        f = np.zeros_like(self.y)
+        kern.evaluate_rhs(self.kpar, self.y, f, self.order, self.odd)
+        self.counters[:, K.C_RHS] += 1
+        if indicators:
+            direction = planar.shadow_direction() if self.model == "planar" else _shadow_direction()
+            shadow = self.y + separation * direction
+            shadow_f = np.zeros_like(shadow)
+            kern.evaluate_rhs(self.kpar, shadow, shadow_f, self.order, self.odd)
+            ind = np.zeros((n, 3))
+        else:  # unused by the kernel variant without indicators
+            shadow = shadow_f = np.zeros((1, kern.NSTATE))
+            ind = np.zeros((1, 3))
+        samples = [[] for _ in range(n)]
+        if sampling:  # the first sample is the initial state
+            for i in range(n):
+                samples[i].append(np.concatenate([[0.0], self.y[i]])[None])
+        return {"yc": np.zeros_like(self.y), "tc": np.zeros(n), "f": f,
+                "next_sample": np.full(n, float(sample_dt)) if sampling else np.zeros(n),
+                "shadow": shadow, "shadow_f": shadow_f, "ind": ind,
+                "events": [[] for _ in range(n)], "samples": samples,
+                "diag_start": self.diagnostics(), "launches": 0, "seconds": 0.0}
+
+    def _fingerprint(self, t_stop):
+        """Digest of what determines a run's results (inputs at the start of the run)."""
+        import hashlib
+
+        h = hashlib.sha256()
+        for a in (self.par, self._y_start, t_stop):
+            h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
+        return h.hexdigest()
+
+    def _spatial_records(self, chunks):
+        """Concatenate a member's record chunks and convert them to (count, 31) 3-D rows."""
+        from .kernels import ensemble as K
+
+        if not chunks:
+            return np.zeros((0, K.RECORD_WIDTH))
+        rec = np.concatenate(chunks)
+        if self.model != "planar":
+            return rec
+        return np.concatenate([rec[:, :1], planar.to_spatial(rec[:, 1:])], axis=1)
+
+
+def _record_bytes(t_stop, sample_dt, width, cap):
+    """Bytes the recorded crossings (≈ 1.25 per orbit, generous for near-circular orbits) and
+    samples of a run will occupy, plus the window buffers."""
+    orbits = np.asarray(t_stop) / (2.0 * np.pi)
+    rows = np.sum(1.25 * orbits + cap)
+    if sample_dt is not None:
+        rows += np.sum(np.asarray(t_stop) / sample_dt + 1) + len(orbits) * cap
+    return float(rows) * width * 8 * 2          # lists, then the concatenated copy
+
+
+def _choose_model(model, par, y0):
+    """"planar" or "3d" for Ensemble(model=...)."""
+    if model not in ("auto", "planar", "3d"):
+        raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
+    if model == "3d":
+        return "3d"
+    ok = planar.qualifies(par, y0)
+    if model == "planar" and not np.all(ok):
+        bad = np.nonzero(~ok)[0]
+        raise ValueError(f"model='planar' needs planar starts and bodies symmetric about their "
+                         f"equators; members {bad[:10].tolist()} do not qualify (use "
+                         "model='3d' or 'auto')")
+    return "planar" if np.all(ok) else "3d"
 
 
 def _odd_columns(row_length):

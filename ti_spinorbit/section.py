@@ -112,7 +112,8 @@ class SectionResult:
 def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-12,
                        atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
-                       progress=None) -> SectionResult:
+                       progress=None, model="auto", checkpoint=None,
+                       resume=False) -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -138,6 +139,14 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
         MEGNO and the maximal Lyapunov exponent; the main trajectory is unchanged.
     progress : callable, optional
         ``progress(fraction)`` after every window.
+    model : {"auto", "planar", "3d"}
+        Equations of motion. "auto" integrates the reduced planar model when every member
+        starts planar with bodies symmetric about their equators (every catalogued system),
+        else the general 3-D one; "3d" forces the general model (``Ensemble``).
+    checkpoint : path, optional
+        Write a checkpoint after every window (atomic replace); with ``resume=True`` continue
+        from it when it exists. A resumed run equals an uninterrupted one
+        (``ti_spinorbit.checkpoint``).
 
     Returns
     -------
@@ -147,9 +156,9 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     if not np.isfinite(orbits) or orbits <= 0:
         raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
-                  progress=progress)
+                  progress=progress, checkpoint=checkpoint, resume=resume)
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"))
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
@@ -224,7 +233,8 @@ class TimeSeriesResult:
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
                 rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
-                escape_distance=ESCAPE_DISTANCE) -> TimeSeriesResult:
+                escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
+                resume=False) -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
@@ -234,9 +244,10 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     if not np.isfinite(orbits) or orbits <= 0:
         raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
-                  sample_dt=2.0 * np.pi / samples_per_orbit)
+                  sample_dt=2.0 * np.pi / samples_per_orbit, progress=progress,
+                  checkpoint=checkpoint, resume=resume)
     cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r"), ensemble=ens)
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
