@@ -19,10 +19,12 @@ from .chaosmap import chaos_map, parameter_map
 from .classify import classify_section
 from .libration import libration_amplitude, relaxed_libration
 from .overlap import overlap_threshold
+from .io import load, save, to_xarray
 
 __version__ = "0.1.0"
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
-           "overlap_threshold", "chaos_map", "parameter_map", "__version__"]
+           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray",
+           "__version__"]

@@ -1,15 +1,140 @@
-"""Saving results with their parameters (NumPy ``.npz`` + JSON metadata).
+"""Saving and loading results with their parameters (NumPy ``.npz`` + JSON metadata).
 
-Every array of a result goes into the archive under its own name; a ``metadata`` entry holds
-JSON with all inputs and their units, the package version, tolerances, arch and timestamp,
-so a file is self-describing without this package."""
+:func:`save` writes any result object of the package (surface of section, time series, chaos
+map, parameter map, overlap scan, relaxed libration) to one compressed ``.npz``: every array
+under its own name, plus a ``metadata`` entry holding JSON with the result's kind, the
+archive ``format_version``, the package version, Taichi arch and UTC timestamp, every scalar
+input and output, the units of every array and scalar, the systems (all inputs with units,
+body inertia integrals included) and the integrator status codes. A file is self-describing
+without this package (``numpy.load`` + ``json``); :func:`load` turns it back into the same
+result object, with identical arrays and equal systems.
 
+Layout decisions (the README's "Saved files" section documents them for users):
+
+* A result nested in another (``ChaosMap.section``, ``OverlapScan.sections``: the underlying
+  :class:`~ti_spinorbit.section.SectionResult`) is saved with its field name as prefix
+  (``section/theta_p``) so a loaded map can still be plotted with its section overlay;
+  ``save(..., include_sections=False)`` drops it (the file shrinks to the map alone and the
+  loaded field is None).
+* Systems are stored once each: ``metadata["systems"]`` lists the distinct systems and the
+  array ``system_index`` gives each member's entry (a 10^4-member map of one system holds
+  one description, not 10^4).
+* Label arrays (Python ``object`` arrays of str) are stored as fixed-width unicode, so the
+  file opens with ``allow_pickle=False``; :func:`load` gives them back as ``object`` arrays.
+* ``status_names`` (the status code of each member as text) is written next to ``status``
+  for readers without the package; :func:`load` ignores it.
+* Format versions: 1 is this layout; 0 is the layout :func:`save_result` wrote before
+  ``format_version`` existed (sections and time series only), which :func:`load` still reads.
+"""
+
+import dataclasses
 import datetime
 import json
+import os
+import zipfile
 
 import numpy as np
 
 from . import runtime
+
+#: Layout version written into every archive's metadata; bump it when the layout changes.
+FORMAT_VERSION = 1
+#: Versions :func:`load` reads (0: files from save_result before format_version existed).
+READABLE_FORMAT_VERSIONS = (0, 1)
+
+SPIN = "mean motion n"                 # spin rates and frequencies in units of n
+STATUS = "status code (metadata status_codes)"
+LABEL = "label"
+_COMMON_UNITS = {"status_names": "name", "system_index": "index into metadata systems",
+                 "rtol": "1", "atol": "1", "orbits": "orbital periods", "seconds": "s"}
+#: Units of every array and scalar field, per kind ("1": dimensionless).
+UNITS = {
+    "section": {
+        "theta_p": "deg", "thetadot_p": SPIN, "t": "s", "r": "m", "a": "m", "e": "1",
+        "count": "crossings", "energy_drift": "1 (relative)", "angmom_drift": "1 (relative)",
+        "status": STATUS, "accepted": "steps", "rejected": "steps", "rhs_calls": "calls",
+        "initial_theta_p": "deg", "initial_thetadot_p": SPIN, "megno": "1",
+        "lyapunov": "1/orbit", "order": "potential truncation order"},
+    "time_series": {
+        "t": "s", "alpha": "deg", "theta": "deg", "thetadot": SPIN, "r": "m", "energy": "J",
+        "energy_orbit": "J", "energy_primary": "J", "energy_secondary": "J",
+        "angmom_orbit": "kg m^2 s^-1", "angmom_primary": "kg m^2 s^-1",
+        "angmom_secondary": "kg m^2 s^-1", "status": STATUS, "initial_theta_p": "deg",
+        "initial_thetadot_p": SPIN},
+    "chaos_map": {
+        "theta_p": "deg", "thetadot_p": SPIN, "megno": "1", "lyapunov": "1/orbit",
+        "classification": LABEL, "mean_spin": SPIN, "status": STATUS, "chaotic_fraction": "1",
+        "megno_chaotic": "1"},
+    "parameter_map": {
+        "elongations": "1 (a/b)", "eccentricities": "1", "chaotic_fraction": "1",
+        "megno": "1", "labels": LABEL, "status": STATUS, "theta_p": "deg",
+        "thetadot_p": SPIN, "omega0": SPIN},
+    "overlap_scan": {
+        "eccentricity": "1", "elongations": "1 (a/b)", "overlaps": "bool",
+        "first_overlap": "1 (a/b)", "omega0_ro": SPIN, "elongation_ro": "1 (a/b)",
+        # the per-elongation decisions (metadata records), OverlapDecision fields
+        "decisions/elongation": "1 (a/b)", "decisions/omega0": SPIN,
+        "decisions/center_1": SPIN, "decisions/center_3_2": SPIN,
+        "decisions/connecting_start": SPIN, "decisions/connecting_range": SPIN,
+        "decisions/widest_range": SPIN, "decisions/connecting_megno": "1",
+        "decisions/connecting_lyapunov": "1/orbit",
+        "decisions/separatrix_chaotic_fraction": "1"},
+    "relaxed_libration": {
+        "center_thetadot_p": SPIN, "amplitude": "deg", "extent": "deg", "psi_A": "deg",
+        "psi_A_effective": "deg", "omega0": SPIN, "omega0_effective": SPIN,
+        "iterations": "launches", "converged": "bool", "candidates": SPIN, "extents": "deg",
+        "samples_per_orbit": "1/orbit", "xtol": SPIN},
+}
+
+
+def _kinds():
+    """kind name -> result class (imported here: io must not import the heavy modules first)."""
+    from .chaosmap import ChaosMap, ParameterMap
+    from .libration import RelaxedLibration
+    from .overlap import OverlapScan
+    from .section import SectionResult, TimeSeriesResult
+
+    return {"section": SectionResult, "time_series": TimeSeriesResult, "chaos_map": ChaosMap,
+            "parameter_map": ParameterMap, "overlap_scan": OverlapScan,
+            "relaxed_libration": RelaxedLibration}
+
+
+def _record_types():
+    """Small dataclasses stored as JSON records inside a result (name -> class)."""
+    from .overlap import OverlapDecision
+
+    return {"OverlapDecision": OverlapDecision}
+
+
+def kind_of(result):
+    """The archive kind of a result object ("section", "chaos_map", ...), or TypeError."""
+    for kind, cls in _kinds().items():
+        if type(result) is cls:
+            return kind
+    raise TypeError(f"cannot save a {type(result).__name__}: save() takes one of "
+                    f"{', '.join(c.__name__ for c in _kinds().values())}")
+
+
+def units(kind):
+    """Units of the arrays and scalars of a result kind (a copy), e.g. ``units("section")``."""
+    if kind not in UNITS:
+        raise ValueError(f"unknown kind {kind!r}; known kinds: {', '.join(UNITS)}")
+    return {**_COMMON_UNITS, **UNITS[kind]}
+
+
+def status_codes():
+    """Integrator status code -> name, e.g. {0: "running", 1: "done", ...}."""
+    from .kernels.ensemble import STATUS_NAMES
+
+    return dict(enumerate(STATUS_NAMES))
+
+
+def status_names(status):
+    """Names of an array of status codes (same shape, str), e.g. [1, 3] -> ["done", "escape"]."""
+    status = np.asarray(status)
+    if not status.size:
+        return status.astype(str)
+    return np.vectorize(status_codes().get, otypes=[str])(status)
 
 
 def provenance():
@@ -30,40 +155,320 @@ def _json_default(x):
 
 
 def write_archive(path, arrays, metadata):
-    """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``."""
+    """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``.
+
+    Returns the path written: NumPy appends ``.npz`` to a file name without it."""
     np.savez_compressed(path, metadata=np.array(json.dumps(metadata, indent=1, default=_json_default)),
                         **{k: np.asarray(v) for k, v in arrays.items()})
+    if isinstance(path, (str, os.PathLike)) and not os.fspath(path).endswith(".npz"):
+        return os.fspath(path) + ".npz"
     return path
 
 
-def _metadata(result, kind, extra=None):
-    meta = {
-        "kind": kind,
-        **provenance(),
-        "rtol": getattr(result, "rtol", None),
-        "atol": getattr(result, "atol", None),
-        "order": getattr(result, "order", None),
-        "orbits": getattr(result, "orbits", None),
-        "systems": [s.describe() for s in result.systems],
-        "units": {"theta_p": "deg", "thetadot_p": "mean motion n", "t": "s", "r": "m",
-                  "a": "m", "e": "1", "initial_theta_p": "deg", "initial_thetadot_p": "n",
-                  "alpha": "deg", "theta": "deg", "thetadot": "n", "energy": "J"},
-    }
+# ---- writing ----------------------------------------------------------------------------
+class _Systems:
+    """The distinct systems of an archive, each described once (by identity, then content)."""
+
+    def __init__(self):
+        self.descriptions, self._by_id, self._by_text = [], {}, {}
+
+    def index(self, system):
+        key = id(system)
+        if key not in self._by_id:
+            d = describe_system(system)
+            text = json.dumps(d, sort_keys=True, default=_json_default)
+            if text not in self._by_text:
+                self._by_text[text] = len(self.descriptions)
+                self.descriptions.append(d)
+            self._by_id[key] = self._by_text[text]
+        return self._by_id[key]
+
+
+def describe_system(system):
+    """``system.describe()`` plus each body's inertia integrals (``"integrals"``,
+    ``{"l,m,n": T^{lmn}}`` in kg m^(l+m+n), non-zero entries), so that
+    :meth:`BinarySystem.from_description` rebuilds any body exactly, not only ellipsoids."""
+    from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
+
+    d = system.describe()
+    for label, body in (("primary", system.primary), ("secondary", system.secondary)):
+        row = body.as_row()[1:]
+        keys = EXPONENTS_2 + EXPONENTS_3 + EXPONENTS_4
+        d[label] = {**d[label], "integrals": {",".join(map(str, k)): float(v)
+                                              for k, v in zip(keys, row) if v != 0.0}}
+    return d
+
+
+def _is_system(x):
+    from .systems import BinarySystem
+
+    return isinstance(x, BinarySystem)
+
+
+#: Metadata entries that tell load() how to rebuild a result (empty ones are left out).
+_BLOCK_KEYS = {"arrays": [], "object_arrays": [], "array_lists": {}, "system_refs": {},
+               "records": {}, "nested": {}, "dropped": []}
+
+
+def _encode(result, prefix, systems, arrays, units_out, include_sections):
+    """Put a result's arrays into ``arrays`` (names prefixed) and return its metadata block:
+    which fields are arrays, scalars, systems, records, nested results."""
+    kind = kind_of(result)
+    table = units(kind)
+    block = {"kind": kind, "fields": {}, **{k: type(v)() for k, v in _BLOCK_KEYS.items()}}
+    kinds = tuple(_kinds().values())
+    for f in dataclasses.fields(result):
+        name, value = f.name, getattr(result, f.name)
+        key = prefix + name
+        if isinstance(value, kinds):
+            if include_sections:
+                block["nested"][name] = _encode(value, key + "/", systems, arrays, units_out,
+                                                include_sections)
+            else:
+                block["fields"][name] = None
+                block["dropped"].append(name)
+        elif isinstance(value, np.ndarray):
+            if value.dtype == object:
+                if not all(isinstance(v, str) for v in value.flat):
+                    raise TypeError(f"{kind} field {name!r}: object arrays can only be saved "
+                                    "when they hold str")
+                value = value.astype(str)
+                block["object_arrays"].append(name)
+            arrays[key] = value
+            block["arrays"].append(name)
+            if name == "status":
+                arrays[key + "_names"] = status_names(value)
+                units_out[key + "_names"] = table["status_names"]
+        elif _is_system(value):
+            block["system_refs"][name] = {"index": systems.index(value)}
+        elif isinstance(value, list) and value and all(_is_system(s) for s in value):
+            arrays[prefix + "system_index"] = np.array([systems.index(s) for s in value],
+                                                       dtype=np.int64)
+            block["system_refs"][name] = {"array": "system_index"}
+            units_out[prefix + "system_index"] = table["system_index"]
+        elif isinstance(value, list) and all(isinstance(a, np.ndarray) for a in value):
+            for k, a in enumerate(value):
+                arrays[f"{key}/{k}"] = a
+                if name in table:
+                    units_out[f"{key}/{k}"] = table[name]
+            block["array_lists"][name] = len(value)
+        elif isinstance(value, list) and all(dataclasses.is_dataclass(r) for r in value):
+            block["records"][name] = _encode_records(kind, name, value)
+        elif value is None or isinstance(value, (bool, int, float, str, np.generic)):
+            block["fields"][name] = value.item() if isinstance(value, np.generic) else value
+        else:
+            raise TypeError(f"{kind} field {name!r} of type {type(value).__name__} has no "
+                            "archive representation")
+        if name in table:
+            units_out[key] = table[name]
+        for k, v in table.items():   # units of record fields ("decisions/center_1")
+            if k.startswith(name + "/"):
+                units_out[prefix + k] = v
+    return {k: v for k, v in block.items() if v or k in ("kind", "fields")}
+
+
+def _encode_records(kind, name, records):
+    types = {type(r).__name__ for r in records}
+    known = _record_types()
+    if len(types) > 1 or not types <= set(known):
+        raise TypeError(f"{kind} field {name!r}: records of type {sorted(types)} cannot be saved")
+    items = [dataclasses.asdict(r) for r in records]
+    tuples = sorted({k for item in items for k, v in item.items() if isinstance(v, tuple)})
+    return {"type": types.pop() if types else None, "tuples": tuples, "items": items}
+
+
+def save(result, path, extra=None, include_sections=True):
+    """Save a result object to ``path`` (``.npz``, compressed); returns the path written.
+
+    Parameters
+    ----------
+    result : SectionResult, TimeSeriesResult, ChaosMap, ParameterMap, OverlapScan or
+        RelaxedLibration
+        What the package's entry points return.
+    path : str or path-like
+        File to write; NumPy appends ``.npz`` when the name lacks it.
+    extra : dict, optional
+        More JSON-able metadata (e.g. the command line that made the result); its keys must
+        not clash with the standard ones.
+    include_sections : bool
+        Also save a nested section (``ChaosMap.section``, ``OverlapScan.sections``) under the
+        prefix ``section/`` (or ``sections/``). False drops it: smaller file, and the loaded
+        result has None there.
+
+    The metadata holds ``kind``, ``format_version``, ``package``, ``version``, ``arch``,
+    ``created_utc``, ``rtol``/``atol``/``order``/``orbits`` where the result has them,
+    ``fields`` (every scalar field), ``units`` (every array and scalar), ``systems``,
+    ``status_codes`` and ``status_counts``; see the module docstring for the layout.
+    """
+    kind = kind_of(result)
+    systems, arrays, units_out = _Systems(), {}, {}
+    block = _encode(result, "", systems, arrays, units_out, bool(include_sections))
+    fields = block["fields"]
+    meta = {"kind": kind, "format_version": FORMAT_VERSION, **provenance(),
+            **{k: fields.get(k) for k in ("rtol", "atol", "order", "orbits")},
+            "systems": systems.descriptions, "units": units_out,
+            "status_codes": {str(k): v for k, v in status_codes().items()}}
+    status = getattr(result, "status", None)
+    if isinstance(status, np.ndarray):
+        names, counts = np.unique(arrays["status_names"], return_counts=True)
+        meta["status_counts"] = {str(n): int(c) for n, c in zip(names, counts)}
+    meta.update(block)
     if extra:
+        clash = sorted(set(extra) & (set(meta) | set(_BLOCK_KEYS) | {"status_counts"}))
+        if clash:
+            raise ValueError(f"extra metadata keys {clash} clash with the standard keys; "
+                             "rename them")
         meta.update(extra)
-    return meta
+    return write_archive(path, arrays, meta)
 
 
-def save_result(result, path, kind="section", extra=None):
-    """Write a SectionResult or TimeSeriesResult to ``path`` (.npz); returns the path."""
-    arrays = {k: np.asarray(v) for k, v in vars(result).items()
-              if isinstance(v, np.ndarray)}
-    if hasattr(result, "status_names"):
-        arrays["status_names"] = np.array(result.status_names)
-    return write_archive(path, arrays, _metadata(result, kind, extra))
+def save_result(result, path, kind=None, extra=None):
+    """Alias of :func:`save` kept for older callers; ``kind``, if given, must match the
+    result's kind ("section" for a SectionResult, "time_series" for a TimeSeriesResult, ...)."""
+    if kind is not None and kind != kind_of(result):
+        raise ValueError(f"kind {kind!r} does not match the result: a {type(result).__name__} "
+                         f"is saved as kind {kind_of(result)!r}")
+    return save(result, path, extra=extra)
+
+
+# ---- reading ----------------------------------------------------------------------------
+def _open(path):
+    """np.load of an archive with clear errors; returns (NpzFile, metadata dict or None)."""
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        hint = f" (did you mean {p + '.npz'!r}?)" if os.path.isfile(p + ".npz") else ""
+        raise FileNotFoundError(f"no saved result at {p!r}{hint}")
+    try:
+        data = np.load(p, allow_pickle=False)
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise ValueError(f"{p!r} is not a ti_spinorbit archive: not a NumPy .npz file ({exc})") from None
+    if not isinstance(data, np.lib.npyio.NpzFile):
+        raise ValueError(f"{p!r} is not a ti_spinorbit archive: a single .npy array, not an .npz")
+    if "metadata" not in data.files:
+        data.close()
+        raise ValueError(f"{p!r} is not a ti_spinorbit archive: it has no 'metadata' entry "
+                         f"(entries: {', '.join(data.files) or 'none'})")
+    try:
+        meta = json.loads(str(data["metadata"]))
+    except (ValueError, TypeError) as exc:
+        data.close()
+        raise ValueError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not JSON "
+                         f"({exc})") from None
+    if not isinstance(meta, dict):
+        data.close()
+        raise ValueError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not a JSON object")
+    return data, meta
 
 
 def read_metadata(path):
     """The JSON metadata of a saved result, as a dict."""
-    with np.load(path) as data:
-        return json.loads(str(data["metadata"]))
+    data, meta = _open(path)
+    data.close()
+    return meta
+
+
+def load(path):
+    """Load a file written by :func:`save` (or the CLI) into the same result object.
+
+    Arrays come back identical (dtype and values, NaN padding included), scalar fields
+    equal, and systems rebuilt with :meth:`BinarySystem.from_description` (identical
+    parameter rows and initial states; members that shared a system share it again).
+
+    Raises
+    ------
+    FileNotFoundError
+        No file at ``path``.
+    ValueError
+        Not a ti_spinorbit archive (not an .npz, no metadata, no ``kind``), an unknown kind,
+        or a ``format_version`` this version of the package cannot read.
+    """
+    from . import __version__
+    from .systems import BinarySystem
+
+    p = os.fspath(path)
+    data, meta = _open(p)
+    with data:
+        if "kind" not in meta:
+            raise ValueError(
+                f"{p!r} is not a ti_spinorbit result archive: its metadata has no 'kind' (it was "
+                "written by write_archive directly, e.g. by an experiment script; read it with "
+                "numpy.load and ti_spinorbit.io.read_metadata)")
+        version = meta.get("format_version", 0)
+        if type(version) is not int or version not in READABLE_FORMAT_VERSIONS:
+            raise ValueError(
+                f"{p!r} has archive format_version {version!r}; ti_spinorbit {__version__} reads "
+                f"format versions {', '.join(map(str, READABLE_FORMAT_VERSIONS))} (a newer "
+                "package wrote it: upgrade ti_spinorbit)")
+        kind = meta["kind"]
+        if kind not in _kinds():
+            raise ValueError(f"{p!r} holds unknown kind {kind!r}; known kinds: "
+                             f"{', '.join(_kinds())}")
+        arrays = {k: data[k] for k in data.files if k != "metadata"}
+    if version == 0:
+        meta = _upgrade_v0(p, meta, arrays)
+    systems = [BinarySystem.from_description(d) for d in meta.get("systems", [])]
+    return _decode(meta, arrays, "", systems)
+
+
+def _decode(block, arrays, prefix, systems):
+    cls = _kinds()[block["kind"]]
+    kwargs = dict(block.get("fields", {}))
+    for name in block.get("arrays", []):
+        value = arrays[prefix + name]
+        kwargs[name] = value.astype(object) if name in block.get("object_arrays", []) else value
+    for name, count in block.get("array_lists", {}).items():
+        kwargs[name] = [arrays[f"{prefix}{name}/{k}"] for k in range(count)]
+    for name, ref in block.get("system_refs", {}).items():
+        if "index" in ref:
+            kwargs[name] = systems[ref["index"]]
+        else:
+            kwargs[name] = [systems[i] for i in arrays[prefix + ref["array"]]]
+    for name, rec in block.get("records", {}).items():
+        rtype = _record_types()[rec["type"]] if rec["type"] else None
+        kwargs[name] = [rtype(**{k: tuple(v) if k in rec["tuples"] and v is not None else v
+                                 for k, v in item.items()}) for item in rec["items"]]
+    for name, sub in block.get("nested", {}).items():
+        kwargs[name] = _decode(sub, arrays, f"{prefix}{name}/", systems)
+    return cls(**kwargs)
+
+
+def _upgrade_v0(path, meta, arrays):
+    """Metadata of a pre-format_version file (save_result of ti_spinorbit 0.1: a section or
+    time series with one system description per member) in the version-1 layout."""
+    from .systems import BinarySystem
+
+    kind = "time_series" if "alpha" in arrays else "section"
+    if meta["kind"] not in ("section", "time_series"):
+        raise ValueError(f"{path!r} (format_version 0) holds kind {meta['kind']!r}; format 0 "
+                         "files can only be sections or time series")
+    names = {f.name for f in dataclasses.fields(_kinds()[kind])}
+    members = meta.get("systems", [])
+    if len(members) != len(arrays["status"]):
+        raise ValueError(f"{path!r}: {len(members)} system descriptions for "
+                         f"{len(arrays['status'])} members")
+    unique, index = [], []
+    for d in members:
+        if d not in unique:
+            BinarySystem.from_description(d)   # fail here, naming the file's content
+            unique.append(d)
+        index.append(unique.index(d))
+    arrays["system_index"] = np.array(index, dtype=np.int64)
+    return {"kind": kind, "systems": unique,
+            "fields": {k: meta[k] for k in ("rtol", "atol", "order", "orbits")
+                       if k in names and meta.get(k) is not None},
+            "arrays": [k for k in arrays if k in names],
+            "system_refs": {"systems": {"array": "system_index"}}}
+
+
+def to_xarray(result_or_path):
+    """Labelled ``xarray.Dataset`` of a result or of a saved file: see
+    :func:`ti_spinorbit.xarray_io.to_xarray` (xarray is imported only when this is called;
+    ``pip install "ti-spinorbit[xarray]"``)."""
+    from .xarray_io import to_xarray as convert
+
+    return convert(result_or_path)
+
+
+__all__ = ["save", "load", "to_xarray", "save_result", "read_metadata", "write_archive",
+           "provenance", "describe_system", "units", "status_codes", "status_names", "kind_of",
+           "FORMAT_VERSION"]

@@ -187,3 +187,66 @@ class BinarySystem:
                 "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
                 "mean_motion_rad_s": self.mean_motion, "mass_ratio": self.mass_ratio,
                 "omega0": self.omega0}
+
+    @classmethod
+    def from_description(cls, d: dict) -> "BinarySystem":
+        """Rebuild a system from :meth:`describe` output (e.g. read back from a saved file).
+
+        The result has the identical :meth:`parameter_row` and :meth:`initial_state`.
+
+        Each body entry (``d["primary"]``, ``d["secondary"]``) is rebuilt
+
+        * from ``"integrals"``, ``{"l,m,n": T^{lmn} in kg m^(l+m+n)}`` with ``"mass_kg"`` and
+          ``"bounding_radius_m"``, when present (:func:`ti_spinorbit.io.save` writes them for
+          every body): a general :class:`Body`, or a uniform ellipsoid when ``"semi_axes_m"``
+          is also given and the ellipsoid's integrals equal the saved ones exactly;
+        * else from ``"semi_axes_m"`` (m) and ``"mass_kg"`` as a uniform ellipsoid, which is
+          exact because an ellipsoid's integrals depend on nothing else.
+
+        A general body described by :meth:`describe` alone (no semi-axes, no integrals)
+        cannot be rebuilt: ValueError. Derived entries (mean motion, mass ratio, ω0) are
+        recomputed, not read.
+        """
+        from .bodies import Ellipsoid
+
+        if not isinstance(d, dict):
+            raise TypeError(f"system description must be a dict from BinarySystem.describe() "
+                            f"(got {type(d).__name__})")
+        missing = [k for k in ("primary", "secondary", "a_m", "e") if k not in d]
+        if missing:
+            raise ValueError(f"system description lacks {', '.join(map(repr, missing))} "
+                             f"(has {', '.join(map(repr, d))}); expected BinarySystem.describe() output")
+
+        def body(label, b):
+            for key in ("mass_kg", "bounding_radius_m"):
+                if key not in b:
+                    raise ValueError(f"{label} description lacks {key!r} (has {', '.join(map(repr, b))})")
+            name = b.get("name", "body")
+            ellipsoid = None
+            if b.get("semi_axes_m") is not None:
+                ellipsoid = Ellipsoid(*b["semi_axes_m"], mass=b["mass_kg"], name=name)
+            if b.get("integrals") is None:
+                if ellipsoid is None:
+                    raise ValueError(
+                        f"{label} {name!r} is a general Body: its description needs 'integrals' "
+                        "({'l,m,n': T^lmn}, as written by ti_spinorbit.io.save) or 'semi_axes_m'; "
+                        "describe() alone does not hold its inertia integrals")
+                return ellipsoid
+            integrals = {}
+            for key, value in b["integrals"].items():
+                try:
+                    lmn = tuple(int(i) for i in key.split(","))
+                except (AttributeError, ValueError):
+                    raise ValueError(f"{label} integrals: key {key!r} is not 'l,m,n'") from None
+                integrals[lmn] = float(value)
+            general = Body(float(b["mass_kg"]), integrals, float(b["bounding_radius_m"]), name)
+            if ellipsoid is not None and np.array_equal(ellipsoid.as_row(), general.as_row()) \
+                    and ellipsoid.bounding_radius == general.bounding_radius:
+                return ellipsoid
+            return general
+
+        period = d.get("primary_spin_period_s")
+        return cls(body("primary", d["primary"]), body("secondary", d["secondary"]),
+                   float(d["a_m"]), float(d["e"]),
+                   primary_spin_period=None if period is None else float(period),
+                   name=d.get("name", "binary"))

@@ -1,0 +1,210 @@
+"""Results as labelled :class:`xarray.Dataset` objects (optional: ``pip install "ti-spinorbit[xarray]"``).
+
+:func:`to_xarray` gives every array of a result its named dimensions and coordinates and a
+``units`` attribute (the same units :func:`ti_spinorbit.io.save` writes), and the scalar
+metadata as dataset attributes, ready for ``.sel``, ``.plot`` or ``.to_netcdf``. xarray is
+imported only when :func:`to_xarray` is called, never at package import.
+
+Dimensions per result:
+
+=====================  ===========================================================
+SectionResult          (member, crossing); member coords initial_theta_p, initial_thetadot_p
+TimeSeriesResult       (member, sample); angular momenta also (component: x, y, z)
+ChaosMap               (theta_p, thetadot_p)
+ParameterMap           (elongation, eccentricity); per start also (start) with coords
+                       theta_p, thetadot_p
+OverlapScan            (elongation); the ranges also (bound: low, high)
+RelaxedLibration       (candidate) with coord launch (0: coarse bracket, then zooms)
+=====================  ===========================================================
+
+A nested section (``ChaosMap.section``, ``OverlapScan.sections``) is not merged in (its
+dimensions differ): convert it on its own, ``to_xarray(cmap.section)``.
+"""
+
+import json
+import os
+
+import numpy as np
+
+from . import io
+
+INSTALL_HINT = 'to_xarray needs xarray: pip install "ti-spinorbit[xarray]"'
+
+
+def _xarray():
+    try:
+        import xarray
+    except ImportError as exc:
+        raise ImportError(INSTALL_HINT) from exc
+    return xarray
+
+
+def _attrs(result, kind, metadata):
+    """JSON-able scalar metadata: the result's scalar fields, provenance, systems (as JSON)."""
+    attrs = {"kind": kind}
+    source = metadata if metadata is not None else {**io.provenance(),
+                                                    "format_version": io.FORMAT_VERSION}
+    for key in ("format_version", "package", "version", "arch", "created_utc"):
+        if source.get(key) is not None:
+            attrs[key] = source[key]
+    for name, value in vars(result).items():
+        if isinstance(value, np.generic):
+            value = value.item()
+        if isinstance(value, (bool, np.bool_)):
+            attrs[name] = int(value)           # netCDF has no bool attribute
+        elif isinstance(value, (int, float, str)):
+            attrs[name] = value
+    systems = getattr(result, "systems", None)
+    if systems is None and getattr(result, "system", None) is not None:
+        systems = [result.system]
+    for nested in ("section", "sections"):   # ChaosMap.section, OverlapScan.sections
+        if systems is None and getattr(result, nested, None) is not None:
+            systems = getattr(result, nested).systems
+    if systems:
+        unique = []
+        for s in systems:
+            if not any(s is u for u in unique):
+                unique.append(s)
+        attrs["systems"] = json.dumps([io.describe_system(s) for s in unique],
+                                     default=io._json_default)
+    return attrs
+
+
+def _labels(a):
+    """Object arrays of str as fixed-width unicode (netCDF cannot hold Python objects)."""
+    return a.astype(str) if isinstance(a, np.ndarray) and a.dtype == object else a
+
+
+def _section(r, units):
+    n, width = np.shape(r.theta_p)
+    member_vars = ["count", "energy_drift", "angmom_drift", "status", "accepted", "rejected",
+                   "rhs_calls", "megno", "lyapunov"]
+    data = {k: (("member", "crossing"), getattr(r, k)) for k in ("theta_p", "thetadot_p", "t", "r", "a", "e")}
+    data.update({k: ("member", getattr(r, k)) for k in member_vars if getattr(r, k) is not None})
+    data["status_name"] = ("member", io.status_names(r.status))
+    coords = {"member": np.arange(n), "crossing": np.arange(width),
+              "initial_theta_p": ("member", r.initial_theta_p),
+              "initial_thetadot_p": ("member", r.initial_thetadot_p),
+              "system": ("member", [s.name for s in r.systems])}
+    return data, coords
+
+
+def _time_series(r, units):
+    n, width = np.shape(r.t)
+    data = {k: (("member", "sample"), getattr(r, k))
+            for k in ("t", "alpha", "theta", "thetadot", "r", "energy", "energy_orbit",
+                      "energy_primary", "energy_secondary")}
+    data.update({k: (("member", "sample", "component"), getattr(r, k))
+                 for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")})
+    data["status"] = ("member", r.status)
+    data["status_name"] = ("member", io.status_names(r.status))
+    coords = {"member": np.arange(n), "sample": np.arange(width), "component": ["x", "y", "z"],
+              "system": ("member", [s.name for s in r.systems])}
+    if r.initial_theta_p is not None:
+        coords["initial_theta_p"] = ("member", r.initial_theta_p)
+    if r.initial_thetadot_p is not None:
+        coords["initial_thetadot_p"] = ("member", r.initial_thetadot_p)
+    return data, coords
+
+
+def _chaos_map(r, units):
+    dims = ("theta_p", "thetadot_p")
+    data = {k: (dims, _labels(getattr(r, k)))
+            for k in ("megno", "lyapunov", "classification", "mean_spin", "status")}
+    data["status_name"] = (dims, io.status_names(r.status))
+    return data, {"theta_p": r.theta_p, "thetadot_p": r.thetadot_p}
+
+
+def _parameter_map(r, units):
+    grid, per_start = ("elongation", "eccentricity"), ("elongation", "eccentricity", "start")
+    data = {"chaotic_fraction": (grid, r.chaotic_fraction),
+            "megno": (per_start, r.megno), "labels": (per_start, _labels(r.labels)),
+            "status": (per_start, r.status), "status_name": (per_start, io.status_names(r.status)),
+            "omega0": ("elongation", r.omega0)}
+    coords = {"elongation": r.elongations, "eccentricity": r.eccentricities,
+              "start": np.arange(len(r.theta_p)), "theta_p": ("start", r.theta_p),
+              "thetadot_p": ("start", r.thetadot_p)}
+    return data, coords
+
+
+def _overlap_scan(r, units):
+    d = r.decisions
+
+    def col(name):
+        return np.array([np.nan if getattr(x, name) is None else getattr(x, name) for x in d],
+                        dtype=np.float64)
+
+    def ranges(name):
+        return np.array([(np.nan, np.nan) if getattr(x, name) is None else getattr(x, name)
+                         for x in d], dtype=np.float64).reshape(len(d), 2)
+
+    data = {"overlaps": ("elongation", r.overlaps)}
+    for name in ("omega0", "center_1", "center_3_2", "connecting_start", "connecting_megno",
+                 "connecting_lyapunov", "separatrix_chaotic_fraction"):
+        data[name] = ("elongation", col(name))
+    data["center_3_2_found"] = ("elongation", np.array([x.center_3_2_found for x in d], dtype=bool))
+    for name in ("connecting_range", "widest_range"):
+        data[name] = (("elongation", "bound"), ranges(name))
+    for name in list(data):
+        units.setdefault(name, units.get("decisions/" + name))
+    return data, {"elongation": r.elongations, "bound": ["low", "high"]}
+
+
+def _relaxed_libration(r, units):
+    launch = np.concatenate([np.full(len(c), k) for k, c in enumerate(r.candidates)])
+    data = {"extent": ("candidate", np.concatenate(r.extents))}
+    coords = {"candidate": np.arange(len(launch)), "launch": ("candidate", launch),
+              "thetadot_p": ("candidate", np.concatenate(r.candidates))}
+    units["extent"], units["thetadot_p"] = units["extents"], units["candidates"]
+    return data, coords
+
+
+_BUILDERS = {"section": _section, "time_series": _time_series, "chaos_map": _chaos_map,
+             "parameter_map": _parameter_map, "overlap_scan": _overlap_scan,
+             "relaxed_libration": _relaxed_libration}
+_COORD_UNITS = {"elongation": "1 (a/b)", "eccentricity": "1", "member": "index",
+                "crossing": "index", "sample": "index", "start": "index", "candidate": "index",
+                "launch": "index", "component": "inertial axis", "bound": "",
+                "system": "name", "status_name": "name"}
+
+
+def to_xarray(result_or_path):
+    """An :class:`xarray.Dataset` of a result, or of a file written by :func:`ti_spinorbit.io.save`.
+
+    Parameters
+    ----------
+    result_or_path : result object or str / path-like
+        A SectionResult, TimeSeriesResult, ChaosMap, ParameterMap, OverlapScan or
+        RelaxedLibration, or the path of a saved one (then the dataset's attrs carry the
+        file's provenance: version, arch, created_utc).
+
+    Returns
+    -------
+    xarray.Dataset
+        Data variables and coordinates with a ``units`` attribute each; scalar fields,
+        provenance and the systems (JSON text, ``attrs["systems"]``) as attributes.
+
+    Raises
+    ------
+    ImportError
+        xarray is not installed (``pip install "ti-spinorbit[xarray]"``).
+    """
+    xr = _xarray()
+    metadata = None
+    if isinstance(result_or_path, (str, os.PathLike)):
+        metadata = io.read_metadata(result_or_path)
+        result = io.load(result_or_path)
+    else:
+        result = result_or_path
+    kind = io.kind_of(result)
+    units = io.units(kind)
+    data, coords = _BUILDERS[kind](result, units)
+    ds = xr.Dataset(data, coords=coords, attrs=_attrs(result, kind, metadata))
+    for name, var in ds.variables.items():
+        unit = units.get(name, _COORD_UNITS.get(name))
+        if unit is not None:
+            var.attrs["units"] = unit
+    return ds
+
+
+__all__ = ["to_xarray"]
