@@ -2,170 +2,669 @@
 
 Subcommands
 -----------
-systems   list the catalogued systems, or show one
-section   surface of section of a catalogued system, written as PNG + .npz
-map       chaos map (MEGNO, Lyapunov, classification) over a (θ_p, θ̇_p/n) grid, PNG + .npz
-overlap   1:1 / 3:2 resonance-overlap scan over the elongation a/b, PNG + .npz
-figures   run the experiment scripts that reproduce the paper's studies (needs a source
-          checkout: the scripts live in experiments/)
+systems    list the catalogued systems, or show one
+section    surface of section of a catalogued system, PNG + .npz
+map        chaos map (MEGNO, Lyapunov, classification) over a (θ_p, θ̇_p/n) grid, PNG + .npz
+overlap    1:1 / 3:2 resonance-overlap scan over the elongation a/b, PNG + .npz
+libration  relaxed libration amplitude at the synchronous island's centre, PNG + .npz
+energy     energy and angular-momentum conservation check (exit 1 above --max-drift), PNG + .npz
+benchmark  ensemble throughput in member-orbits/s, JSON
+figures    run the experiment scripts that reproduce the paper's studies (needs a source
+           checkout: the scripts live in experiments/)
 
-Errors in the inputs print one line and exit with status 2 (no traceback)."""
+Conventions: every flag is checked before any work starts; a bad value, like any other error
+in the inputs, prints ONE line naming the flag, the value and the allowed range, and exits with
+status 2 (no traceback). Long runs draw a progress bar on stderr (:mod:`ti_spinorbit.progress`);
+``--quiet`` prints nothing but errors. Data files are self-describing ``.npz``
+(:func:`ti_spinorbit.io.save`); figures are PNG (or PDF/SVG by the extension of ``--out``)."""
 
 import argparse
+import math
+import os
+import shlex
 import sys
 
-EXAMPLES = """examples:
+#: Largest --orbits accepted (10 million orbits is days of CPU time even for one member).
+MAX_ORBITS = 1e7
+#: Accepted --rtol range (the integrator's own limits, ensemble.check_tolerances).
+RTOL_RANGE = (1e-16, 1e-2)
+#: Largest grid side of a chaos map, and most members of any run.
+MAX_GRID = 1024
+MAX_MEMBERS = 2**20
+#: Largest |θ̇_p/n| accepted for a start (a spin 100 times the mean motion is no binary).
+MAX_SPIN = 100.0
+#: Largest elongation a/b (the catalogue's own limit) and scan length.
+MAX_ELONGATION = 10.0
+MAX_SCAN_STEPS = 1001
+#: Largest --density, kg/m^3 (five times osmium: anything above is a unit mistake).
+MAX_DENSITY = 1e5
+#: dest -> (flag, low, high, low_open, high_open): the allowed interval of every plain
+#: numeric flag, whichever subcommand has it.
+FLAG_RANGES = {
+    "orbits": ("--orbits", 0.0, MAX_ORBITS, True, False),
+    "rtol": ("--rtol", RTOL_RANGE[0], RTOL_RANGE[1], False, False),
+    "elongation": ("--elongation", 1.0, MAX_ELONGATION, False, False),
+    "density": ("--density", 0.0, MAX_DENSITY, True, False),
+    "eccentricity": ("--eccentricity", 0.0, 1.0, False, True),
+    "theta_p": ("--theta-p", -360.0, 360.0, False, False),
+    "thetadot": ("--thetadot", -MAX_SPIN, MAX_SPIN, False, False),
+    "thetadot_range": ("--thetadot-range", -MAX_SPIN, MAX_SPIN, False, False),
+    "grid": ("--grid", 1, MAX_GRID, False, False),
+    "members": ("--members", 1, MAX_MEMBERS, False, False),
+    "repeat": ("--repeat", 1, 100, False, False),
+    "samples_per_orbit": ("--samples-per-orbit", 1, 100000, False, False),
+    "max_drift": ("--max-drift", 0.0, 1.0, True, False),
+    "xtol": ("--xtol", 1e-12, 0.1, False, False),
+    "only": ("--only", 1, 99, False, False),
+}
+#: Figures and data files.
+FIGURE_EXTENSIONS = (".png", ".pdf", ".svg")
+#: Energy check: samples per primary rotation when --samples-per-orbit is not given (resolves
+#: the fast primary spin so the energy exchange is not aliased), at least MIN_SAMPLES_PER_ORBIT.
+SAMPLES_PER_PRIMARY_ROTATION = 40
+MIN_SAMPLES_PER_ORBIT = 64
+#: Benchmark: the spread of starts (as experiments/bench_throughput.py).
+BENCH_THETADOT_RANGE = (0.4, 2.6)
+
+EXAMPLES_BY_COMMAND = {
+    "systems": """\
   ti-spinorbit systems
   ti-spinorbit systems --show "2004 DC"
+  ti-spinorbit systems --out catalogue.json""",
+    "section": """\
   ti-spinorbit section --system "1991 VH" --out sos_1991VH.png
-  ti-spinorbit section --system "1991 VH" --elongation 1.06 --thetadot 1.13 1.63 1.70 1.78 --orbits 1000
-  ti-spinorbit map --system "2004 DC" --grid 32 32 --orbits 300 --out dc_map.png
-  ti-spinorbit overlap --system "1991 VH" --elongations 1.01 1.10 0.01 --orbits 500
-"""
+  ti-spinorbit section --system "1991 VH" --elongation 1.06 --thetadot 1.13 1.63 1.70 1.78 --orbits 1000""",
+    "map": """\
+  ti-spinorbit map --system "2004 DC" --grid 32 32 --orbits 300 --out dc_map.png""",
+    "overlap": """\
+  ti-spinorbit overlap --system "1991 VH" --elongations 1.01 1.10 0.01 --orbits 500""",
+    "libration": """\
+  ti-spinorbit libration --system Didymos --orbits 100
+  ti-spinorbit libration --system "2000 DP107" --elongation 1.2 --out dp107_libration.png""",
+    "energy": """\
+  ti-spinorbit energy                          # the paper's energy-check case ("test")
+  ti-spinorbit energy --orbits 20 --rtol 1e-13 --max-drift 1e-10 --out energy.png
+  ti-spinorbit energy --system "1991 VH" --thetadot 1.0 --orbits 50""",
+    "benchmark": """\
+  ti-spinorbit benchmark --members 1024 --orbits 20
+  ti-spinorbit benchmark --arch cuda --members 65536 --orbits 20 --out bench_cuda.json""",
+    "figures": """\
+  ti-spinorbit figures --quick --only 1 4 --out out/""",
+}
+EXAMPLES = "examples:\n" + "\n".join(EXAMPLES_BY_COMMAND.values()) + "\n"
+
+
+class CommandLineError(ValueError):
+    """A bad command line (unknown flag, unparsable value): one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises instead of printing usage and exiting, so every bad input ends
+    the same way: one line on stderr, status 2 (``--help`` still prints and exits 0)."""
+
+    def error(self, message):
+        raise CommandLineError(f"{self.prog}: error: {message}")
+
+
+def _help_epilog(command):
+    return f"examples:\n{EXAMPLES_BY_COMMAND[command]}\n"
 
 
 def _parser():
-    p = argparse.ArgumentParser(prog="ti-spinorbit", description=(
+    from .runtime import _KNOWN_ARCHS
+
+    p = _Parser(prog="ti-spinorbit", description=(
         "Coupled spin-orbit dynamics of binary asteroids (full two-body problem, 4th-order "
         "mutual potential), ensembles integrated with Taichi."),
         epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
 
-    s = sub.add_parser("systems", help="list catalogued systems or show one")
-    s.add_argument("--show", metavar="NAME", help="print one system's parameters")
+    def command(name, help):
+        return sub.add_parser(name, help=help, description=help, epilog=_help_epilog(name),
+                              formatter_class=argparse.RawDescriptionHelpFormatter)
 
-    s = sub.add_parser("section", help="surface of section of a catalogued system (PNG + .npz)",
-                       epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    s.add_argument("--system", default="1991 VH", help="catalogued system name (default: 1991 VH)")
-    s.add_argument("--elongation", type=float, help="secondary a/b (default: catalogue value)")
-    s.add_argument("--density", type=float, help="secondary density, kg/m^3")
-    s.add_argument("--eccentricity", type=float, help="initial osculating eccentricity")
-    s.add_argument("--theta-p", type=float, default=0.0, help="initial θ_p, deg (default 0)")
+    def common(s, out_help, data=True, orbits=300.0, rtol=1e-10):
+        if orbits is not None:
+            s.add_argument("--orbits", type=float, default=orbits,
+                           help=f"orbits to integrate, in (0, {MAX_ORBITS:g}] (default {orbits:g})")
+        s.add_argument("--rtol", type=float, default=rtol,
+                       help=f"relative tolerance in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}] "
+                            f"(default {rtol:g})")
+        s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,
+                       help="Taichi arch: cpu (default, or $TI_SPINORBIT_ARCH), cuda, vulkan, "
+                            "...; a missing GPU is an error, never a silent CPU fallback")
+        s.add_argument("--out", default=None, help=out_help)
+        if data:
+            s.add_argument("--data", default=None,
+                           help=".npz path (default: the --out path with .npz)")
+        s.add_argument("--quiet", action="store_true",
+                       help="print nothing but errors (no progress bar, no summary)")
+
+    def system_flags(s, default="1991 VH", shape=True):
+        s.add_argument("--system", default=default,
+                       help=f"catalogued system name (default: {default}; see 'ti-spinorbit systems')")
+        if shape:
+            s.add_argument("--elongation", type=float,
+                           help=f"secondary a/b in [1, {MAX_ELONGATION:g}] (default: catalogue value)")
+            s.add_argument("--density", type=float,
+                           help=f"secondary density, kg/m^3, in (0, {MAX_DENSITY:g}] (default: catalogue value)")
+        s.add_argument("--eccentricity", type=float,
+                       help="initial osculating eccentricity in [0, 1) (default: catalogue value)")
+
+    s = sub.add_parser("systems", help="list catalogued systems or show one",
+                       description="List the catalogued systems (Naidu & Margot 2015, Table 1).",
+                       epilog=_help_epilog("systems"),
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    s.add_argument("--show", metavar="NAME", help="print one system's parameters")
+    s.add_argument("--out", default=None, help="also write the descriptions (SI) to this .json")
+    s.add_argument("--quiet", action="store_true", help="print nothing (with --out)")
+
+    s = command("section", "surface of section of a catalogued system (PNG + .npz)")
+    system_flags(s)
+    s.add_argument("--theta-p", type=float, default=0.0,
+                   help="initial θ_p, deg, in [-360, 360] (default 0)")
     s.add_argument("--thetadot", type=float, nargs="+",
                    help="initial θ̇_p/n values (default: the paper's starts for this system)")
-    s.add_argument("--orbits", type=float, default=500, help="orbits to integrate (default 500)")
-    s.add_argument("--rtol", type=float, default=1e-12, help="relative tolerance (default 1e-12)")
-    s.add_argument("--arch", default=None, help="cpu (default) or cuda, vulkan, ...")
-    s.add_argument("--out", default=None, help="PNG path (default sos_<system>.png)")
-    s.add_argument("--data", default=None, help=".npz path (default: PNG path with .npz)")
-    s.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12)
 
-    def system_flags(s):
-        s.add_argument("--system", default="1991 VH", help="catalogued system name (default: 1991 VH)")
-        s.add_argument("--eccentricity", type=float, help="initial osculating eccentricity")
-        s.add_argument("--orbits", type=float, default=300, help="orbits per trajectory (default 300)")
-        s.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance (default 1e-10)")
-        s.add_argument("--arch", default=None, help="cpu (default) or cuda, vulkan, ...")
-        s.add_argument("--out", default=None, help="PNG path (the .npz is written beside it)")
-        s.add_argument("--quiet", action="store_true", help="print nothing but errors")
-
-    s = sub.add_parser("map", help="chaos map over (theta_p, thetadot_p/n): MEGNO, Lyapunov, classes",
-                       epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    s = command("map", "chaos map over (θ_p, θ̇_p/n): MEGNO, Lyapunov, classes (PNG + .npz)")
     system_flags(s)
-    s.add_argument("--elongation", type=float, help="secondary a/b (default: catalogue value)")
-    s.add_argument("--density", type=float, help="secondary density, kg/m^3")
     s.add_argument("--grid", type=int, nargs=2, default=[32, 32], metavar=("NTHETA", "NTHETADOT"),
-                   help="grid size (default 32 32)")
-    s.add_argument("--thetadot-range", type=float, nargs=2, default=[0.2, 3.0], metavar=("LO", "HI"),
-                   help="θ̇_p/n range (default 0.2 3.0)")
+                   help=f"grid size, each in [1, {MAX_GRID}] (default 32 32)")
+    s.add_argument("--thetadot-range", type=float, nargs=2, default=[0.2, 3.0],
+                   metavar=("LO", "HI"), help="θ̇_p/n range, LO < HI (default 0.2 3.0)")
+    common(s, "PNG path (default map_<system>.png)")
 
-    s = sub.add_parser("overlap", help="resonance-overlap scan over a/b (1:1 and 3:2)",
-                       epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
-    system_flags(s)
+    s = command("overlap", "resonance-overlap scan over a/b, 1:1 and 3:2 (PNG + .npz)")
+    system_flags(s, shape=False)
     s.add_argument("--elongations", type=float, nargs=3, default=[1.01, 1.15, 0.01],
-                   metavar=("START", "STOP", "STEP"), help="a/b scan (default 1.01 1.15 0.01)")
+                   metavar=("START", "STOP", "STEP"),
+                   help=f"a/b scan, 1 < START <= STOP <= {MAX_ELONGATION:g}, STEP > 0 "
+                        "(default 1.01 1.15 0.01)")
+    common(s, "PNG path (default overlap_<system>.png)")
 
-    s = sub.add_parser("figures", help="reproduce the paper's studies (experiments/study*.py)")
+    s = command("libration", "relaxed libration amplitude at the synchronous island centre "
+                "(PNG + .npz)")
+    system_flags(s, default="Didymos")
+    s.add_argument("--xtol", type=float, default=1e-6,
+                   help="stop the centre search when the window half-width (units of n) is "
+                        "below this, in [1e-12, 0.1] (default 1e-6)")
+    s.add_argument("--candidates", type=float, nargs=3, metavar=("LO", "HI", "N"),
+                   help="coarse bracket of θ̇_p/n: N (5 to 10001) values over LO..HI "
+                        "(default 45 over 0.2..1.3)")
+    common(s, "PNG path of the centre search, extent vs θ̇_p/n (default libration_<system>.png)",
+           orbits=100.0, rtol=1e-12)
+
+    s = command("energy", "energy and angular-momentum conservation check (PNG + .npz; "
+                "exit status 1 when the drift exceeds --max-drift)")
+    system_flags(s, default="test")
+    s.add_argument("--theta-p", type=float, default=0.0,
+                   help="initial θ_p, deg, in [-360, 360] (default 0)")
+    s.add_argument("--thetadot", type=float, default=None,
+                   help="initial θ̇_p/n (default: the catalogued spin period, else 1)")
+    s.add_argument("--samples-per-orbit", type=int, default=None,
+                   help=f"samples per orbit in [1, 100000] (default: {SAMPLES_PER_PRIMARY_ROTATION} "
+                        f"per primary rotation, at least {MIN_SAMPLES_PER_ORBIT})")
+    s.add_argument("--max-drift", type=float, default=1e-9,
+                   help="largest relative energy or angular-momentum drift that passes, "
+                        "in (0, 1] (default 1e-9)")
+    common(s, "PNG path of drift vs time (default energy_<system>.png)", orbits=5.0, rtol=1e-12)
+
+    s = command("benchmark", "ensemble throughput in member-orbits/s on 1991 VH (JSON)")
+    s.add_argument("--system", default="1991 VH", help="catalogued system (default 1991 VH)")
+    s.add_argument("--members", type=int, default=256,
+                   help=f"ensemble size in [1, {MAX_MEMBERS}] (default 256)")
+    s.add_argument("--repeat", type=int, default=1,
+                   help="timed runs, the best is reported, in [1, 100] (default 1)")
+    common(s, "JSON path (default benchmark.json)", data=False, orbits=20.0, rtol=1e-12)
+
+    s = sub.add_parser("figures", help="reproduce the paper's studies (experiments/study*.py)",
+                       epilog=_help_epilog("figures"),
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
     s.add_argument("--quick", action="store_true", help="small runs (minutes in all)")
     s.add_argument("--out", default="out", help="output folder (default out/)")
     s.add_argument("--only", nargs="+", metavar="N", type=int, help="study numbers, e.g. 4 6")
     s.add_argument("--experiments", default=None,
                    help="folder holding the study scripts (default: ./experiments or the "
                         "checkout this package was installed from)")
+    s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,
+                   help="Taichi arch for the scripts (sets TI_SPINORBIT_ARCH)")
+    s.add_argument("--quiet", action="store_true", help="hide the scripts' output; print failures only")
     return p
 
 
-def _base_meta(args, system):
-    from .io import provenance
+# ---- flag checks ------------------------------------------------------------------------
 
-    return {**provenance(), "command": args.command, "orbits": args.orbits, "rtol": args.rtol,
-            "system": system.describe()}
+def _fmt(x):
+    """Integers as they are (1048576), other numbers short (1e+07, 0.01, nan)."""
+    return str(x) if isinstance(x, int) and not isinstance(x, bool) else f"{x:g}"
+
+
+def _interval(low, high, low_open, high_open):
+    return f"{'(' if low_open else '['}{_fmt(low)}, {_fmt(high)}{')' if high_open else ']'}"
+
+
+def _check_range(flag, value, low, high, low_open=False, high_open=False):
+    """ValueError naming the flag, the value and the interval unless value lies in it."""
+    ok = math.isfinite(value)
+    ok = ok and (value > low if low_open else value >= low)
+    ok = ok and (value < high if high_open else value <= high)
+    if not ok:
+        raise ValueError(f"{flag} must lie in {_interval(low, high, low_open, high_open)} "
+                         f"(got {_fmt(value)})")
+
+
+def _check_output(flag, path, extensions):
+    """The file's folder must exist and be writable, and its extension be one of ours: a
+    typo should fail before a long run, not after it."""
+    if path is None:
+        return
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in extensions:
+        raise ValueError(f"{flag} must end in {', '.join(extensions)} (got {path!r})")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise ValueError(f"{flag}: folder {folder!r} does not exist (got {path!r})")
+    if not os.access(folder, os.W_OK):
+        raise ValueError(f"{flag}: folder {folder!r} is not writable (got {path!r})")
+
+
+def check_args(args):
+    """Check every flag of a parsed command line; ValueError with flag, value and range.
+
+    FLAG_RANGES covers the plain numeric flags of every subcommand (a flag is checked
+    wherever it exists; each value of a multi-value flag); relations between values and the
+    output paths follow."""
+    for dest, (flag, low, high, low_open, high_open) in FLAG_RANGES.items():
+        value = getattr(args, dest, None)
+        for v in (value if isinstance(value, list) else [] if value is None else [value]):
+            _check_range(flag, v, low, high, low_open, high_open)
+    if getattr(args, "thetadot_range", None):
+        lo, hi = args.thetadot_range
+        if not hi > lo:
+            raise ValueError(f"--thetadot-range needs LO < HI (got {lo:g} {hi:g})")
+    if getattr(args, "elongations", None):
+        start, stop, step = args.elongations
+        _check_range("--elongations START", start, 1.0, MAX_ELONGATION, low_open=True)
+        _check_range("--elongations STOP", stop, start, MAX_ELONGATION)
+        _check_range("--elongations STEP", step, 0.0, MAX_ELONGATION, low_open=True)
+        if (stop - start) / step + 1 > MAX_SCAN_STEPS:
+            raise ValueError(f"--elongations: at most {MAX_SCAN_STEPS} elongations per scan "
+                             f"(got {start:g} {stop:g} {step:g}); use a larger STEP")
+    if getattr(args, "candidates", None):
+        lo, hi, n = args.candidates
+        _check_range("--candidates LO", lo, -MAX_SPIN, MAX_SPIN)
+        _check_range("--candidates HI", hi, lo, MAX_SPIN, low_open=True)
+        if not (float(n).is_integer() and 5 <= n <= 10001):
+            raise ValueError(f"--candidates N must be an integer in [5, 10001] (got {n:g})")
+    if args.command in ("benchmark", "systems"):
+        _check_output("--out", getattr(args, "out", None), (".json",))
+    elif args.command != "figures":                  # figures: --out is a folder
+        _check_output("--out", args.out, FIGURE_EXTENSIONS)
+        _check_output("--data", args.data, (".npz",))
+
+
+# ---- shared steps -----------------------------------------------------------------------
+
+def _init(args):
+    """Start Taichi on --arch; with --quiet, Taichi's own "Starting on arch" line is hidden."""
+    import contextlib
+    import io
+
+    from . import init
+
+    if not args.quiet:
+        return init(arch=args.arch)
+    with contextlib.redirect_stdout(io.StringIO()):
+        return init(arch=args.arch)
+
+
+def _system(args):
+    from . import catalog
+
+    return catalog.system(args.system, elongation=getattr(args, "elongation", None),
+                          secondary_density=getattr(args, "density", None),
+                          eccentricity=args.eccentricity)
+
+
+def _paths(args, prefix, system_name):
+    """(figure path, data path) from --out/--data or the defaults <prefix>_<system>.png/.npz."""
+    out = args.out or f"{prefix}_{system_name.replace(' ', '')}.png"
+    return out, args.data or os.path.splitext(out)[0] + ".npz"
+
+
+def _progress(args):
+    from .progress import ProgressBar
+
+    return ProgressBar(args.command, quiet=args.quiet)
+
+
+def _with_progress(func, bar):
+    """``{"progress": bar}`` where ``func`` takes a progress callback, else nothing."""
+    import inspect
+
+    return {"progress": bar} if "progress" in inspect.signature(func).parameters else {}
+
+
+def _save(result, path, extra):
+    """Write a result with :func:`ti_spinorbit.io.save` (self-describing, loadable with
+    ``io.load``), the command's own numbers in the metadata under ``extra``."""
+    from .io import save
+
+    return save(result, path, extra=extra)
+
+
+def _print(args, *lines):
+    if not args.quiet:
+        for line in lines:
+            print(line)
+
+
+# ---- subcommands ------------------------------------------------------------------------
+
+def _cmd_systems(args):
+    import json
+
+    from . import catalog
+
+    if args.show:
+        system = catalog.system(args.show)
+        if args.out:
+            with open(args.out, "w") as f:
+                json.dump(system.describe(), f, indent=1)
+        if not args.quiet:
+            for k, v in system.describe().items():
+                print(f"{k:24s} {v}")
+        return 0
+    systems = [catalog.system(name) for name in catalog.names()]
+    if args.out:
+        with open(args.out, "w") as f:
+            json.dump([s.describe() for s in systems], f, indent=1)
+    _print(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} {'omega0':>7s}")
+    for s in systems:
+        ax = s.secondary.semi_axes
+        _print(args, f"{s.name:12s} {s.mass_ratio:10.2f} {s.a:8.0f} {s.e:7.4f} "
+                     f"{ax[0] / ax[1]:5.2f} {s.omega0:7.3f}")
+    return 0
+
+
+def _cmd_section(args):
+    import numpy as np
+
+    from . import catalog, surface_of_section
+    from .plotting import plot_section, save_figure
+
+    system = _system(args)
+    starts = args.thetadot or catalog.section_starts(args.system)
+    out, data = _paths(args, "sos", system.name)
+    _init(args)
+    with _progress(args) as bar:
+        result = surface_of_section(system, args.theta_p, np.array(starts), orbits=args.orbits,
+                                    rtol=args.rtol, progress=bar)
+    save_figure(plot_section(result), out)
+    _save(result, data, {"command": args.command_line})
+    _print(args, f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
+                 f"{len(starts)} trajectories x {args.orbits:g} orbits in {result.seconds:.2f} s "
+                 f"({result.member_orbits_per_second:.0f} member-orbits/s)")
+    for k, v in enumerate(starts):
+        _print(args, f"  thetadot_p/n = {v:5.2f}: {result.count[k]} crossings, status "
+                     f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}")
+    _print(args, f"wrote {out} and {data}")
+    return 0
 
 
 def _cmd_map(args):
-    import os
-
     import numpy as np
 
-    from . import catalog, init
     from .chaosmap import chaos_map
-    from .io import write_archive
     from .plotting import save_figure
 
-    system = catalog.system(args.system, elongation=args.elongation,
-                            secondary_density=args.density, eccentricity=args.eccentricity)
+    system = _system(args)
     nt, nd = args.grid
-    if not (1 <= nt <= 1024 and 1 <= nd <= 1024):
-        raise ValueError(f"--grid sizes must lie in [1, 1024] (got {nt} {nd})")
     lo, hi = args.thetadot_range
-    if not hi > lo:
-        raise ValueError(f"--thetadot-range needs LO < HI (got {lo} {hi})")
-    init(arch=args.arch)
+    out, data = _paths(args, "map", system.name)
+    _init(args)
     theta = (np.arange(nt) + 0.5) * 180.0 / nt
-    cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits, rtol=args.rtol)
-    out = args.out or f"map_{system.name.replace(' ', '')}.png"
+    with _progress(args) as bar:
+        cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
+                         rtol=args.rtol, progress=bar)
     save_figure(cmap.plot(), out)
-    meta = _base_meta(args, system)
-    meta.update(chaotic_fraction=cmap.chaotic_fraction, units={"theta_p": "deg", "thetadot_p": "n",
-                "lyapunov": "1/orbit", "megno": "1"})
-    write_archive(os.path.splitext(out)[0] + ".npz",
-               {"theta_p": cmap.theta_p, "thetadot_p": cmap.thetadot_p, "megno": cmap.megno,
-                "lyapunov": cmap.lyapunov, "classification": cmap.classification,
-                "mean_spin": cmap.mean_spin, "status": cmap.status}, meta)
-    if not args.quiet:
-        print(f"{system.name}: {nt} x {nd} map, {args.orbits:g} orbits: chaotic fraction "
-              f"{cmap.chaotic_fraction:.3f} in {cmap.seconds:.1f} s; wrote {out}")
+    _save(cmap, data, {"command": args.command_line})
+    _print(args, f"{system.name}: {nt} x {nd} map, {args.orbits:g} orbits: chaotic fraction "
+                 f"{cmap.chaotic_fraction:.3f} in {cmap.seconds:.1f} s; wrote {out} and {data}")
     return 0
 
 
 def _cmd_overlap(args):
-    import os
-
     import numpy as np
 
-    from . import catalog, init
-    from .io import write_archive
+    from . import catalog
     from .overlap import overlap_threshold
     from .plotting import save_figure
 
     start, stop, step = args.elongations
-    if not (step > 0 and stop >= start > 1.0):
-        raise ValueError(f"--elongations needs 1 < START <= STOP and STEP > 0 (got {start} {stop} {step})")
-    catalog.system(args.system, eccentricity=args.eccentricity)       # validates the name and e
-    init(arch=args.arch)
+    system = catalog.system(args.system, eccentricity=args.eccentricity)   # checks name and e
+    out, data = _paths(args, "overlap", system.name)
+    _init(args)
     q = np.round(np.arange(start, stop + step / 2, step), 10)
-    scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
-                             orbits=args.orbits, rtol=args.rtol)
-    out = args.out or f"overlap_{scan.name.replace(' ', '')}.png"
+    with _progress(args) as bar:
+        scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
+                                 orbits=args.orbits, rtol=args.rtol, progress=bar)
     save_figure(scan.plot(), out)
-    system = catalog.system(args.system, eccentricity=args.eccentricity)
-    meta = _base_meta(args, system)
-    meta.update(first_overlap=scan.first_overlap, elongation_ro=scan.elongation_ro,
-                omega0_ro=scan.omega0_ro, decisions=[vars(d) for d in scan.decisions])
-    write_archive(os.path.splitext(out)[0] + ".npz",
-               {"elongations": scan.elongations, "overlaps": scan.overlaps}, meta)
-    if not args.quiet:
-        print(f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
-              f"(analytic {scan.elongation_ro:.4f}) in {scan.seconds:.1f} s; wrote {out}")
-        for d in scan.decisions:
-            extra = f", connecting <Y> = {d.connecting_megno:.1f}" if d.overlap else ""
-            print(f"  a/b = {d.elongation:.2f}: {'overlap' if d.overlap else 'separate'}{extra}")
+    _save(scan, data, {"command": args.command_line})
+    _print(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
+                 f"(analytic {scan.elongation_ro:.4f}) in {scan.seconds:.1f} s; wrote {out} and {data}")
+    for d in scan.decisions:
+        extra = f", connecting <Y> = {d.connecting_megno:.1f}" if d.overlap else ""
+        _print(args, f"  a/b = {d.elongation:.2f}: {'overlap' if d.overlap else 'separate'}{extra}")
+    return 0
+
+
+def _plot_libration(result):
+    """Two panels of the centre search: every launch's section extent against the start
+    θ̇_p/n (the V whose tip is the centre), and the last window around the centre."""
+    import numpy as np
+
+    from .plotting import _pyplot
+
+    plt = _pyplot()
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9.6, 4.2), dpi=150)
+    for k, (x, extent) in enumerate(zip(result.candidates, result.extents)):
+        style = dict(marker="o", ms=3, lw=0.8) if k == 0 else dict(marker=".", ms=2, lw=0.6)
+        left.plot(x, extent, label="coarse" if k == 0 else ("zooms" if k == 1 else None),
+                  **style)
+    left.axvline(result.center_thetadot_p, color="k", lw=0.6, ls="--", label="centre")
+    left.set_xlabel(r"$\dot\theta_p(0)/n$")
+    left.set_ylabel("section extent max |θ_p| (deg)")
+    left.legend(fontsize=7)
+    x, extent = result.candidates[-1], result.extents[-1]
+    right.plot(x - result.center_thetadot_p, extent, ".-", ms=3, lw=0.6)
+    right.axvline(0.0, color="k", lw=0.6, ls="--")
+    right.set_xlabel(r"$\dot\theta_p(0)/n$ − centre")
+    right.set_ylabel("extent (deg)")
+    right.set_title(f"last window ({len(result.candidates) - 1} zooms)", fontsize=8)
+    s = result.system
+    fig.suptitle(f"{s.name if s else ''}: centre θ̇_p/n = {result.center_thetadot_p:.8f}, "
+                 f"amplitude {result.amplitude:.3f}°, |ψ_A| {abs(result.psi_A):.3f}°"
+                 + ("" if result.converged else " (NOT converged)"), fontsize=9)
+    finite = [e[np.isfinite(e)] for e in result.extents]
+    if any(len(e) for e in finite):
+        left.set_ylim(bottom=0)
+    return left
+
+
+def _cmd_libration(args):
+    import warnings
+
+    import numpy as np
+
+    from .libration import relaxed_libration
+    from .plotting import save_figure
+
+    system = _system(args)
+    out, data = _paths(args, "libration", system.name)
+    kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol)
+    if args.candidates:
+        lo, hi, n = args.candidates
+        kwargs["candidates"] = np.linspace(lo, hi, int(n))
+    _init(args)
+    with _progress(args) as bar, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RuntimeWarning)
+        result = relaxed_libration(system, **kwargs, **_with_progress(relaxed_libration, bar))
+    for w in caught:
+        if not args.quiet:
+            print(f"ti-spinorbit libration: warning: {w.message}", file=sys.stderr)
+    plot = getattr(result, "plot", None)
+    save_figure(plot() if callable(plot) else _plot_libration(result), out)
+    _save(result, data, {"command": args.command_line})
+    _print(args,
+           f"{system.name}: relaxed libration amplitude {result.amplitude:.4f} deg at the "
+           f"synchronous centre thetadot_p/n = {result.center_thetadot_p:.8f}",
+           f"  psi_A = {result.psi_A:.4f} deg (omega0 {result.omega0:.4f}), "
+           f"coupled psi_A = {result.psi_A_effective:.4f} deg (omega0_eff {result.omega0_effective:.4f})",
+           f"  section extent at the centre {result.extent:.2e} deg, {result.iterations} zooms, "
+           f"{'converged' if result.converged else 'NOT converged'}, {result.seconds:.1f} s",
+           f"wrote {out} and {data}")
+    return 0
+
+
+def energy_check(ts, member=0):
+    """Conservation numbers of one member of a TimeSeriesResult: the largest relative drift of
+    the total energy and of the total angular-momentum vector over the run, and the largest
+    change of each energy part relative to |E0| (the orbit/spin exchange). Returns a dict of
+    floats and the per-sample arrays (t, dE/|E0|, |ΔL|/|L0|, parts) used for the plot."""
+    import numpy as np
+
+    ok = np.isfinite(ts.t[member])
+    t = ts.t[member][ok]
+    energy = ts.energy[member][ok]
+    e0 = energy[0]
+    angmom = sum(getattr(ts, f"angmom_{k}")[member][ok] for k in ("orbit", "primary", "secondary"))
+    l0 = np.linalg.norm(angmom[0])
+    de = (energy - e0) / abs(e0)
+    dl = np.linalg.norm(angmom - angmom[0], axis=1) / l0
+    parts = {k: (getattr(ts, f"energy_{k}")[member][ok] - getattr(ts, f"energy_{k}")[member][ok][0])
+             / abs(e0) for k in ("orbit", "primary", "secondary")}
+    numbers = {"energy_drift": float(np.max(np.abs(de))), "angmom_drift": float(np.max(dl)),
+               **{f"exchange_{k}": float(np.max(np.abs(v))) for k, v in parts.items()},
+               "samples": int(len(t))}
+    return numbers, (t, de, dl, parts)
+
+
+def _plot_energy(system, series, orbits, rtol):
+    from .plotting import _pyplot
+
+    plt = _pyplot()
+    t, de, dl, parts = series
+    t_orbits = t / system.orbital_period
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True, dpi=150)
+    top.plot(t_orbits, de, "k", lw=0.8, label=r"energy $\Delta E/|E_0|$")
+    top.plot(t_orbits, dl, "C3", lw=0.8, label=r"angular momentum $|\Delta \mathbf{L}|/|L_0|$")
+    top.set_ylabel("relative drift")
+    top.legend(fontsize=7)
+    top.set_title(f"{system.name}: conservation at rtol {rtol:.0e} over {orbits:g} orbits",
+                  fontsize=9)
+    for name, v in parts.items():
+        bottom.plot(t_orbits, v, lw=0.8, label=f"{name}" + (" spin" if name != "orbit" else ""))
+    bottom.set_ylabel(r"energy exchange $\Delta E_i/|E_0|$")
+    bottom.set_xlabel("time (initial orbital periods)")
+    bottom.legend(fontsize=7)
+    return top
+
+
+def _cmd_energy(args):
+    import math as m
+
+    from . import catalog, time_series
+    from .plotting import save_figure
+
+    system = _system(args)
+    out, data = _paths(args, "energy", system.name)
+    thetadot = args.thetadot
+    if thetadot is None:
+        period = catalog.secondary_spin_period(args.system)
+        thetadot = 1.0 if period is None else 2 * m.pi / period / system.mean_motion
+    samples = args.samples_per_orbit
+    if samples is None:
+        rotations = 0 if not system.primary_spin_period else \
+            system.orbital_period / abs(system.primary_spin_period)
+        samples = max(MIN_SAMPLES_PER_ORBIT, m.ceil(SAMPLES_PER_PRIMARY_ROTATION * rotations))
+    _init(args)
+    with _progress(args) as bar:
+        ts = time_series(system, args.theta_p, thetadot, args.orbits, samples_per_orbit=samples,
+                         rtol=args.rtol, **_with_progress(time_series, bar))
+    numbers, series = energy_check(ts)
+    status = ts.status_names[0] if hasattr(ts, "status_names") else _status_name(ts.status[0])
+    save_figure(_plot_energy(system, series, args.orbits, args.rtol), out)
+    _save(ts, data, {"command": args.command_line, "energy_check": numbers,
+                     "max_drift": args.max_drift, "member_status": status})
+    worst = max(numbers["energy_drift"], numbers["angmom_drift"])
+    _print(args,
+           f"{system.name}: {args.orbits:g} orbits at rtol {args.rtol:g}, {numbers['samples']} "
+           f"samples, status {status}",
+           f"  max relative energy drift           {numbers['energy_drift']:.3e}",
+           f"  max relative angular-momentum drift {numbers['angmom_drift']:.3e}",
+           "  largest exchange, |ΔE_i|/|E0|: orbit {exchange_orbit:.3e}, primary spin "
+           "{exchange_primary:.3e}, secondary spin {exchange_secondary:.3e}".format(**numbers),
+           f"wrote {out} and {data}")
+    if status != "done":
+        print(f"ti-spinorbit energy: the integration stopped early (status {status})",
+              file=sys.stderr)
+        return 1
+    if not worst <= args.max_drift:
+        print(f"ti-spinorbit energy: drift {worst:.3e} exceeds --max-drift {args.max_drift:g}",
+              file=sys.stderr)
+        return 1
+    return 0
+
+
+def _status_name(code):
+    from .kernels.ensemble import STATUS_NAMES
+
+    return STATUS_NAMES[code]
+
+
+def _cmd_benchmark(args):
+    import json
+    import platform
+    import time
+
+    import numpy as np
+
+    from . import catalog, runtime, surface_of_section
+    from .io import provenance
+
+    system = catalog.system(args.system)
+    out = args.out or "benchmark.json"
+    thetadot = np.linspace(*BENCH_THETADOT_RANGE, args.members)
+    _init(args)
+    started = time.perf_counter()
+    surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, rtol=args.rtol)   # compile / load
+    warmup = time.perf_counter() - started
+    runs = [surface_of_section(system, 0.0, thetadot, orbits=args.orbits, rtol=args.rtol)
+            for _ in range(args.repeat)]
+    best = min(runs, key=lambda r: r.seconds)
+    rate = args.members * args.orbits / best.seconds
+    names, counts = np.unique(best.status_names, return_counts=True)
+    report = {**provenance(), "command": args.command_line, "system": args.system,
+              "members": args.members, "orbits": args.orbits, "rtol": args.rtol,
+              "arch": runtime.current_arch(), "seconds": [r.seconds for r in runs],
+              "best_seconds": best.seconds, "member_orbits_per_second": rate,
+              "warmup_seconds": warmup,
+              "steps_per_member_orbit": float(np.mean(best.accepted + best.rejected) / args.orbits),
+              "rhs_calls_per_member_orbit": float(np.mean(best.rhs_calls) / args.orbits),
+              "status_counts": {str(n): int(c) for n, c in zip(names, counts)},
+              "machine": {"platform": platform.platform(), "processor": platform.processor(),
+                          "cpu_count": os.cpu_count(), "python": platform.python_version()}}
+    with open(out, "w") as f:
+        json.dump(report, f, indent=1)
+    _print(args, f"{args.system}: {args.members} members x {args.orbits:g} orbits at rtol "
+                 f"{args.rtol:g} on {report['arch']}: {best.seconds:.3g} s (best of {args.repeat}), "
+                 f"{rate:.0f} member-orbits/s; first call {warmup:.1f} s; wrote {out}")
     return 0
 
 
 def _experiments_dir(given):
-    import os
-
     here = os.path.dirname(os.path.abspath(__file__))
     for d in ([given] if given else [os.path.join(os.getcwd(), "experiments"),
                                     os.path.join(os.path.dirname(here), "experiments")]):
@@ -177,7 +676,6 @@ def _experiments_dir(given):
 
 def _cmd_figures(args):
     import glob
-    import os
     import subprocess
     import time
 
@@ -188,13 +686,16 @@ def _cmd_figures(args):
     if not scripts:
         raise ValueError(f"no study scripts selected in {folder}")
     out = os.path.abspath(args.out)
+    env = dict(os.environ, **({"TI_SPINORBIT_ARCH": args.arch} if args.arch else {}))
+    hide = subprocess.DEVNULL if args.quiet else None
     failed = []
     for script in scripts:
         t0 = time.perf_counter()
         cmd = [sys.executable, script, "--out", out] + (["--quick"] if args.quick else [])
-        rc = subprocess.call(cmd, cwd=folder)
-        print(f"{os.path.basename(script)}: {'ok' if rc == 0 else f'FAILED ({rc})'} "
-              f"in {time.perf_counter() - t0:.0f} s", flush=True)
+        rc = subprocess.call(cmd, cwd=folder, env=env, stdout=hide)
+        _print(args, f"{os.path.basename(script)}: {'ok' if rc == 0 else f'FAILED ({rc})'} "
+                     f"in {time.perf_counter() - t0:.0f} s")
+        sys.stdout.flush()
         if rc:
             failed.append(os.path.basename(script))
     if failed:
@@ -202,62 +703,42 @@ def _cmd_figures(args):
     return 0
 
 
-def _cmd_systems(args):
-    from . import catalog
-
-    if args.show:
-        system = catalog.system(args.show)
-        for k, v in system.describe().items():
-            print(f"{k:24s} {v}")
-        return 0
-    print(f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} {'omega0':>7s}")
-    for name in catalog.names():
-        s = catalog.system(name)
-        ax = s.secondary.semi_axes
-        print(f"{name:12s} {s.mass_ratio:10.2f} {s.a:8.0f} {s.e:7.4f} {ax[0] / ax[1]:5.2f} {s.omega0:7.3f}")
-    return 0
+HANDLERS = {"systems": _cmd_systems, "section": _cmd_section, "map": _cmd_map,
+            "overlap": _cmd_overlap, "libration": _cmd_libration, "energy": _cmd_energy,
+            "benchmark": _cmd_benchmark, "figures": _cmd_figures}
 
 
-def _cmd_section(args):
-    import os
-
-    import numpy as np
-
-    from . import catalog, init, surface_of_section
-    from .io import save_result
-    from .plotting import plot_section, save_figure
-
-    system = catalog.system(args.system, elongation=args.elongation,
-                            secondary_density=args.density, eccentricity=args.eccentricity)
-    init(arch=args.arch)
-    starts = args.thetadot or catalog.section_starts(args.system)
-    stem = "sos_" + system.name.replace(" ", "")
-    out = args.out or f"{stem}.png"
-    data = args.data or os.path.splitext(out)[0] + ".npz"
-    result = surface_of_section(system, args.theta_p, np.array(starts), orbits=args.orbits,
-                                rtol=args.rtol)
-    save_figure(plot_section(result), out)
-    save_result(result, data, kind="section")
-    if not args.quiet:
-        print(f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
-              f"{len(starts)} trajectories x {args.orbits:g} orbits in {result.seconds:.2f} s "
-              f"({result.member_orbits_per_second:.0f} member-orbits/s)")
-        for k, v in enumerate(starts):
-            print(f"  thetadot_p/n = {v:5.2f}: {result.count[k]} crossings, status "
-                  f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}")
-        print(f"wrote {out} and {data}")
-    return 0
+def _one_line(exc):
+    return " ".join(str(exc).split())
 
 
 def main(argv=None):
-    args = _parser().parse_args(argv)
-    handler = {"systems": _cmd_systems, "section": _cmd_section, "map": _cmd_map,
-               "overlap": _cmd_overlap, "figures": _cmd_figures}[args.command]
+    """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit status:
+    0 success, 1 a check failed (energy), 2 bad input or a failed run (one line on stderr),
+    130 interrupted."""
     try:
-        return handler(args)
-    except (ValueError, TypeError, RuntimeError) as exc:
-        print(f"ti-spinorbit {args.command}: error: {exc}", file=sys.stderr)
+        args, unknown = _parser().parse_known_args(argv)
+        if unknown:       # argparse would blame the top-level parser; name the subcommand
+            raise CommandLineError(f"ti-spinorbit {args.command}: error: unrecognized "
+                                   f"arguments: {' '.join(unknown)}")
+    except CommandLineError as exc:
+        print(_one_line(exc), file=sys.stderr)
         return 2
+    # recorded in every data file, quoted so that it can be pasted back into a shell
+    args.command_line = shlex.join(["ti-spinorbit", *(sys.argv[1:] if argv is None else argv)])
+    try:
+        check_args(args)
+        return HANDLERS[args.command](args)
+    except (ValueError, TypeError, RuntimeError, OSError) as exc:
+        print(f"ti-spinorbit {args.command}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"ti-spinorbit {args.command}: error: out of memory; use fewer members "
+              "(--grid, --members, --thetadot) or orbits", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"ti-spinorbit {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":
