@@ -27,7 +27,8 @@ import numpy as np
 from . import analytic, catalog
 from ._validate import require_positive
 from .classify import MIN_POINTS, classify_section
-from .section import SectionResult, surface_of_section
+from .distributed import sections
+from .section import SectionResult
 from .systems import BinarySystem
 from .kernels.ensemble import DONE
 
@@ -174,7 +175,8 @@ def _edges(centres, low=None, high=None):
 
 
 def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
-              progress: Optional[Callable[[float], None]] = None) -> ChaosMap:
+              progress: Optional[Callable[[float], None]] = None, client=None,
+              chunk_size=None) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -192,7 +194,12 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic (default 4; ⟨Y⟩ → 2 when regular).
     progress : callable, optional
-        ``progress(fraction)`` after every window.
+        ``progress(fraction)`` after every window (with ``client``: after every chunk).
+    client : dask.distributed.Client, optional
+        Run the grid in chunks on the cluster's workers (:mod:`ti_spinorbit.distributed`);
+        the map is identical to the single-process one.
+    chunk_size : int, optional
+        Members per chunk with ``client`` (default: a few chunks per worker).
 
     Returns
     -------
@@ -207,8 +214,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     require_positive("megno_chaotic", megno_chaotic)
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
-    section = surface_of_section(system, tp, td, orbits, rtol=rtol, indicators=True,
-                                 progress=progress)
+    section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
+                       indicators=True, progress=progress)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = tp.shape
@@ -288,7 +295,7 @@ class ParameterMap:
 def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySystem]],
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
-                  progress=None) -> ParameterMap:
+                  progress=None, client=None, chunk_size=None) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -307,6 +314,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         Integrator tolerance.
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
+    progress, client, chunk_size
+        As for :func:`chaos_map`.
 
     Returns
     -------
@@ -336,8 +345,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         name = grid[0].name
     members = [s for s in grid for _ in range(starts)]
     started = time.perf_counter()
-    section = surface_of_section(members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
-                                 orbits, rtol=rtol, indicators=True, progress=progress)
+    section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
+                       chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = (elongations.size, eccentricities.size, starts)

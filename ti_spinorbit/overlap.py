@@ -39,7 +39,7 @@ from . import analytic, catalog
 from ._validate import require_range
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
-from .section import surface_of_section
+from .distributed import sections
 from .systems import BinarySystem
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
@@ -123,7 +123,8 @@ def _factory(system_name_or_factory, eccentricity):
 def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongations=None,
                       eccentricity=None, orbits=1000, rtol=1e-10, center_starts=48,
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
-                      indicators=True, progress=None) -> OverlapScan:
+                      indicators=True, progress=None, client=None,
+                      chunk_size=None) -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -143,6 +144,9 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         Starts per elongation in the θ_p = 0 and θ_p = 90° columns.
     indicators : bool
         Integrate MEGNO / Lyapunov shadows too (about twice the cost) for the evidence.
+    progress, client, chunk_size
+        As for :func:`~ti_spinorbit.chaosmap.chaos_map`: with a ``dask.distributed.Client``
+        the members run in chunks on its workers, with an identical result.
     """
     import time
 
@@ -161,8 +165,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
         rates += list(centre_rates) + list(sep_rates)
     t0 = time.perf_counter()
-    sec = surface_of_section(members, np.array(theta0), np.array(rates), orbits=orbits,
-                             rtol=rtol, indicators=indicators, progress=progress)
+    sec = sections(client, members, np.array(theta0), np.array(rates), orbits=orbits,
+                   chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress)
     per = len(centre_rates) + len(sep_rates)
     decisions = []
     for k, s in enumerate(systems):
@@ -219,8 +223,8 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
 
 def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     """Overlap scans of a catalogued system at several eccentricities (same kwargs as
-    :func:`overlap_threshold`). Returns (eccentricities, numerical first_overlap (NaN if
-    none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
+    :func:`overlap_threshold`, ``client`` included). Returns (eccentricities, numerical
+    first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
     ecc = np.asarray(eccentricities, dtype=np.float64).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
     scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
