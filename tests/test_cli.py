@@ -273,3 +273,38 @@ def test_quiet_bar_draws_nothing():
             bar(0.5)
             bar(1.0)
         assert stream.getvalue() == ""
+
+
+def read_checkpoint_launches(path):
+    import json
+    with np.load(path / "state.npz") as d:
+        return json.loads(str(d["header"]))["launches"]
+
+
+def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
+    """The map is interrupted by SIGKILL after two windows, `--resume` finishes it, and the
+    saved arrays equal those of an uninterrupted run."""
+    import signal
+    import time
+
+    env = dict(os.environ, MPLBACKEND="Agg")
+    args = ["map", "--system", "1991 VH", "--grid", "3", "3", "--orbits", "1600", "--rtol", "1e-9",
+            "--quiet"]
+    ckpt = tmp_path / "m.ckpt"
+    proc = subprocess.Popen([sys.executable, "-m", "ti_spinorbit", *args, "--out", "m.png",
+                             "--checkpoint", str(ckpt)], cwd=tmp_path, env=env)
+    deadline = time.time() + 300
+    while time.time() < deadline and not (ckpt / "records-000001.npz").exists():
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL                    # killed, not finished
+    done = read_checkpoint_launches(ckpt)
+    assert 2 <= done < 100                                       # 100 windows of 16 orbits
+    p = run_cli(*args, "--out", "m.png", "--checkpoint", str(ckpt), "--resume", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    p = run_cli(*args, "--out", "full.png", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    with np.load(tmp_path / "m.npz") as a, np.load(tmp_path / "full.npz") as b:
+        for key in ("megno", "lyapunov", "status", "section/theta_p", "section/thetadot_p"):
+            np.testing.assert_array_equal(a[key], b[key], err_msg=key)

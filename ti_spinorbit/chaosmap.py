@@ -176,7 +176,7 @@ def _edges(centres, low=None, high=None):
 
 def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
               progress: Optional[Callable[[float], None]] = None, client=None,
-              chunk_size=None) -> ChaosMap:
+              chunk_size=None, model="auto", checkpoint=None, resume=False) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -200,6 +200,11 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         the map is identical to the single-process one.
     chunk_size : int, optional
         Members per chunk with ``client`` (default: a few chunks per worker).
+    model : {"auto", "planar", "3d"}
+        Equations of motion (see :func:`~ti_spinorbit.section.surface_of_section`).
+    checkpoint, resume
+        Checkpoint file written after every window, and whether to continue from it
+        (single process only; see :mod:`ti_spinorbit.checkpoint`).
 
     Returns
     -------
@@ -215,7 +220,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
-                       indicators=True, progress=progress)
+                       indicators=True, progress=progress, model=model, checkpoint=checkpoint,
+                       resume=resume)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = tp.shape
@@ -295,7 +301,8 @@ class ParameterMap:
 def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySystem]],
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
-                  progress=None, client=None, chunk_size=None) -> ParameterMap:
+                  progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
+                  resume=False) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -314,7 +321,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         Integrator tolerance.
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
-    progress, client, chunk_size
+    progress, client, chunk_size, model, checkpoint, resume
         As for :func:`chaos_map`.
 
     Returns
@@ -346,7 +353,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     members = [s for s in grid for _ in range(starts)]
     started = time.perf_counter()
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
-                       chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress)
+                       chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
+                       model=model, checkpoint=checkpoint, resume=resume)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = (elongations.size, eccentricities.size, starts)

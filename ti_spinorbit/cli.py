@@ -75,7 +75,9 @@ EXAMPLES_BY_COMMAND = {
   ti-spinorbit section --system "1991 VH" --out sos_1991VH.png
   ti-spinorbit section --system "1991 VH" --elongation 1.06 --thetadot 1.13 1.63 1.70 1.78 --orbits 1000""",
     "map": """\
-  ti-spinorbit map --system "2004 DC" --grid 32 32 --orbits 300 --out dc_map.png""",
+  ti-spinorbit map --system "2004 DC" --grid 32 32 --orbits 300 --out dc_map.png
+  ti-spinorbit map --system "2004 DC" --grid 128 128 --orbits 500 --resume   # Ctrl-C safe
+  ti-spinorbit map --system "1991 VH" --grid 16 16 --model 3d                # force 3-D""",
     "overlap": """\
   ti-spinorbit overlap --system "1991 VH" --elongations 1.01 1.10 0.01 --orbits 500""",
     "libration": """\
@@ -123,7 +125,7 @@ def _parser():
         return sub.add_parser(name, help=help, description=help, epilog=_help_epilog(name),
                               formatter_class=argparse.RawDescriptionHelpFormatter)
 
-    def common(s, out_help, data=True, orbits=300.0, rtol=1e-10):
+    def common(s, out_help, data=True, orbits=300.0, rtol=1e-10, model=True, resume=False):
         if orbits is not None:
             s.add_argument("--orbits", type=float, default=orbits,
                            help=f"orbits to integrate, in (0, {MAX_ORBITS:g}] (default {orbits:g})")
@@ -139,6 +141,17 @@ def _parser():
                            help=".npz path (default: the --out path with .npz)")
         s.add_argument("--quiet", action="store_true",
                        help="print nothing but errors (no progress bar, no summary)")
+        if model:
+            s.add_argument("--model", choices=("auto", "planar", "3d"), default="auto",
+                           help="equations of motion: the reduced planar model for planar "
+                                "starts (auto, default) or the general 3-D one (3d)")
+        if resume:
+            s.add_argument("--checkpoint", default=None, metavar="DIR",
+                           help="write a checkpoint directory after every window (default "
+                                "with --resume: the --data path with .ckpt)")
+            s.add_argument("--resume", action="store_true",
+                           help="continue an interrupted run from its checkpoint (same "
+                                "results as an uninterrupted run; starts afresh if none)")
 
     def system_flags(s, default="1991 VH", shape=True):
         s.add_argument("--system", default=default,
@@ -165,7 +178,7 @@ def _parser():
                    help="initial θ_p, deg, in [-360, 360] (default 0)")
     s.add_argument("--thetadot", type=float, nargs="+",
                    help="initial θ̇_p/n values (default: the paper's starts for this system)")
-    common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12)
+    common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12, resume=True)
 
     s = command("map", "chaos map over (θ_p, θ̇_p/n): MEGNO, Lyapunov, classes (PNG + .npz)")
     system_flags(s)
@@ -173,7 +186,7 @@ def _parser():
                    help=f"grid size, each in [1, {MAX_GRID}] (default 32 32)")
     s.add_argument("--thetadot-range", type=float, nargs=2, default=[0.2, 3.0],
                    metavar=("LO", "HI"), help="θ̇_p/n range, LO < HI (default 0.2 3.0)")
-    common(s, "PNG path (default map_<system>.png)")
+    common(s, "PNG path (default map_<system>.png)", resume=True)
 
     s = command("overlap", "resonance-overlap scan over a/b, 1:1 and 3:2 (PNG + .npz)")
     system_flags(s, shape=False)
@@ -193,7 +206,7 @@ def _parser():
                    help="coarse bracket of θ̇_p/n: N (5 to 10001) values over LO..HI "
                         "(default 45 over 0.2..1.3)")
     common(s, "PNG path of the centre search, extent vs θ̇_p/n (default libration_<system>.png)",
-           orbits=100.0, rtol=1e-12)
+           orbits=100.0, rtol=1e-12, model=False)
 
     s = command("energy", "energy and angular-momentum conservation check (PNG + .npz; "
                 "exit status 1 when the drift exceeds --max-drift)")
@@ -208,7 +221,8 @@ def _parser():
     s.add_argument("--max-drift", type=float, default=1e-9,
                    help="largest relative energy or angular-momentum drift that passes, "
                         "in (0, 1] (default 1e-9)")
-    common(s, "PNG path of drift vs time (default energy_<system>.png)", orbits=5.0, rtol=1e-12)
+    common(s, "PNG path of drift vs time (default energy_<system>.png)", orbits=5.0, rtol=1e-12,
+           resume=True)
 
     s = command("benchmark", "ensemble throughput in member-orbits/s on 1991 VH (JSON)")
     s.add_argument("--system", default="1991 VH", help="catalogued system (default 1991 VH)")
@@ -346,6 +360,17 @@ def _with_progress(func, bar):
     return {"progress": bar} if "progress" in inspect.signature(func).parameters else {}
 
 
+def _run_flags(args, data):
+    """model, checkpoint and resume keywords from the flags (the checkpoint defaults to the
+    data path with .ckpt when --resume is given alone)."""
+    import os
+
+    checkpoint = args.checkpoint
+    if checkpoint is None and args.resume:
+        checkpoint = os.path.splitext(data)[0] + ".ckpt"
+    return {"model": args.model, "checkpoint": checkpoint, "resume": args.resume}
+
+
 def _save(result, path, extra):
     """Write a result with :func:`ti_spinorbit.io.save` (self-describing, loadable with
     ``io.load``), the command's own numbers in the metadata under ``extra``."""
@@ -400,7 +425,7 @@ def _cmd_section(args):
     _init(args)
     with _progress(args) as bar:
         result = surface_of_section(system, args.theta_p, np.array(starts), orbits=args.orbits,
-                                    rtol=args.rtol, progress=bar)
+                                    rtol=args.rtol, progress=bar, **_run_flags(args, data))
     save_figure(plot_section(result), out)
     _save(result, data, {"command": args.command_line})
     _print(args, f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
@@ -427,7 +452,7 @@ def _cmd_map(args):
     theta = (np.arange(nt) + 0.5) * 180.0 / nt
     with _progress(args) as bar:
         cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
-                         rtol=args.rtol, progress=bar)
+                         rtol=args.rtol, progress=bar, **_run_flags(args, data))
     save_figure(cmap.plot(), out)
     _save(cmap, data, {"command": args.command_line})
     _print(args, f"{system.name}: {nt} x {nd} map, {args.orbits:g} orbits: chaotic fraction "
@@ -449,7 +474,8 @@ def _cmd_overlap(args):
     q = np.round(np.arange(start, stop + step / 2, step), 10)
     with _progress(args) as bar:
         scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
-                                 orbits=args.orbits, rtol=args.rtol, progress=bar)
+                                 orbits=args.orbits, rtol=args.rtol, progress=bar,
+                                 model=args.model)
     save_figure(scan.plot(), out)
     _save(scan, data, {"command": args.command_line})
     _print(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
@@ -592,7 +618,8 @@ def _cmd_energy(args):
     _init(args)
     with _progress(args) as bar:
         ts = time_series(system, args.theta_p, thetadot, args.orbits, samples_per_orbit=samples,
-                         rtol=args.rtol, **_with_progress(time_series, bar))
+                         rtol=args.rtol, **_with_progress(time_series, bar),
+                         **_run_flags(args, data))
     numbers, series = energy_check(ts)
     status = ts.status_names[0] if hasattr(ts, "status_names") else _status_name(ts.status[0])
     save_figure(_plot_energy(system, series, args.orbits, args.rtol), out)
@@ -639,9 +666,11 @@ def _cmd_benchmark(args):
     thetadot = np.linspace(*BENCH_THETADOT_RANGE, args.members)
     _init(args)
     started = time.perf_counter()
-    surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, rtol=args.rtol)   # compile / load
+    surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, rtol=args.rtol,
+                       model=args.model)                                          # compile / load
     warmup = time.perf_counter() - started
-    runs = [surface_of_section(system, 0.0, thetadot, orbits=args.orbits, rtol=args.rtol)
+    runs = [surface_of_section(system, 0.0, thetadot, orbits=args.orbits, rtol=args.rtol,
+                               model=args.model)
             for _ in range(args.repeat)]
     best = min(runs, key=lambda r: r.seconds)
     rate = args.members * args.orbits / best.seconds

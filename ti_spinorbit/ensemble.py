@@ -156,10 +156,11 @@ class Ensemble:
         renormalised to that separation after every accepted step; it yields the finite-time
         maximal Lyapunov exponent and MEGNO ⟨Y⟩ (``RunOutput.lyapunov``, ``.megno``).
 
-        ``checkpoint`` (a path) saves everything needed to resume after every window, with an
-        atomic replace (``ti_spinorbit.checkpoint``); with ``resume=True`` a run continues
-        from that file when it exists and gives the same results as an uninterrupted run. A
-        checkpoint written for other inputs or settings, or a damaged one, raises ValueError.
+        ``checkpoint`` (a directory path) saves everything needed to resume after every
+        window, with atomic replaces (``ti_spinorbit.checkpoint``); with ``resume=True`` a run
+        continues from it when it exists and gives the same results as an uninterrupted run.
+        A checkpoint written for other inputs or settings, or a damaged one, raises
+        ValueError.
         """
         import time
 
@@ -199,6 +200,9 @@ class Ensemble:
         n_events = np.zeros(n, dtype=np.int32)
         n_samples = np.zeros(n, dtype=np.int32)
         events, samples = st["events"], st["samples"]
+        # records not yet in the checkpoint (a fresh run's first sample is the initial state)
+        pending = {"events": {}, "samples": {} if st["launches"] else
+                   {i: list(s) for i, s in enumerate(samples) if s}}
         t0 = time.perf_counter() - st["seconds"]
         while np.any(self.status == K.RUNNING):
             t_end = np.minimum(t_stop, self.t + window)
@@ -208,10 +212,12 @@ class Ensemble:
                          self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
                          float(separation), self.order, self.odd, sampling, bool(indicators))
             st["launches"] += 1
-            for i in np.nonzero(n_events)[0]:
-                events[i].append(events_buf[i, :n_events[i]].copy())
-            for i in np.nonzero(n_samples)[0]:
-                samples[i].append(samples_buf[i, :n_samples[i]].copy())
+            for name, store, buf, count in (("events", events, events_buf, n_events),
+                                            ("samples", samples, samples_buf, n_samples)):
+                for i in np.nonzero(count)[0]:
+                    chunk = buf[i, :count[i]].copy()
+                    store[i].append(chunk)
+                    pending[name].setdefault(i, []).append(chunk)
             n_events[:] = 0
             n_samples[:] = 0
             finished = (self.status == K.RUNNING) & (self.t >= t_stop)
@@ -220,7 +226,8 @@ class Ensemble:
             if checkpoint is not None:
                 ckpt.save(checkpoint, settings, self._fingerprint(t_stop),
                           dict(st, y=self.y, t=self.t, h=self.h, status=self.status,
-                               counters=self.counters))
+                               counters=self.counters), pending)
+            pending = {"events": {}, "samples": {}}
             if progress is not None:
                 progress(float(np.mean(np.minimum(self.t, t_stop)) / np.mean(t_stop)))
         megno = lyapunov = np.full(n, np.nan)

@@ -124,7 +124,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                       eccentricity=None, orbits=1000, rtol=1e-10, center_starts=48,
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
                       indicators=True, progress=None, client=None,
-                      chunk_size=None) -> OverlapScan:
+                      chunk_size=None, model="auto") -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -147,10 +147,15 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     progress, client, chunk_size
         As for :func:`~ti_spinorbit.chaosmap.chaos_map`: with a ``dask.distributed.Client``
         the members run in chunks on its workers, with an identical result.
+    model : {"auto", "planar", "3d"}
+        Equations of motion (see :func:`~ti_spinorbit.section.surface_of_section`).
     """
     import time
 
     make, name = _factory(system_name_or_factory, eccentricity)
+    if elongations is not None and (np.ndim(elongations) != 1 or np.size(elongations) == 0):
+        raise ValueError(f"elongations must be a non-empty 1-D array of a/b values in (1, 10] "
+                         f"(got {elongations!r})")
     q = np.round(np.arange(1.01, 1.155, 0.01), 10) if elongations is None else \
         np.asarray(elongations, dtype=np.float64).ravel()
     require_range("elongations", q, 1.0, 10.0, low_open=True, high_open=False)
@@ -166,7 +171,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         rates += list(centre_rates) + list(sep_rates)
     t0 = time.perf_counter()
     sec = sections(client, members, np.array(theta0), np.array(rates), orbits=orbits,
-                   chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress)
+                   chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
+                   model=model)
     per = len(centre_rates) + len(sep_rates)
     decisions = []
     for k, s in enumerate(systems):
