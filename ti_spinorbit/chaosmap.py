@@ -63,7 +63,8 @@ def _labels(section, megno_chaotic, orbits):
     (at least 8), which only affects the geometric rule used in the 2.5 < ⟨Y⟩ < 4 gap and for
     resonant vs quasi-periodic."""
     min_points = int(min(MIN_POINTS, max(8, np.floor(0.8 * orbits))))
-    return classify_section(section, megno_chaotic=megno_chaotic, min_points=min_points).label
+    return classify_section(section, megno_chaotic=megno_chaotic, min_points=min_points,
+                            geometric=False).label
 
 
 def _mean_spin(section):
