@@ -107,7 +107,7 @@ API_CASES = [
      r"fixed shapes: only eccentricity may be changed"),
     # surface of section and time series
     ("section-zero-orbits", lambda vh: tso.surface_of_section(vh, 0, 1.0, 0), ValueError,
-     r"^orbits must be a finite number > 0 \(got 0.0\)"),
+     r"^orbits must be a finite number > 0 \(got 0\)"),
     ("section-nan-orbits", lambda vh: tso.surface_of_section(vh, 0, 1.0, NAN), ValueError,
      r"^orbits must be a finite number > 0 \(got nan\)"),
     ("section-rtol-zero", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, rtol=0), ValueError,
@@ -126,15 +126,20 @@ API_CASES = [
      ValueError, r"cannot broadcast 2 systems, theta_p of shape \(\) and thetadot_p of shape \(3,\)"),
     ("section-order", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, order=5), ValueError,
      r"^order must be 0, 2, 3 or 4 \(got 5\)"),
-    pytest.param("section-escape-distance-negative",
-                 lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, escape_distance=-1), ValueError,
-                 r"escape_distance must .*\(got -1", marks=gap("section.py build_members")),
-    pytest.param("section-orbits-absurd",
-                 lambda vh: tso.surface_of_section(vh, 0, 1.0, 1e12, progress=abort), ValueError,
-                 r"^orbits must .*(1e\+12|1000000000000)",
-                 marks=gap("section.py surface_of_section/time_series (upper bound on orbits)")),
+    ("section-escape-distance-negative",
+     lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, escape_distance=-1), ValueError,
+     r"^escape_distance must be a finite number > 1 \(units of a\) \(got -1\)"),
+    ("section-escape-distance-nan",
+     lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, escape_distance=NAN), ValueError,
+     r"^escape_distance must be a finite number > 1 \(units of a\) \(got nan\)"),
+    ("section-orbits-absurd",
+     lambda vh: tso.surface_of_section(vh, 0, 1.0, 1e12, progress=abort), ValueError,
+     r"^orbits must lie in \(0, 1e\+07\] \(got 1e\+12\)"),
     ("time-series-zero-orbits", lambda vh: tso.time_series(vh, 0, 1.0, 0), ValueError,
-     r"^orbits must be a finite number > 0 \(got 0.0\)"),
+     r"^orbits must be a finite number > 0 \(got 0\)"),
+    ("time-series-orbits-absurd",
+     lambda vh: tso.time_series(vh, 0, 1.0, 2e7, progress=abort), ValueError,
+     r"^orbits must lie in \(0, 1e\+07\] \(got 2e\+07\)"),
     ("time-series-zero-samples", lambda vh: tso.time_series(vh, 0, 1.0, 1, samples_per_orbit=0),
      ValueError, r"^samples_per_orbit must be an integer in \[1, 100000\] \(got 0\)"),
     ("time-series-rtol", lambda vh: tso.time_series(vh, 0, 1.0, 1, rtol=1), ValueError,
@@ -157,19 +162,20 @@ API_CASES = [
     ("overlap-zero-orbits",
      lambda vh: tso.overlap_threshold("1991 VH", elongations=[1.02], orbits=0), ValueError,
      r"^orbits must be a finite number > 0"),
-    pytest.param("overlap-no-elongations",
-                 lambda vh: tso.overlap_threshold("1991 VH", elongations=[], orbits=5), ValueError,
-                 r"^elongations must .*non-empty", marks=gap("overlap.py overlap_threshold")),
+    ("overlap-no-elongations",
+     lambda vh: tso.overlap_threshold("1991 VH", elongations=[], orbits=5), ValueError,
+     r"^elongations must be a non-empty 1-D array of a/b values in \(1, 10\] \(got \[\]\)"),
+    ("overlap-2d-elongations",
+     lambda vh: tso.overlap_threshold("1991 VH", elongations=[[1.02, 1.03]], orbits=5),
+     ValueError, r"^elongations must be a non-empty 1-D array .*\(got \[\[1.02, 1.03\]\]\)"),
     ("libration-system-name", lambda vh: tso.relaxed_libration("1991 VH"), TypeError,
      r"^system must be a BinarySystem \(got str\)"),
     ("libration-zero-orbits", lambda vh: tso.relaxed_libration(vh, orbits=0), ValueError,
      r"^orbits must be a finite number > 0 \(got 0\)"),
     ("libration-rtol-large", lambda vh: tso.relaxed_libration(vh, orbits=5, rtol=1.0), ValueError,
      r"^rtol must lie in \[1e-16, 0.01\] \(got 1.0\)"),
-    pytest.param("libration-rtol-zero", lambda vh: tso.relaxed_libration(vh, orbits=5, rtol=0),
-                 ValueError, r"^rtol must lie in \[1e-16, 0.01\] \(got 0\)",
-                 marks=gap("libration.py relaxed_libration (use ensemble.check_tolerances, as "
-                           "the other entry points do)")),
+    ("libration-rtol-zero", lambda vh: tso.relaxed_libration(vh, orbits=5, rtol=0),
+     ValueError, r"^rtol must lie in \[1e-16, 0.01\] \(got 0\)"),
     ("libration-even-zoom", lambda vh: tso.relaxed_libration(vh, orbits=5, zoom_candidates=10),
      ValueError, r"^zoom_candidates must be odd \(got 10\)"),
     ("libration-few-candidates", lambda vh: tso.relaxed_libration(vh, orbits=5, candidates=[1, 2, 3]),
@@ -186,21 +192,25 @@ API_CASES = [
      ValueError, r"^S must be a rotation matrix"),
     ("potential-R-shape", lambda vh: tso.mutual_potential(P, S, [3000, 0], np.eye(3)), ValueError,
      r"R must be \(\.\.\., 3\) and S \(\.\.\., 3, 3\) .*got \(2,\) and \(3, 3\)"),
-    pytest.param("potential-R-zero", lambda vh: tso.mutual_potential(P, S, [0, 0, 0], np.eye(3)),
-                 ValueError, r"overlap.*bounding radi",
-                 marks=gap("potential.py mutual_potential (|R| > sum of bounding radii; today "
-                           "R = 0 returns NaN silently)")),
-    pytest.param("potential-not-a-body",
-                 lambda vh: tso.mutual_potential("big", S, [3000, 0, 0], np.eye(3)), TypeError,
-                 r"^primary must be a ti_spinorbit Body",
-                 marks=gap("potential.py mutual_potential (today AttributeError: 'str' object "
-                           "has no attribute 'as_row')")),
+    ("potential-R-zero", lambda vh: tso.mutual_potential(P, S, [0, 0, 0], np.eye(3)),
+     ValueError, r"^bodies overlap: \|R\| = 0 m must exceed the sum of bounding radii \(845 m\)"),
+    ("potential-R-inside-contact",
+     lambda vh: tso.mutual_potential(P, S, [[3000, 0, 0], [0, 800, 0]], np.eye(3)[None].repeat(2, 0)),
+     ValueError, r"^bodies overlap: \|R\| = 800 m must exceed the sum of bounding radii \(845 m\)"),
+    ("potential-text-R", lambda vh: tso.mutual_potential(P, S, ["3000", 0, 0], np.eye(3)),
+     TypeError, r"^R must be a number"),
+    ("potential-not-a-body",
+     lambda vh: tso.mutual_potential("big", S, [3000, 0, 0], np.eye(3)), TypeError,
+     r"^primary must be a ti_spinorbit Body .*\(got str\)"),
+    ("potential-secondary-not-a-body",
+     lambda vh: tso.mutual_potential(P, None, [3000, 0, 0], np.eye(3)), TypeError,
+     r"^secondary must be a ti_spinorbit Body .*\(got NoneType\)"),
     ("init-unknown-arch", lambda vh: tso.init(arch="tpu"), ValueError,
      r"^arch must be one of cpu, x64, arm64, cuda, vulkan, metal, opengl, gpu \(got 'tpu'\)"),
-    pytest.param("init-arch-not-text", lambda vh: tso.init(arch=5), ValueError,
-                 r"^arch must be one of .*\(got 5\)",
-                 marks=gap("runtime.py init (today AttributeError: 'int' object has no "
-                           "attribute 'lower')")),
+    ("init-arch-not-text", lambda vh: tso.init(arch=5), ValueError,
+     r"^arch must be one of cpu, x64, arm64, cuda, vulkan, metal, opengl, gpu \(got 5\)"),
+    ("init-arch-empty", lambda vh: tso.init(arch=""), ValueError,
+     r"^arch must be one of .* \(got ''\)"),
 ]
 
 
@@ -209,6 +219,13 @@ API_CASES = [
 def test_api_refuses_bad_input(vh, name, call, error, message):
     with pytest.raises(error, match=message):
         call(vh)
+
+
+def test_init_names_the_environment_variable(monkeypatch):
+    monkeypatch.setenv(tso.runtime.ARCH_ENV, "tpu")
+    with pytest.raises(ValueError, match=r"^the environment variable TI_SPINORBIT_ARCH must be "
+                                         r"one of cpu, .* \(got 'tpu'\)"):
+        tso.init()
 
 
 # (argv, message regex after "ti-spinorbit <command>: error: ")

@@ -28,7 +28,7 @@ from . import analytic, catalog
 from ._validate import require_positive
 from .classify import MIN_POINTS, classify_section
 from .distributed import sections
-from .section import SectionResult
+from .section import SectionResult, check_orbits
 from .systems import BinarySystem
 from .kernels.ensemble import DONE
 
@@ -215,7 +215,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
     theta_p = _axis("theta_p", theta_p)
     thetadot_p = _axis("thetadot_p", thetadot_p)
-    require_positive("orbits", orbits)
+    check_orbits(orbits)
     require_positive("rtol", rtol)
     require_positive("megno_chaotic", megno_chaotic)
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
@@ -333,7 +333,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     eccentricities = _axis("eccentricities", eccentricities)
     theta_p = _axis("theta_p", theta_p)
     thetadot_p = _axis("thetadot_p", thetadot_p)
-    require_positive("orbits", orbits)
+    check_orbits(orbits)
     require_positive("rtol", rtol)
     if np.any(elongations < 1.0):
         raise ValueError(f"elongations must be >= 1 (got {elongations!r})")

@@ -24,8 +24,8 @@ import os
 import shlex
 import sys
 
-#: Largest --orbits accepted (10 million orbits is days of CPU time even for one member).
-MAX_ORBITS = 1e7
+from .section import MAX_ORBITS  # orbits limit shared with the library
+
 #: Accepted --rtol range (the integrator's own limits, ensemble.check_tolerances).
 RTOL_RANGE = (1e-16, 1e-2)
 #: Largest grid side of a chaos map, and most members of any run.

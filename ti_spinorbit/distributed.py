@@ -39,7 +39,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from . import runtime, section
-from ._validate import require_count, require_positive
+from ._validate import require_count
 from .ensemble import check_tolerances
 
 #: Default number of chunks per worker process: enough to balance members of unequal cost
@@ -114,7 +114,7 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
     call = inspect.signature(section.surface_of_section).bind(
         system_or_systems, theta_p, thetadot_p, orbits, **kwargs)
     call.apply_defaults()
-    require_positive("orbits", orbits)
+    section.check_orbits(orbits)
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "

@@ -47,6 +47,7 @@ import numpy as np
 from . import analytic
 from .classify import horizontal_extent
 from ._validate import require_count, require_finite, require_positive
+from .ensemble import check_tolerances
 from .section import SystemLike, surface_of_section, time_series
 from .systems import BinarySystem
 
@@ -185,7 +186,7 @@ def _arm_window(x, extent, best, points):
 def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=None,
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
                       samples_per_orbit=256, coarse_arm_points=3,
-                      max_extent=MAX_CENTER_EXTENT_DEG) -> RelaxedLibration:
+                      max_extent=MAX_CENTER_EXTENT_DEG, progress=None) -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
     Parameters
@@ -213,6 +214,12 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     max_extent : float
         Largest section extent (deg) allowed at the centre found; above it the search is
         reported as not converged (a chaotic zone can also narrow the zoom window).
+    progress : callable, optional
+        ``progress(fraction)`` after every launch of the search (the coarse section, the
+        coarse libration check, each zoom, the final section, the final time series):
+        launches done / (launches done + launches still expected), the zoom launches still
+        expected estimated from the window's half-width, ``xtol`` and ``max_iterations``;
+        1.0 after the last.
 
     Returns
     -------
@@ -231,7 +238,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         raise ValueError("the secondary must be elongated (B > A, omega0 > 0) to have a "
                          "synchronous island")
     require_positive("orbits", orbits)
-    require_positive("rtol", rtol)
+    check_tolerances(rtol, None)
     require_positive("xtol", xtol)
     zoom_candidates = require_count("zoom_candidates", zoom_candidates, 5, 100001)
     if zoom_candidates % 2 == 0:
@@ -245,11 +252,33 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     if len(x) < 5 or np.any(np.diff(x) <= 0):
         raise ValueError(f"candidates must hold at least 5 ascending values (got {candidates!r})")
 
+    shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
+    launches = 0
+
+    def zooms_left(half_width, iterations):
+        """Zoom launches still expected from the window's half-width (a guess: a window
+        that moves instead of shrinking costs one more)."""
+        if half_width <= xtol:
+            return 0
+        needed = max_iterations if shrink <= 1.0 else \
+            math.ceil(math.log(half_width / xtol) / math.log(shrink))
+        return max(0, min(max_iterations - iterations, needed))
+
+    def launched(left):
+        """One more launch done, ``left`` still expected: report the fraction done."""
+        nonlocal launches
+        launches += 1
+        if progress is not None:
+            progress(launches / (launches + left))
+
     start = time.perf_counter()
     # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
+    half_width = float(np.max(np.diff(x)))
     extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol))
+    launched(1 + zooms_left(half_width, 0) + 2)
     librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol,
                                                samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT))
+    launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
     tried, extents = [x], [extent]
     if not np.any(np.isfinite(extent)):
@@ -258,7 +287,6 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     best = int(np.nanargmin(extent))
     near = _arm_window(x, extent, best, coarse_arm_points)
     center = _fit_v(x[near], extent[near], int(np.flatnonzero(near == best)[0]))
-    half_width = float(np.max(np.diff(x)))
     if center is None:
         center = float(x[best])
 
@@ -276,13 +304,15 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         best = int(np.nanargmin(extent))
         if best in (0, len(x) - 1):            # centre outside the window: move, keep width
             center = float(x[best])
-            continue
-        fitted = _fit_v(x, extent, best)
-        center = float(x[best]) if fitted is None else fitted
-        half_width *= 4.0 / (zoom_candidates - 1)
+        else:
+            fitted = _fit_v(x, extent, best)
+            center = float(x[best]) if fitted is None else fitted
+            half_width *= 4.0 / (zoom_candidates - 1)
+        launched(zooms_left(half_width, iterations) + 2)
     # 4. the centre itself
     final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
                                                            rtol=rtol))[0])
+    launched(1)
     # a narrow window is not enough: at a true centre the trace shrinks to a point (a chaotic
     # zone, e.g. 1996 FG3 at a/b = 1.1, also narrows the window but leaves a wide trace)
     converged = half_width <= xtol and final_extent <= max_extent
@@ -293,6 +323,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                       stacklevel=2)
     amplitude = libration_amplitude(system, center, orbits, samples_per_orbit=samples_per_orbit,
                                     rtol=rtol)
+    launched(0)
     if not np.isfinite(amplitude):
         raise RuntimeError(f"the trajectory from θ̇_p/n = {center:.9g} does not librate")
     omega0_effective = analytic.omega0_effective(system)

@@ -37,17 +37,26 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     from .bodies import ROW_LENGTH
     from .systems import G
 
+    for label, body in (("primary", primary), ("secondary", secondary)):
+        if not isinstance(body, Body):
+            raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body) "
+                            f"(got {type(body).__name__})")
     if order not in (0, 2, 3, 4):
         raise ValueError(f"order must be 0, 2, 3 or 4 (got {order!r})")
-    R = np.asarray(R, dtype=np.float64)
-    S = np.asarray(S, dtype=np.float64)
-    require_finite("R", R)
-    require_finite("S", S)
+    # checked before the conversion, so text is a TypeError naming R or S
+    R = np.asarray(require_finite("R", R), dtype=np.float64)
+    S = np.asarray(require_finite("S", S), dtype=np.float64)
     if R.shape[-1:] != (3,) or S.shape[-2:] != (3, 3) or R.shape[:-1] != S.shape[:-2]:
         raise ValueError(f"R must be (..., 3) and S (..., 3, 3) with matching batch shapes "
                          f"(got {R.shape} and {S.shape})")
     if not np.allclose(np.einsum("...ji,...jk->...ik", S, S), np.eye(3), atol=1e-9):
         raise ValueError("S must be a rotation matrix (S^T S = 1)")
+    # the expansion converges only outside the bodies' bounding spheres (R = 0 gave NaN)
+    contact = primary.bounding_radius + secondary.bounding_radius
+    closest = float(np.min(np.linalg.norm(R, axis=-1))) if R.size else np.inf
+    if closest <= contact:
+        raise ValueError(f"bodies overlap: |R| = {closest:.6g} m must exceed the sum of "
+                         f"bounding radii ({contact:.6g} m)")
     batch = R.shape[:-1]
     Rf = np.ascontiguousarray(R.reshape(-1, 3))
     Sf = np.ascontiguousarray(S.reshape(-1, 3, 3))

@@ -10,11 +10,38 @@ Decisions (architecture.md, "Kernel design"):
 * The environment variable ``TI_SPINORBIT_ARCH`` (``cpu``, ``cuda``, ``vulkan``, ...)
   overrides the arch of the lazy default and of ``init()`` called without an arch.
 * ``TI_SKIP_VERSION_CHECK=ON`` is set before Taichi is imported (no network in CI).
+* In the ``ti-spinorbit`` command only, ``ENABLE_TAICHI_HEADER_PRINT=0`` is set too: ``import
+  taichi`` prints a "[Taichi] version ..." line on stdout, and the command's stdout is its
+  own (``--quiet`` prints nothing). Library users still see the banner. Both are defaults
+  (``setdefault``): a value already in the environment wins. This module is imported before
+  anything in the package imports taichi (``ti_spinorbit/__init__.py``).
 """
 
 import os
+import sys
+
+
+def _is_command_line():
+    """True when this process is the ti-spinorbit command: the console script, or
+    ``python -m ti_spinorbit`` (while runpy imports the package, sys.argv[0] is "-m" and the
+    module name is in sys.orig_argv)."""
+    argv0 = sys.argv[0] if sys.argv else ""
+    if os.path.splitext(os.path.basename(argv0))[0] in ("ti-spinorbit", "ti-spinorbit-script"):
+        return True
+    if argv0 != "-m":
+        return False
+    orig = getattr(sys, "orig_argv", [])
+    for k, token in enumerate(orig[1:], 1):
+        if token == "-m":
+            return orig[k + 1:k + 2] == ["ti_spinorbit"]
+        if token.startswith("-m"):
+            return token[2:] == "ti_spinorbit"
+    return False
+
 
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
+if _is_command_line():
+    os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "0")
 
 _STATE = {"arch": None}
 ARCH_ENV = "TI_SPINORBIT_ARCH"
@@ -39,11 +66,14 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
     Returns the arch name in use. Calling again with the same arch is a no-op; calling with
     a different arch re-initialises Taichi, which invalidates existing ensembles.
     """
+    name = arch if arch is not None else (os.environ.get(ARCH_ENV) or "cpu")
+    if not isinstance(name, str) or name.lower() not in _KNOWN_ARCHS:
+        label = "arch" if arch is not None else f"the environment variable {ARCH_ENV}"
+        raise ValueError(f"{label} must be one of {', '.join(_KNOWN_ARCHS)} (got {name!r})")
+    name = name.lower()
+
     import taichi as ti
 
-    name = (arch or os.environ.get(ARCH_ENV) or "cpu").lower()
-    if name not in _KNOWN_ARCHS:
-        raise ValueError(f"arch must be one of {', '.join(_KNOWN_ARCHS)} (got {arch!r})")
     if _STATE["arch"] == name:
         return name
     ti_arch = {"cpu": ti.cpu, "x64": ti.x64, "arm64": ti.arm64, "cuda": ti.cuda,

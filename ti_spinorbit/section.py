@@ -14,11 +14,25 @@ from typing import List, Sequence, Union
 
 import numpy as np
 
-from ._validate import require_count, require_finite
+from ._validate import _as_floats, require_count, require_finite
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
+
+#: Largest ``orbits`` accepted by surface_of_section and time_series (10 million orbits is
+#: days of CPU time even for one member; the command line's --orbits has the same bound).
+MAX_ORBITS = 1e7
+
+
+def check_orbits(orbits):
+    """``orbits`` as a float, or ValueError unless it is finite and lies in (0, MAX_ORBITS]."""
+    value = float(orbits)
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
+    if value > MAX_ORBITS:
+        raise ValueError(f"orbits must lie in (0, {MAX_ORBITS:g}] (got {value:g})")
+    return value
 
 
 def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
@@ -26,7 +40,11 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
     """Broadcast systems and initial conditions into a member table.
 
     Returns (systems list of length N, par (N, NPAR), y0 (N, 30), theta_p_deg (N,),
-    thetadot_p (N,))."""
+    thetadot_p (N,)). ``escape_distance`` is in units of a and must exceed 1."""
+    distance = _as_floats("escape_distance", escape_distance)
+    if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
+        raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
+                         f"(got {escape_distance!r})")
     systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else list(system_or_systems)
     if not systems or not all(isinstance(s, BinarySystem) for s in systems):
         raise TypeError("system_or_systems must be a BinarySystem or a non-empty list of them")
@@ -125,7 +143,8 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     thetadot_p : float or array
         Initial spin rate of the secondary, units of the mean motion n.
     orbits : float
-        Integration time in initial orbital periods 2π/n (each member its own n).
+        Integration time in initial orbital periods 2π/n (each member its own n); orbits
+        must lie in (0, 1e7] (``MAX_ORBITS``).
     rtol, atol : float
         Integrator tolerances on the scaled state (atol defaults to rtol).
     order : {0, 2, 3, 4}
@@ -133,7 +152,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     window_orbits : int
         Orbits per kernel launch (affects speed only).
     escape_distance : float
-        Stop a member as "escape" beyond this distance, units of a.
+        Stop a member as "escape" beyond this distance, units of a (a finite number > 1).
     indicators : bool
         Also integrate a shadow trajectory per member (same steps, about 2x the cost) for
         MEGNO and the maximal Lyapunov exponent; the main trajectory is unchanged.
@@ -152,9 +171,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     -------
     SectionResult
     """
-    orbits = float(orbits)
-    if not np.isfinite(orbits) or orbits <= 0:
-        raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
+    orbits = check_orbits(orbits)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
@@ -238,11 +255,10 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
-    initial orbital period), so samples carry the integrator's accuracy."""
+    initial orbital period), so samples carry the integrator's accuracy. orbits must lie in
+    (0, 1e7] (``MAX_ORBITS``), as for surface_of_section."""
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
-    orbits = float(orbits)
-    if not np.isfinite(orbits) or orbits <= 0:
-        raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
+    orbits = check_orbits(orbits)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
