@@ -1,54 +1,96 @@
-"""Benchmark: ensemble throughput on 1991 VH against scipy's DOP853, start-up, threads.
+"""Benchmark: where the ensemble integrator's time goes on 1991 VH (a/b = 1.5), and how it scales.
 
-What is measured (all on the current Taichi arch, CPU by default; θ_p = 0 and θ̇_p/n spread
-over linspace(0.4, 2.6, N), so every run is deterministic):
+Issue 5, item 1 ("measure first"). Every run is deterministic: member k starts at
+θ_p = 180° frac(½ + k/g), θ̇_p/n = 0.5 + 2 frac(½ + k/g²) with g the plastic number (an
+R2 low-discrepancy sequence over θ_p ∈ [0, 180), θ̇_p/n ∈ [0.5, 2.5]), so the first N
+members of a larger table are the N-member table and every N samples the same mix of regular
+and chaotic starts. Integration uses ``Ensemble`` directly (order 4, atol = rtol, escape
+distance 1000 a so no member stops early). Sections (``--sections``, default all):
 
-1. Kernel throughput: member-orbits per second of ``surface_of_section`` at rtol 1e-12 and
-   1e-15 for N = 1, 64, 1024, 4096 members over 20 orbits (``--quick``: N = 1, 64 over 2
-   orbits). The time is ``SectionResult.seconds`` (kernel launches and buffer draining, not
-   set-up); one warm-up call first compiles or loads the kernels and is timed on its own.
-   Accepted and rejected steps and right-hand-side calls are means per member per orbit.
-2. Baseline: the plain NumPy reference (``reference.integrate``, scipy DOP853) on a few members
-   at the same rtol. Tolerance choice: the kernels control the error of the *scaled* state
-   (every component O(1)) with atol = rtol; the reference integrates the SI state, whose
-   components span 1 (rotation matrices) to 1e13 (Γ1). The baseline therefore uses the
-   per-component atol = rtol × (SI size of one scaled unit) = rtol · to_physical(ones), which is
-   the kernels' own error control carried to SI (scipy's RMS norm is, if anything, looser than
-   the kernels' max norm, which favours the baseline). A "pure relative" atol such as 1e-30
-   does not work: components that are zero in this planar problem pick up round-off
-   (Γ1_z ≈ 1e-27 N m s for the torque-free spherical primary, S1 entries ≈ 1e-52), pure
-   relative control then asks for errors of ~1e-39, and DOP853 shrinks its step to ~1e-15 of
-   an orbit (it did not finish 0.001 orbit in 300 s). scipy raises any rtol below 100 eps to
-   2.2e-14, so the "1e-15" baseline really runs at rtol 2.2e-14 (atol stays 1e-15 · units):
-   easier than the kernels' 1e-15, again in the baseline's favour; the table shows the rtol
-   scipy used. One-off costs (importing scipy.integrate, the reference's cached multipole
-   bases) are paid before timing. Each baseline member is also run by the kernels to the same
-   end time and the final states are compared (max |Δy| in scaled units), so both sides
-   integrate the same problem. The ratio printed is kernel throughput at the largest N over
-   baseline throughput, per tolerance.
-3. First result from a fresh process: ``sys.executable -c`` imports ti_spinorbit and computes
-   a 1-member, 1-orbit section with the offline kernel cache in a new temporary folder: the
-   first run compiles (cold cache), the next ``--repeat`` runs load (warm cache; the best is
-   compared with the target). Wall time includes interpreter start-up.
-4. Threads: N = 1024 (``--quick``: 64) at rtol 1e-12 in fresh processes with
-   ``cpu_max_num_threads = 1`` and with the default (all cores), alternating; Taichi fixes the
-   thread count at ``ti.init``.
+throughput
+    member-orbits per second for N × rtol × model (``--members``, ``--rtols``,
+    ``--models``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10, 1e-12, 1e-15, models
+    planar and 3d) on the arch of ``--arch`` (cpu by default; ``--arch cuda --members ...
+    65536`` for a GPU). The orbits of each point are chosen so that it takes about
+    ``--seconds`` (default 2 s): a short pilot run measures the rate, then the timed run
+    integrates ``seconds × rate / N`` orbits (rounded up to two significant figures, at
+    least one orbit). The time is ``RunOutput.seconds`` (the window loop: kernel launches
+    and draining); accepted and rejected steps and RHS calls are per member-orbit.
+    Per-core CPU-time throughput (member-orbits per process CPU-second) is printed beside
+    the wall-clock rate: it is what to compare on a loaded machine.
+split
+    the time of one integrator pass, split into the right-hand side, the rest of
+    ``advance`` (stage points and combination, error norm, step control, pericentre events,
+    loads and stores) and the drain (Python between launches: buffer copies, status
+    updates). RHS cost: a kernel defined here evaluates each model's ``rhs`` R times in a
+    loop on the N benchmark states (R large, so launch overhead vanishes); each call's
+    argument is y0 + 1e-12 f(previous), a dependent chain like the stages of a step, which
+    stops the compiler from hoisting any of the RHS out of the loop. That chain adds one
+    multiply-add per state component (20 flops beside the planar RHS's 141, 60 beside the
+    3-D's 835), so the RHS share is, if anything, overstated. A store inside the loop, which
+    keeps the parameter loads from being hoisted as the record stores in ``advance`` do,
+    changed nothing (measured once; not in the script). Kernel time: ``advance`` of the
+    model's kernel namespace is wrapped by a timer for the duration of each run (wall and
+    process CPU time per launch), and ``progress`` marks each window's end. On the CPU the
+    ns figures are per core (process CPU time / count), on a GPU wall time / count.
+flops
+    a hand count of floating-point operations per RHS (:data:`FLOPS_PER_RHS`, derivation
+    beside it), the achieved flop rate of the RHS-only kernel and of the whole integrator
+    (RHS flops only), and the fraction of the CPU's f64 peak: cores × GHz (``cpu MHz`` of
+    /proc/cpuinfo) × ``--flops-per-cycle`` (default 16: AVX2 + FMA, 2 FMA units × 4 lanes ×
+    2). The kernels compile to scalar code (one member per thread, no SIMD across members),
+    which uses one of the four lanes: about 1/4 of that peak is its ceiling (a little more
+    where the core has separate add ports or the clock boosts above ``cpu MHz``).
+threads
+    N = 4096 at rtol 1e-12, both models, in fresh processes with
+    ``tso.init(cpu_max_num_threads=k)`` for k = 1, 2 (and all cores when there are more),
+    alternating; speed-up, parallel efficiency and per-core CPU-time throughput (CPU only).
+window
+    throughput for ``window_orbits`` = 4, 16, 64 at N = 4096, planar, rtol 1e-12, over 128
+    orbits (two launches of the longest window), with launches and drain fraction.
+baseline
+    the plain NumPy reference (``reference.integrate``, scipy DOP853) on the first 2 members
+    over 2 orbits per rtol, and the same members through the kernels to the same end time
+    (max |Δy| of the final states, scaled units, so both sides integrate the same problem).
+    Tolerances: the kernels control the error of the scaled state (every component O(1))
+    with atol = rtol; the reference integrates the SI state, whose components span 1
+    (rotation matrices) to 1e13 (Γ1), so the baseline uses the per-component
+    atol = rtol · to_physical(ones), the kernels' own error control carried to SI (scipy's
+    RMS norm is, if anything, looser than the kernels' max norm, which favours the
+    baseline). Pure relative control (atol ~ 1e-30) does not work: components that are zero
+    in this planar problem pick up round-off and DOP853's step collapses. scipy raises any
+    rtol below 100 eps to 2.2e-14, so its "1e-15" runs at 2.2e-14 (shown in the table),
+    again in the baseline's favour. One-off costs (importing scipy.integrate, the
+    reference's cached multipole bases) are paid before timing. The speed-up printed is the
+    kernel rate at the split N over the baseline rate, per model and rtol.
+latency
+    first result from a fresh process: ``sys.executable -c`` imports ti_spinorbit and
+    computes a 1-member, 1-orbit section; with a new, empty offline kernel cache (cold:
+    compiles) and then ``--repeat`` times with it warm. Wall time includes interpreter
+    start-up. ``--quick`` skips the cold run and uses the default cache folder.
 
-``--repeat k`` times every kernel run, warm start and thread setting k times and keeps the
-best, which helps on a shared machine (the load average at start and end is recorded).
+``--quick``: N = 1, 16, split/threads/window at N = 16, 0.05 s per point, 1 baseline member
+over 0.5 orbit, no cold-cache run: every section in about 12 s (CI, not figures).
+``--repeat k`` times every run k times and keeps the best (do that on a shared machine; the
+load average at start and end is recorded, and other processes' load lowers every
+wall-clock figure).
 
-Targets: >= 1000 member-orbits/s at N = 4096, rtol 1e-12; >= 300x the baseline; <= 3 s to
-the first result from a fresh process with a warm cache.
+Targets: >= 1000 member-orbits/s at N = 4096, rtol 1e-12; >= 300x the baseline;
+<= 3 s to the first result from a fresh process with a warm cache.
 
-Writes ``<out>/bench_throughput.json`` (every number plus machine information),
-``bench_throughput.png`` (throughput against N) and ``bench_throughput.npz``; prints the table.
+Writes ``<out>/bench_throughput.json`` (every row of every section, machine information and
+the settings), ``bench_throughput.png`` (throughput against N; time split) and
+``bench_throughput.npz``; prints one table per section.
 
-    python experiments/bench_throughput.py            # full: several minutes on 2 cores
-    python experiments/bench_throughput.py --quick    # CI: under a minute
+    python experiments/bench_throughput.py                      # full: ~3 min on 2 cores
+    python experiments/bench_throughput.py --quick              # CI
+    python experiments/bench_throughput.py --sections throughput --members 4096
+    python experiments/bench_throughput.py --arch cuda --members 1024 4096 16384 65536 262144
 """
 
 import datetime
 import json
+import math
 import os
 import platform
 import subprocess
@@ -62,121 +104,456 @@ import numpy as np
 from _common import parse, save
 
 SYSTEM = "1991 VH"
-THETA_P_DEG = 0.0
-THETADOT_RANGE = (0.4, 2.6)      # θ̇_p/n spread across the members (units of n)
-RTOLS = (1e-12, 1e-15)
-TARGET_RATE = 1000.0             # member-orbits/s at N = 4096, rtol 1e-12
-TARGET_SPEEDUP = 300.0           # over the scipy baseline
-TARGET_FIRST_RESULT_S = 3.0      # fresh process, warm offline cache
-SCIPY_MIN_RTOL = 100 * np.finfo(float).eps  # scipy's RK solvers raise smaller rtol to this
+ELONGATION = 1.5                  # secondary a/b
+THETA_P_RANGE = (0.0, 180.0)      # degrees
+THETADOT_RANGE = (0.5, 2.5)       # θ̇_p/n
+ESCAPE_DISTANCE = 1000.0          # units of a: nobody escapes within a benchmark
+PLASTIC = 1.32471795724474602596  # g of the R2 sequence (g³ = g + 1)
+RTOLS = (1e-10, 1e-12, 1e-15)
+MODELS = ("planar", "3d")
+WINDOWS = (4, 16, 64)
+SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "latency")
+TARGET_RATE = 1000.0              # member-orbits/s at N = 4096, rtol 1e-12
+TARGET_SPEEDUP = 300.0            # over the scipy baseline
+TARGET_FIRST_RESULT_S = 3.0       # fresh process, warm offline cache
+SCIPY_MIN_RTOL = 100 * np.finfo(float).eps   # scipy's RK solvers raise smaller rtol to this
+FLOPS_PER_CYCLE = 16              # f64, AVX2 + FMA: 2 FMA units × 4 lanes × 2 flops
+RHS_PERTURBATION = 1e-12          # RHS-only loop: next argument y0 + this · f(previous)
 
-# Full and --quick settings.
-FULL = dict(sizes=(1, 64, 1024, 4096), orbits=20.0, baseline_members=2, baseline_orbits=2.0,
-            thread_members=1024, thread_orbits=20.0)
-QUICK = dict(sizes=(1, 64), orbits=2.0, baseline_members=1, baseline_orbits=0.5,
-             thread_members=64, thread_orbits=2.0)
+# Floating-point operations per right-hand side, order 4, bodies symmetric about their
+# principal planes (odd=False: every catalogued system). Counted by hand from the kernels,
+# after removing what the compiler removes (dead code: the potential's value, which dy/dt
+# does not use; the cos/sin 3ψ and order-3 terms; common subexpressions). One add, subtract,
+# multiply, divide or square root = 1 flop; negations free. Check: the optimised LLVM IR of
+# each model's evaluate_rhs (Taichi 1.7.4, x64, fast_math off) holds 138 (planar) and 832
+# (3-D) scalar fadd/fsub/fmul/fdiv/sqrt, no vector operations.
+#
+# planar, kernels/planar.py                                                                     141
+#   1/r 1 (the only division), start of V_r 2                                                     3
+#   per body (_series): cos, sin of 2ψ and 4ψ 10, P2 4, dP2/dψ 4, P4 8, dP4/dψ 9 = 35; ×2        70
+#   1/r², 1/r³ 2; order-2 terms into V_r 5, V_A 2, V_B 2                                         11
+#   order 4: cos, sin (2ψ_A − 2ψ_B) 6, X 9, X_A 6, X_B 5, 1/r⁵ 1, P4 + Q4 + X 2,
+#     V_r 4, V_A 3, V_B 3                                                                        39
+#   rhs_member: dλ/dt 2, dψ_A/dt and dψ_B/dt 4, dv_r/dt 4, dℓ/dt 2, cos/sin rates 4,
+#     spins 2                                                                                    18
+# 3-D, kernels/eom.py + kernels/potential.py (G = 1 folds away)                                 835
+#   eom.rhs around the potential: Ω1 3, Ω2 = S I2⁻¹ Sᵀ w2 33, dR/dt 12, dV/dt 15,
+#     dw1/dt 15, dw2/dt 15 (3 divisions each), Ω2 − Ω1 3, dS/dt 27, dS1/dt 27                   150
+#   mutual: R·R 5, sqrt 1, 1/r 1, e 3, ∇(mA mB/r) 6                                              16
+#     e_B = Sᵀ e 15; single_body_terms per body 118 (L2 13, ∇L2 3, powers of u 9,
+#       the 6 even 4th-order monomials and their gradient 51, the K diagonal 6,
+#       K u 15 (a full 3×3 product: 0·x does not fold), L4 12, ∇L4 9); two bodies 236           251
+#     order 2: 1/r², 1/r³ 2, S ∇L2_B 15, U2 3, ∇U2 9, ∂U/∂R 27, torque on B 9                    65
+#     order 4: J'_B = S J_B Sᵀ 90, traces 4, J_A e 3, J'_B e 15, a, b 10, X 24,
+#       J_A J'_B e 3, J'_B J_A e 15, ∇X 36, S ∇L4_B 15, U4 4, ∇U4 12, 1/r⁵ 1,
+#       ∂U/∂R 27, torque on B 9, ε_AB 6, quadrupole-quadrupole torque 55                        329
+#     μ2 += e × τ 12, μ1 = R × ∂U/∂R − μ2 12                                                     24
+FLOPS_PER_RHS = {"planar": 141, "3d": 835}
 
+FULL = dict(sizes=(1, 16, 256, 1024, 4096, 16384), seconds=2.0, min_orbits=1.0,
+            split_members=4096, rhs_seconds=1.0, window_orbits=2.0 * max(WINDOWS),
+            baseline_members=2, baseline_orbits=2.0, cold_latency=True)
+QUICK = dict(sizes=(1, 16), seconds=0.05, min_orbits=0.1,
+             split_members=16, rhs_seconds=0.05, window_orbits=2.0 * max(WINDOWS),
+             baseline_members=1, baseline_orbits=0.5, cold_latency=False)
+FIRST_RATE_GUESS = 1000.0         # member-orbits/s, for sizing the very first pilot run
+PILOT_FRACTION = 0.125            # pilot run length, fraction of --seconds
+MIN_PILOT_ORBITS = 0.05
+
+EXPERIMENTS = os.path.dirname(os.path.abspath(__file__))
 # Child processes print one JSON line last; sys.argv[1:] carries their inputs.
+CHILD_THREADS = (f"import sys; sys.path.insert(0, {EXPERIMENTS!r}); import bench_throughput; "
+                 "bench_throughput.child_threads(*sys.argv[1:])")
 CHILD_FIRST_RESULT = """
 import json, time
 t0 = time.perf_counter()
 import ti_spinorbit as tso
 imported = time.perf_counter() - t0
-r = tso.surface_of_section(tso.catalog.system({system!r}), {theta_p!r}, [1.0], orbits=1)
+r = tso.surface_of_section(tso.catalog.system({system!r}, elongation={elongation!r}), 90.0,
+                           [1.5], orbits=1)
 print(json.dumps({{"import_s": imported, "in_process_s": time.perf_counter() - t0,
                   "integrate_s": r.seconds, "crossings": int(r.count[0])}}))
 """
-CHILD_THREADS = """
-import json, sys
-import numpy as np
-import ti_spinorbit as tso
-threads, n = int(sys.argv[1]), int(sys.argv[2])
-orbits, rtol = float(sys.argv[3]), float(sys.argv[4])
-tso.init(arch="cpu", cpu_max_num_threads=threads or None)
-system = tso.catalog.system({system!r})
-tso.surface_of_section(system, {theta_p!r}, [1.0], orbits=1, rtol=rtol)  # compile or load
-r = tso.surface_of_section(system, {theta_p!r}, np.linspace({lo!r}, {hi!r}, n), orbits=orbits,
-                           rtol=rtol)
-print(json.dumps({{"seconds": r.seconds, "member_orbits_per_s": r.member_orbits_per_second}}))
-"""
 
 
-def spread(n):
-    """The benchmark's initial spin rates θ̇_p/n for n members."""
-    return np.linspace(*THETADOT_RANGE, n)
+# ---- inputs ------------------------------------------------------------------------------
+
+def starts(n):
+    """(θ_p in degrees, θ̇_p/n) of the first n benchmark members (R2 sequence)."""
+    k = np.arange(n)
+    u = np.mod(0.5 + k / PLASTIC, 1.0)
+    v = np.mod(0.5 + k / PLASTIC**2, 1.0)
+    return (THETA_P_RANGE[0] + (THETA_P_RANGE[1] - THETA_P_RANGE[0]) * u,
+            THETADOT_RANGE[0] + (THETADOT_RANGE[1] - THETADOT_RANGE[0]) * v)
 
 
-def machine_info():
-    """Versions, CPU, git state and the load average (taken at the start; the machine may be
-    shared, and other processes' load lowers every timing here)."""
-    import scipy
+def benchmark_system():
+    import ti_spinorbit as tso
+    return tso.catalog.system(SYSTEM, elongation=ELONGATION)
+
+
+def member_table(n):
+    """Member parameter rows and initial 3-D states (scaled) of the first n members."""
+    from ti_spinorbit.section import build_members
+
+    theta_p, thetadot_p = starts(n)
+    _, par, y0, _, _ = build_members(benchmark_system(), theta_p, thetadot_p, ESCAPE_DISTANCE)
+    return par, y0
+
+
+def nice_ceil(x):
+    """x rounded up to two significant figures."""
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.ceil(x / scale - 1e-9) * scale
+
+
+def on_cpu():
+    import ti_spinorbit as tso
+    return tso.runtime.current_arch() in ("cpu", "x64", "arm64")
+
+
+# ---- timing one run ----------------------------------------------------------------------
+
+class AdvanceTimer:
+    """Times every launch of ``kern.advance`` while active (wall and process CPU time, after
+    a device sync), and the end of every window through :meth:`window_done`, which is
+    ``Ensemble.run``'s ``progress`` callback. The window loop of a run then lasts from the
+    first launch to the last window end; what is not inside a launch is the drain."""
+
+    def __init__(self, kern):
+        import taichi as ti
+
+        self.kern, self._sync = kern, ti.sync
+        self.launches, self.kernel_wall, self.kernel_cpu = 0, 0.0, 0.0
+        self.first = self.last = None
+
+    def __enter__(self):
+        self._advance = self.kern.advance
+        self.kern.advance = self._timed
+        return self
+
+    def __exit__(self, *exc):
+        self.kern.advance = self._advance
+
+    def _timed(self, *args):
+        wall, cpu = time.perf_counter(), time.process_time()
+        if self.first is None:
+            self.first = (wall, cpu)
+        self._advance(*args)
+        self._sync()
+        self.kernel_wall += time.perf_counter() - wall
+        self.kernel_cpu += time.process_time() - cpu
+        self.launches += 1
+
+    def window_done(self, fraction):
+        self.last = (time.perf_counter(), time.process_time())
+
+
+def run_point(par, y0, model, rtol, orbits, window=16):
+    """Integrate the members (par, y0) for ``orbits`` with ``model``; one result row."""
+    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.kernels.ensemble import DONE
+
+    ens = Ensemble(par, y0, rtol=rtol, model=model)
+    n = len(par)
+    t_stop = 2.0 * np.pi * orbits
+    with AdvanceTimer(ens.kernels) as timer:
+        out = ens.run(t_stop, window_orbits=window, progress=timer.window_done)
+    loop_wall = timer.last[0] - timer.first[0]
+    loop_cpu = timer.last[1] - timer.first[1]
+    member_orbits = float(np.sum(np.minimum(out.t, t_stop)) / (2.0 * np.pi))
+    accepted, rejected, calls = out.counters.sum(axis=0)
+    calls -= n                                   # the first-stage evaluation before the loop
+    return {"model": model, "rtol": rtol, "members": n, "orbits": orbits, "window_orbits": window,
+            "seconds": out.seconds, "loop_wall_s": loop_wall, "loop_cpu_s": loop_cpu,
+            "kernel_wall_s": timer.kernel_wall, "kernel_cpu_s": timer.kernel_cpu,
+            "launches": timer.launches, "member_orbits": member_orbits,
+            "member_orbits_per_s": member_orbits / out.seconds,
+            "member_orbits_per_cpu_s": member_orbits / loop_cpu,
+            "accepted_per_orbit": accepted / member_orbits,
+            "rejected_per_orbit": rejected / member_orbits,
+            "rhs_per_orbit": calls / member_orbits, "rhs_calls": int(calls),
+            "steps": int(accepted + rejected),
+            "drain_fraction": max(0.0, loop_wall - timer.kernel_wall) / loop_wall,
+            "not_done": int(np.sum(out.status != DONE))}
+
+
+class Points:
+    """Throughput points measured so far, keyed by (model, rtol, N, window, orbits); a point
+    asked for without orbits is sized by pilot runs so that it lasts about ``seconds``."""
+
+    def __init__(self, settings, repeat):
+        self.settings, self.repeat = settings, repeat
+        self.rows, self._rate, self.warmup_s = {}, {}, {}
+        self.par = self.y0 = None
+
+    def table(self, n):
+        """Parameter rows and initial states of the first n members (built once, for the
+        largest N of the settings or n if larger)."""
+        if self.par is None or n > len(self.par):
+            self.par, self.y0 = member_table(max(n, *self.settings["sizes"]))
+        return self.par[:n], self.y0[:n]
+
+    def warm_up(self, model):
+        """Compile or load the model's kernels (timed once, not part of any point)."""
+        if model not in self.warmup_s:
+            par, y0 = self.table(1)
+            t0 = time.perf_counter()
+            run_point(par, y0, model, RTOLS[0], MIN_PILOT_ORBITS)
+            self.warmup_s[model] = time.perf_counter() - t0
+        return self.warmup_s[model]
+
+    def get(self, model, rtol, n, window=16, orbits=None):
+        """The row of (model, rtol, N, window) over ``orbits`` (None: sized by pilot runs)."""
+        key = (model, rtol, n, window, orbits)
+        if key in self.rows:
+            return self.rows[key]
+        self.warm_up(model)
+        par, y0 = self.table(n)
+        if orbits is None:
+            orbits = self._orbits(par, y0, model, rtol, window)
+        runs = [run_point(par, y0, model, rtol, orbits, window) for _ in range(self.repeat)]
+        row = dict(min(runs, key=lambda r: r["seconds"]),
+                   all_seconds=[r["seconds"] for r in runs])
+        self._rate[(model, rtol)] = row["member_orbits_per_s"]
+        self.rows[key] = row
+        print(f"  {model:6} rtol {rtol:.0e} N {n:6d} window {window:3d}: {orbits:9.4g} orbits "
+              f"{row['seconds']:7.2f} s  {row['member_orbits_per_s']:10.1f} member-orbits/s",
+              flush=True)
+        return row
+
+    def measured(self, model, rtol, n):
+        """The sized, default-window row of (model, rtol, N), or None if not measured."""
+        return self.rows.get((model, rtol, n, 16, None))
+
+    def _orbits(self, par, y0, model, rtol, window):
+        """Orbits for a run of about ``seconds``: a pilot run of PILOT_FRACTION of that,
+        sized by the last rate of this model and rtol, measures the rate (a pilot shorter than
+        half its plan is repeated with the rate it measured, at most twice)."""
+        n, s = len(par), self.settings
+        plan = PILOT_FRACTION * s["seconds"]
+        rate = self._rate.get((model, rtol), FIRST_RATE_GUESS)
+        for _ in range(3):
+            pilot = run_point(par, y0, model, rtol, max(MIN_PILOT_ORBITS, plan * rate / n),
+                              window)
+            rate = pilot["member_orbits_per_s"]
+            if pilot["seconds"] >= 0.5 * plan:
+                break
+        return max(s["min_orbits"], nice_ceil(s["seconds"] * rate / n))
+
+
+# ---- sections ----------------------------------------------------------------------------
+
+def bench_throughput(points, models, rtols, sizes):
+    return [points.get(model, rtol, n) for model in models for rtol in rtols
+            for n in sorted(sizes)]
+
+
+_RHS_LOOPS = {}
+
+
+def rhs_loop_kernel(model):
+    """Kernel: for each member, R dependent evaluations of ``model.rhs`` (see ``split``)."""
+    if model.__name__ in _RHS_LOOPS:
+        return _RHS_LOOPS[model.__name__]
     import taichi as ti
 
-    import ti_spinorbit as tso
+    nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
+    nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
 
-    model = platform.processor()
+    @ti.kernel
+    def rhs_loop(par: nd2f, y_nd: nd2f, out: nd1f, repeats: ti.i32, order: ti.template(),
+                 odd: ti.template()):
+        for i in range(y_nd.shape[0]):
+            y0 = model.state(0.0)
+            for k in ti.static(range(model.NSTATE)):
+                y0[k] = y_nd[i, k]
+            z = y0
+            for _ in range(repeats):
+                z = y0 + RHS_PERTURBATION * model.rhs(par, i, z, order, odd)
+            out[i] = z.sum()
+
+    _RHS_LOOPS[model.__name__] = rhs_loop
+    return rhs_loop
+
+
+def bench_rhs(points, model_name, n, seconds, repeat):
+    """ns per RHS evaluation of one model on the first n benchmark states."""
+    import taichi as ti
+
+    from ti_spinorbit.ensemble import Ensemble
+
+    ens = Ensemble(*points.table(n), model=model_name)    # kernel-layout parameters, states
+    kernel = rhs_loop_kernel(ens.kernels.model)
+    out = np.zeros(n)
+
+    def timed(repeats):
+        wall, cpu = time.perf_counter(), time.process_time()
+        kernel(ens.kpar, ens.y, out, repeats, ens.order, ens.odd)
+        ti.sync()
+        return time.perf_counter() - wall, time.process_time() - cpu
+
+    timed(1)                                      # compile or load
+    calibration = 16
+    wall, _ = timed(calibration)
+    repeats = max(calibration, int(seconds / max(wall, 1e-6) * calibration))
+    wall, cpu = min((timed(repeats) for _ in range(repeat)), key=lambda t: t[0])
+    evaluations = n * repeats
+    row = {"model": model_name, "members": n, "repeats": repeats, "wall_s": wall, "cpu_s": cpu,
+           "ns_per_rhs_wall": 1e9 * wall / evaluations, "ns_per_rhs_cpu": 1e9 * cpu / evaluations}
+    print(f"  RHS only {model_name:6} N {n}: {repeats} repeats, {wall:.2f} s", flush=True)
+    return row
+
+
+def time_split(points, rhs_rows, models, rtols, n):
+    """Per model and rtol at N = n: ns per RHS, per pass, and the RHS / rest / drain split."""
+    basis = "cpu" if on_cpu() else "wall"
+    rows = []
+    for model in models:
+        ns_rhs = rhs_rows[model][f"ns_per_rhs_{basis}"]
+        for rtol in rtols:
+            p = points.get(model, rtol, n)
+            kernel, loop = p[f"kernel_{basis}_s"], p[f"loop_{basis}_s"]
+            ns_pass = 1e9 * kernel / p["rhs_calls"]
+            rhs_share = min(1.0, ns_rhs / ns_pass)
+            inside = 1.0 - p["drain_fraction"]
+            rows.append({"model": model, "rtol": rtol, "members": n, "basis": basis,
+                         "ns_per_rhs": ns_rhs, "ns_per_pass": ns_pass,
+                         "ns_per_pass_with_drain": 1e9 * loop / p["rhs_calls"],
+                         "us_per_step": 1e6 * loop / p["steps"],
+                         "passes_per_step": p["rhs_calls"] / p["steps"],
+                         "overhead_fraction": 1.0 - rhs_share,
+                         "drain_fraction": p["drain_fraction"],
+                         "rhs_share_of_total": rhs_share * inside,
+                         "rest_share_of_total": (1.0 - rhs_share) * inside,
+                         "launches": p["launches"]})
+    return rows
+
+
+def cpu_info():
+    """(model name, mean clock in GHz, flags) from /proc/cpuinfo; Nones where unreadable."""
+    name, mhz, flags = platform.processor() or None, [], set()
     try:
         with open("/proc/cpuinfo") as f:
-            model = next(line.split(":", 1)[1].strip() for line in f
-                         if line.startswith("model name"))
-    except (OSError, StopIteration):
+            for line in f:
+                key, _, value = line.partition(":")
+                key = key.strip()
+                if key == "model name":
+                    name = value.strip()
+                elif key == "cpu MHz":
+                    mhz.append(float(value))
+                elif key == "flags" and not flags:
+                    flags = set(value.split())
+    except OSError:
         pass
-    try:
-        commit = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True,
-                                text=True, cwd=os.path.dirname(os.path.abspath(__file__)),
-                                check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        commit = None
-    return {"date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-            "cpu_count": os.cpu_count(),
-            "cpus_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
-            else None,
-            "cpu_model": model, "machine": platform.machine(), "platform": platform.platform(),
-            "python": platform.python_version(), "taichi": ".".join(map(str, ti.__version__)),
-            "numpy": np.__version__, "scipy": scipy.__version__,
-            "ti_spinorbit": tso.__version__, "arch": tso.runtime.current_arch(), "git": commit,
-            "load_average_1min_start": os.getloadavg()[0]}
+    return name, (sum(mhz) / len(mhz) / 1000.0 if mhz else None), flags
 
 
-def bench_kernel(system, sizes, orbits, repeat):
-    """Warm-up, then ``surface_of_section`` per (rtol, N), best of ``repeat`` timings."""
+def flop_rates(points, rhs_rows, models, rtols, n, machine, flops_per_cycle):
+    """Achieved flop rates (RHS flops only) and the fraction of the f64 peak."""
+    cores, ghz = machine["cpus_usable"], machine["cpu_ghz"]
+    cpu = on_cpu() and ghz is not None
+    core_peak = ghz * flops_per_cycle if cpu else None           # Gflop/s per core
+    rows = []
+    for model in models:
+        flops = FLOPS_PER_RHS[model]
+        r = rhs_rows[model]
+        evaluations = r["members"] * r["repeats"]
+        measured = [("RHS only", None, flops * evaluations / r["wall_s"] / 1e9,
+                     flops / r["ns_per_rhs_cpu"] if cpu else None)]
+        for rtol in rtols:
+            p = points.get(model, rtol, n)
+            measured.append(("integrator", rtol, flops * p["rhs_calls"] / p["loop_wall_s"] / 1e9,
+                             flops * p["rhs_calls"] / p["loop_cpu_s"] / 1e9 if cpu else None))
+        for what, rtol, total, per_core in measured:
+            rows.append({"model": model, "what": what, "rtol": rtol, "members": n,
+                         "flops_per_rhs": flops, "gflops_wall": total,
+                         "gflops_per_core_cpu": per_core,
+                         "peak_gflops": core_peak * cores if cpu else None,
+                         "fraction_of_peak": per_core / core_peak if cpu else None})
+    return rows
+
+
+def child_threads(threads, members, rtol, window, orbits_json):
+    """Child process of the threads section: both models at ``threads`` CPU threads; prints
+    the result rows as one JSON line."""
     import ti_spinorbit as tso
 
-    t0 = time.perf_counter()
-    tso.surface_of_section(system, THETA_P_DEG, [1.0], orbits=1, rtol=RTOLS[0])
-    warmup = time.perf_counter() - t0
+    tso.init(arch="cpu", cpu_max_num_threads=int(threads))
+    par, y0 = member_table(int(members))
     rows = []
-    for rtol in RTOLS:
-        for n in sizes:
-            runs = [tso.surface_of_section(system, THETA_P_DEG, spread(n), orbits=orbits,
-                                           rtol=rtol) for _ in range(repeat)]
-            r = min(runs, key=lambda run: run.seconds)
-            rows.append({"rtol": rtol, "members": n, "orbits": orbits, "seconds": r.seconds,
-                         "all_seconds": [run.seconds for run in runs],
-                         "member_orbits_per_s": r.member_orbits_per_second,
-                         "accepted_per_orbit": float(r.accepted.mean() / orbits),
-                         "rejected_per_orbit": float(r.rejected.mean() / orbits),
-                         "rhs_per_orbit": float(r.rhs_calls.mean() / orbits),
-                         "not_done": int(np.sum(np.asarray(r.status_names) != "done"))})
-            print(f"  kernel rtol {rtol:.0e} N {n:5d}: {r.seconds:8.3f} s", flush=True)
-    return warmup, rows
+    for model, orbits in json.loads(orbits_json).items():
+        run_point(par[:1], y0[:1], model, float(rtol), MIN_PILOT_ORBITS)   # compile or load
+        rows.append(run_point(par, y0, model, float(rtol), orbits, int(window)))
+    print(json.dumps(rows))
 
 
-def bench_baseline(system, members, orbits):
+def run_child(code, args=(), env=None):
+    """Run ``sys.executable -c code *args``; returns (wall seconds, its last-line JSON)."""
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True,
+                          text=True, env=env, cwd=EXPERIMENTS)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise RuntimeError(f"child process failed ({proc.returncode}):\n{proc.stderr[-3000:]}")
+    return wall, json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def child_env(arch, **extra):
+    env = dict(os.environ, **extra)
+    if arch:
+        env["TI_SPINORBIT_ARCH"] = arch
+    return env
+
+
+def bench_threads(points, models, n, repeat, rtol=1e-12, window=16):
+    """Each model with k = 1, 2 (, all) threads in fresh processes, alternating; best of
+    ``repeat``. Orbits: the in-process rate at N = n sized for ``seconds`` on all cores."""
+    seconds = points.settings["seconds"]
+    orbits = {m: max(points.settings["min_orbits"],
+                     nice_ceil(seconds * points.get(m, rtol, n)["member_orbits_per_s"] / n))
+              for m in models}
+    counts = sorted({1, 2, os.cpu_count() or 1})
+    runs = {(k, m): [] for k in counts for m in models}
+    for _ in range(repeat):
+        for k in counts:
+            _, rows = run_child(CHILD_THREADS, (k, n, rtol, window, json.dumps(orbits)),
+                                env=child_env(None))
+            for r in rows:
+                runs[(k, r["model"])].append(r)
+    out = []
+    for m in models:
+        one = None
+        for k in counts:
+            best = min(runs[(k, m)], key=lambda r: r["seconds"])
+            one = one or best
+            speedup = best["member_orbits_per_s"] / one["member_orbits_per_s"]
+            out.append({"threads": k, **best, "all_seconds": [r["seconds"] for r in runs[(k, m)]],
+                        "speedup": speedup, "efficiency": speedup / k})
+            print(f"  threads {k} {m:6}: {best['seconds']:7.2f} s  "
+                  f"{best['member_orbits_per_s']:10.1f} member-orbits/s", flush=True)
+    return out
+
+
+def bench_window(points, n):
+    return [points.get("planar", 1e-12, n, window=w, orbits=points.settings["window_orbits"])
+            for w in WINDOWS]
+
+
+def bench_baseline(members, orbits, rtols):
     """scipy DOP853 on the NumPy reference, and the same members through the kernels."""
     import ti_spinorbit as tso
     from ti_spinorbit import reference
     from ti_spinorbit.ensemble import Ensemble
-    from ti_spinorbit.section import build_members
 
+    system = benchmark_system()
     unit = system.to_physical(np.ones(30))  # SI size of one scaled unit, per component
     t_end = orbits * system.orbital_period
-    _, par, y0_scaled, _, _ = build_members(system, THETA_P_DEG, spread(members))
-    # one-off costs (importing scipy.integrate, building the cached multipole bases) before timing
-    import scipy.integrate  # noqa: F401
+    par, y0_scaled = member_table(members)
+    import scipy.integrate  # noqa: F401  one-off costs before timing
     reference.rhs(tso.G, system.primary, system.secondary, system.to_physical(y0_scaled[0]))
     rows = []
-    for rtol in RTOLS:
+    for rtol in rtols:
         seconds, steps, rhs, final = 0.0, 0, 0, []
         for y0 in y0_scaled:
             t0 = time.perf_counter()
@@ -204,177 +581,283 @@ def bench_baseline(system, members, orbits):
     return rows
 
 
-def run_child(code, args=(), env=None):
-    """Run ``sys.executable -c code *args``; returns (wall seconds, its last-line JSON)."""
-    t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True,
-                          text=True, env=env)
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise RuntimeError(f"child process failed ({proc.returncode}):\n{proc.stderr[-3000:]}")
-    return wall, json.loads(proc.stdout.strip().splitlines()[-1])
-
-
-def child_env(arch, **extra):
-    env = dict(os.environ, **extra)
-    if arch:
-        env["TI_SPINORBIT_ARCH"] = arch
-    return env
-
-
-def bench_first_result(arch, repeat):
-    """A cold run, then ``repeat`` warm runs, in fresh processes sharing a new cache folder."""
-    code = CHILD_FIRST_RESULT.format(system=SYSTEM, theta_p=THETA_P_DEG)
+def bench_first_result(arch, repeat, cold):
+    """Fresh processes: with ``cold``, a run with a new empty kernel cache and then
+    ``repeat`` runs with it warm; else ``repeat`` runs with the default cache folder."""
+    code = CHILD_FIRST_RESULT.format(system=SYSTEM, elongation=ELONGATION)
     runs = []
     with tempfile.TemporaryDirectory(prefix="ti_spinorbit_cache_") as cache:
-        env = child_env(arch, TI_OFFLINE_CACHE_FILE_PATH=cache)
-        for label in ["cold cache"] + ["warm cache"] * repeat:
+        env = child_env(arch, TI_OFFLINE_CACHE_FILE_PATH=cache) if cold else child_env(arch)
+        labels = (["cold cache"] if cold else []) + ["warm cache"] * repeat
+        for label in labels:
             wall, inside = run_child(code, env=env)
-            runs.append({"run": label, "wall_s": wall, **inside})
+            runs.append({"run": label, "new_cache_folder": cold, "wall_s": wall, **inside})
             print(f"  fresh process, {label}: {wall:8.3f} s", flush=True)
     return runs
 
 
-def bench_threads(members, orbits, repeat, rtol=RTOLS[0]):
-    """Same ensemble with one thread and with Taichi's default, each in its own process;
-    the two settings alternate and the best of ``repeat`` runs of each is kept."""
-    code = CHILD_THREADS.format(system=SYSTEM, theta_p=THETA_P_DEG, lo=THETADOT_RANGE[0],
-                                hi=THETADOT_RANGE[1])
-    settings = (1, 0)  # 0: Taichi's default, all cores
-    seconds = {threads: [] for threads in settings}
-    for _ in range(repeat):
-        for threads in settings:
-            _, inside = run_child(code, (threads, members, orbits, rtol), env=child_env(None))
-            seconds[threads].append(inside["seconds"])
-    rows = []
-    for threads in settings:
-        best = min(seconds[threads])
-        rows.append({"threads": threads or f"default ({os.cpu_count()})", "members": members,
-                     "orbits": orbits, "rtol": rtol, "seconds": best,
-                     "all_seconds": seconds[threads],
-                     "member_orbits_per_s": members * orbits / best})
-        print(f"  threads {rows[-1]['threads']}: {best:8.3f} s", flush=True)
-    return rows
-
-
-def targets(kernel_rows, baseline_rows, first_runs):
-    """Each target with its measured value; kernel figures at the largest N measured."""
-    largest = max(r["members"] for r in kernel_rows)
-    rate = {r["rtol"]: r["member_orbits_per_s"] for r in kernel_rows if r["members"] == largest}
-    out = [{"target": f">= {TARGET_RATE:.0f} member-orbits/s, N = {largest}, "
-                      f"rtol {RTOLS[0]:.0e}",
-            "value": rate[RTOLS[0]], "met": rate[RTOLS[0]] >= TARGET_RATE}]
-    for b in baseline_rows:
-        ratio = rate[b["rtol"]] / b["member_orbits_per_s"]
-        out.append({"target": f">= {TARGET_SPEEDUP:.0f}x scipy DOP853, N = {largest}, "
-                              f"rtol {b['rtol']:.0e}",
-                    "value": ratio, "met": ratio >= TARGET_SPEEDUP})
-    warm = min(f["wall_s"] for f in first_runs if f["run"] == "warm cache")
-    out.append({"target": f"<= {TARGET_FIRST_RESULT_S:.0f} s first result, fresh process, "
-                          "warm cache",
-                "value": warm, "met": warm <= TARGET_FIRST_RESULT_S})
+def targets(points, baseline_rows, first_runs, models, n):
+    """Each target with its measured value (kernel figures at N = n)."""
+    out = []
+    for m in models:
+        row = points.measured(m, 1e-12, n)
+        if row:
+            rate = row["member_orbits_per_s"]
+            out.append({"target": f">= {TARGET_RATE:.0f} member-orbits/s, {m}, N = {n}, "
+                                  "rtol 1e-12", "value": rate, "met": rate >= TARGET_RATE})
+        for b in baseline_rows:
+            row = points.measured(m, b["rtol"], n)
+            if row:
+                ratio = row["member_orbits_per_s"] / b["member_orbits_per_s"]
+                out.append({"target": f">= {TARGET_SPEEDUP:.0f}x scipy DOP853, {m}, N = {n}, "
+                                      f"rtol {b['rtol']:.0e}",
+                            "value": ratio, "met": ratio >= TARGET_SPEEDUP})
+    warm = [f["wall_s"] for f in first_runs if f["run"] == "warm cache"]
+    if warm:
+        out.append({"target": f"<= {TARGET_FIRST_RESULT_S:.0f} s first result, fresh process, "
+                              "warm cache", "value": min(warm),
+                    "met": min(warm) <= TARGET_FIRST_RESULT_S})
     return out
 
 
+# ---- report ------------------------------------------------------------------------------
+
+def machine_info():
+    """Versions, CPU, git state and the load average at the start (the machine may be
+    shared: other processes' load lowers every wall-clock figure)."""
+    import scipy
+    import taichi as ti
+
+    import ti_spinorbit as tso
+
+    name, ghz, flags = cpu_info()
+    try:
+        commit = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True,
+                                text=True, cwd=EXPERIMENTS, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        commit = None
+    return {"date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+            "cpu_count": os.cpu_count(),
+            "cpus_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+            else os.cpu_count(),
+            "cpu_model": name, "cpu_ghz": ghz,
+            "simd": sorted(f for f in flags if f in ("avx2", "fma", "avx512f")),
+            "machine": platform.machine(), "platform": platform.platform(),
+            "python": platform.python_version(), "taichi": ".".join(map(str, ti.__version__)),
+            "numpy": np.__version__, "scipy": scipy.__version__,
+            "ti_spinorbit": tso.__version__, "arch": tso.runtime.current_arch(), "git": commit,
+            "load_average_1min_start": os.getloadavg()[0]}
+
+
+def _opt(x, fmt):
+    return "-" if x is None else format(x, fmt)
+
+
+def _table(rows, columns):
+    """Print ``rows`` (dicts) under ``columns`` = (header, key, format spec); None prints as
+    "-", the spec "%" as a percentage; every column is right-aligned to its widest entry."""
+    def cell(value, spec):
+        return f"{100.0 * value:.1f}%" if spec == "%" and value is not None else _opt(value, spec)
+
+    body = [[cell(r[key], spec) for _, key, spec in columns] for r in rows]
+    lines = [[header for header, _, _ in columns]] + body
+    widths = [max(len(line[k]) for line in lines) for k in range(len(columns))]
+    for line in lines:
+        print(" ".join(text.rjust(width) for text, width in zip(line, widths)))
+
+
+MODEL, RTOL, N = ("model", "model", "s"), ("rtol", "rtol", ".0e"), ("N", "members", "d")
+RATE = ("mo/s", "member_orbits_per_s", ".1f")
+CPU_RATE = ("mo/CPU-s", "member_orbits_per_cpu_s", ".1f")
+ORBITS, SECONDS = ("orbits", "orbits", ".4g"), ("seconds", "seconds", ".2f")
+LAUNCHES, DRAIN = ("launches", "launches", "d"), ("drain", "drain_fraction", "%")
+TABLES = {
+    "throughput": [MODEL, RTOL, N, ORBITS, SECONDS, RATE, CPU_RATE,
+                   ("acc/orb", "accepted_per_orbit", ".1f"),
+                   ("rej/orb", "rejected_per_orbit", ".2f"), ("RHS/orb", "rhs_per_orbit", ".1f"),
+                   LAUNCHES, DRAIN, ("not done", "not_done", "d")],
+    "split": [MODEL, RTOL, N, ("basis", "basis", "s"), ("ns/RHS", "ns_per_rhs", ".1f"),
+              ("ns/pass", "ns_per_pass", ".1f"), ("+drain", "ns_per_pass_with_drain", ".1f"),
+              ("us/step", "us_per_step", ".2f"), ("pass/step", "passes_per_step", ".2f"),
+              ("overhead", "overhead_fraction", "%"), ("RHS", "rhs_share_of_total", "%"),
+              ("rest", "rest_share_of_total", "%"), DRAIN],
+    "flops": [MODEL, ("what", "what", "s"), RTOL, ("Gflop/s", "gflops_wall", ".2f"),
+              ("per core", "gflops_per_core_cpu", ".2f"), ("of peak", "fraction_of_peak", "%")],
+    "threads": [MODEL, ("k", "threads", "d"), N, ORBITS, SECONDS, RATE, CPU_RATE,
+                ("speed-up", "speedup", ".2f"), ("efficiency", "efficiency", "%")],
+    "window": [("window", "window_orbits", "d"), N, ORBITS, SECONDS, RATE, CPU_RATE, LAUNCHES,
+               DRAIN],
+    "baseline": [RTOL, ("scipy rtol", "scipy_rtol", ".2g"), ("members", "members", "d"),
+                 ORBITS, ("seconds", "seconds", ".3f"), ("mo/s", "member_orbits_per_s", ".3f"),
+                 ("steps/orb", "steps_per_orbit", ".1f"), ("RHS/orb", "rhs_per_orbit", ".1f"),
+                 ("max|dy| vs kernel", "kernel_reference_max_diff_scaled", ".2e")],
+}
+
+
 def print_report(result):
-    m, p = result["machine"], result["parameters"]
+    m, s, p = result["machine"], result["sections"], result["parameters"]
     print()
-    mode = "quick" if result["quick"] else "full"
-    print(f"ti_spinorbit throughput benchmark  {m['date_utc']}  {mode}")
-    print(f"machine: {m['cpu_model']}, {m['cpu_count']} CPUs ({m['machine']}), "
-          f"Taichi {m['taichi']}, arch {m['arch']}, git {m['git']}")
+    print(f"ti_spinorbit throughput benchmark  {m['date_utc']}  "
+          f"{'quick' if result['quick'] else 'full'}, {result['total_seconds']:.0f} s")
+    print(f"machine: {m['cpu_model']} at {_opt(m['cpu_ghz'], '.2f')} GHz, {m['cpus_usable']} "
+          f"usable CPUs ({m['machine']}, {', '.join(m['simd']) or 'no AVX2'}), Taichi "
+          f"{m['taichi']}, arch {m['arch']}, git {m['git']}")
     print(f"load average (1 min) at start {m['load_average_1min_start']:.2f}, at end "
           f"{m['load_average_1min_end']:.2f} (other processes share the CPUs if > 0)")
-    print(f"system {SYSTEM}, theta_p = {THETA_P_DEG} deg, thetadot_p/n = linspace"
-          f"({THETADOT_RANGE[0]}, {THETADOT_RANGE[1]}, N), {p['orbits']:g} orbits; "
-          f"warm-up (compile/load) {result['warmup_s']:.2f} s")
-    print()
-    print(f"{'rtol':>6} {'N':>5} {'seconds':>9} {'member-orb/s':>13} {'acc/orbit':>10} "
-          f"{'rej/orbit':>10} {'RHS/orbit':>10} {'not done':>8}")
-    for r in result["kernel"]:
-        print(f"{r['rtol']:6.0e} {r['members']:5d} {r['seconds']:9.3f} "
-              f"{r['member_orbits_per_s']:13.1f} {r['accepted_per_orbit']:10.1f} "
-              f"{r['rejected_per_orbit']:10.2f} {r['rhs_per_orbit']:10.1f} {r['not_done']:8d}")
-    print()
-    print("scipy DOP853 + NumPy reference RHS, atol = rtol * to_physical(ones)")
-    print(f"{'rtol':>6} {'scipy rtol':>10} {'members x orbits':>16} {'seconds':>9} "
-          f"{'member-orb/s':>13} {'steps/orbit':>11} {'RHS/orbit':>10} {'max|dy| vs kernel':>18}")
-    for b in result["baseline"]:
-        print(f"{b['rtol']:6.0e} {b['scipy_rtol']:10.2g} {b['members']:>7d} x {b['orbits']:<6g} "
-              f"{b['seconds']:9.3f} "
-              f"{b['member_orbits_per_s']:13.3f} {b['steps_per_orbit']:11.1f} "
-              f"{b['rhs_per_orbit']:10.1f} {b['kernel_reference_max_diff_scaled']:18.2e}")
-    print()
-    print("first result from a fresh process (1 member, 1 orbit; new offline-cache folder)")
-    for f in result["first_result"]:
-        print(f"  {f['run']:<10}  wall {f['wall_s']:6.2f} s  (import {f['import_s']:.2f} s, "
-              f"in process {f['in_process_s']:.2f} s)")
-    print()
-    print("threads (fresh processes, rtol 1e-12)")
-    for t in result["threads"]:
-        print(f"  {str(t['threads']):<12} N {t['members']:5d} x {t['orbits']:g} orbits: "
-              f"{t['seconds']:8.3f} s  {t['member_orbits_per_s']:9.1f} member-orbits/s")
-    print()
-    print("targets")
-    for t in result["targets"]:
-        print(f"  {'MET ' if t['met'] else 'MISS'}  {t['target']}: {t['value']:.4g}")
+    print(f"system {SYSTEM}, a/b = {ELONGATION}; starts: R2 sequence over theta_p in "
+          f"[{THETA_P_RANGE[0]:g}, {THETA_P_RANGE[1]:g}) deg, thetadot_p/n in "
+          f"[{THETADOT_RANGE[0]}, {THETADOT_RANGE[1]}]; kernel warm-up (compile or load) "
+          + ", ".join(f"{k} {v:.2f} s" for k, v in result["warmup_s"].items()))
+    captions = {
+        "throughput": "member-orbits per second (wall) and per process CPU-second; steps and "
+                      "RHS calls per member-orbit",
+        "split": "ns per pass = advance time / RHS calls; overhead = 1 - RHS/pass (stage "
+                 "points and combination, error norm, step control, events, loads/stores); "
+                 "drain = Python between launches; RHS, rest, drain: shares of the wall time",
+        "flops": "hand-counted flops per RHS: "
+                 + ", ".join(f"{k} {v}" for k, v in FLOPS_PER_RHS.items())
+                 + f"; peak assumed {m['cpus_usable']} cores x {_opt(m['cpu_ghz'], '.2f')} GHz "
+                 f"x {p['flops_per_cycle']:g} f64 flops/cycle (AVX2+FMA: 2 FMA units x 4 lanes "
+                 "x 2); scalar code reaches about 1/4 of it",
+        "threads": "fresh processes, cpu_max_num_threads = k; speed-up over 1 thread (wall), "
+                   "efficiency = speed-up / k",
+        "window": "planar, rtol 1e-12: orbits per launch",
+        "baseline": "scipy DOP853 + NumPy reference RHS, atol = rtol * to_physical(ones)"}
+    for name, columns in TABLES.items():
+        if s.get(name):
+            print(f"\n[{name}] {captions[name]}")
+            if name == "split":
+                print("RHS-only kernel, per RHS: " + "; ".join(
+                    f"{k} {v['ns_per_rhs_cpu']:.1f} ns CPU time, {v['ns_per_rhs_wall']:.1f} ns "
+                    f"wall (N = {v['members']}, {v['repeats']} repeats)"
+                    for k, v in s["rhs_only"].items()))
+            _table(s[name], columns)
+    if "latency" in s:
+        print("\n[latency] first result from a fresh process (1 member, 1 orbit)")
+        for f in s["latency"]:
+            where = "new cache folder" if f["new_cache_folder"] else "default cache folder"
+            print(f"  {f['run']:<10} ({where}): wall {f['wall_s']:6.2f} s  (import "
+                  f"{f['import_s']:.2f} s, in process {f['in_process_s']:.2f} s)")
+    if result["targets"]:
+        print("\n[targets]")
+        for t in result["targets"]:
+            print(f"  {'MET ' if t['met'] else 'MISS'}  {t['target']}: {t['value']:.4g}")
 
 
 def figure(result):
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for k, rtol in enumerate(RTOLS):
-        rows = [r for r in result["kernel"] if r["rtol"] == rtol]
-        line, = ax.loglog([r["members"] for r in rows], [r["member_orbits_per_s"] for r in rows],
-                          "o-", label=f"kernels, rtol {rtol:.0e}")
-        for b in result["baseline"]:
+    s = result["sections"]
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+    styles = {"planar": "-", "3d": "--"}
+    for k, rtol in enumerate(result["parameters"]["rtols"]):
+        color = f"C{k}"
+        for model in result["parameters"]["models"]:
+            rows = [r for r in s.get("throughput", []) if r["rtol"] == rtol and r["model"] == model]
+            if rows:
+                ax.loglog([r["members"] for r in rows], [r["member_orbits_per_s"] for r in rows],
+                          "o" + styles[model], color=color, label=f"{model}, rtol {rtol:.0e}")
+        for b in s.get("baseline", []):
             if b["rtol"] == rtol:
-                ax.axhline(b["member_orbits_per_s"], color=line.get_color(), ls=":",
+                ax.axhline(b["member_orbits_per_s"], color=color, ls=":", lw=1,
                            label=f"scipy DOP853, rtol {b['scipy_rtol']:.2g}")
-    ax.axhline(TARGET_RATE, color="k", ls="--", lw=0.8, label="target (rtol 1e-12)")
+    ax.axhline(TARGET_RATE, color="k", ls="-.", lw=0.8, label="target (N = 4096, rtol 1e-12)")
     ax.set_xlabel("members N")
     ax.set_ylabel("member-orbits per second")
     m = result["machine"]
-    ax.set_title(f"{SYSTEM}, {m['cpu_count']}-CPU {m['arch']}, Taichi {m['taichi']}", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title(f"{SYSTEM}, a/b = {ELONGATION}; {m['cpus_usable']}-CPU {m['arch']}, "
+                 f"Taichi {m['taichi']}", fontsize=9)
+    ax.legend(fontsize=6, ncol=2, loc="lower center", bbox_to_anchor=(0.5, 0.1), handlelength=3)
+    split = s.get("split", [])
+    labels = [f"{r['model']}\n{r['rtol']:.0e}" for r in split]
+    bottom = np.zeros(len(split))
+    for key, name in (("rhs_share_of_total", "RHS"), ("rest_share_of_total", "rest of advance"),
+                      ("drain_fraction", "drain")):
+        values = np.array([r[key] for r in split])
+        bx.bar(labels, values, bottom=bottom, label=name)
+        bottom += values
+    bx.set_ylabel("share of wall time")
+    bx.set_title(f"time split, N = {split[0]['members']}" if split else "time split (not run)",
+                 fontsize=9)
+    bx.legend(fontsize=7)
     return fig
 
 
-def main():
-    args, started = parse(__doc__.splitlines()[0], lambda p: p.add_argument(
-        "--repeat", type=lambda text: max(1, int(text)), default=1,
-        help="time each kernel run and thread setting this many times, keep the best "
-             "(default 1; raise it on a shared or noisy machine)"))
-    import ti_spinorbit as tso
+def _extra(p):
+    p.add_argument("--repeat", type=lambda text: max(1, int(text)), default=1,
+                   help="time every run this many times, keep the best (default 1; raise it "
+                        "on a shared or noisy machine)")
+    p.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS),
+                   help="sections to run (default: all)")
+    p.add_argument("--members", type=int, nargs="+", default=None,
+                   help="ensemble sizes N of the throughput section (default 1 16 256 1024 "
+                        "4096 16384; e.g. add 65536 262144 on a GPU)")
+    p.add_argument("--rtols", type=float, nargs="+", default=list(RTOLS),
+                   help="tolerances (default 1e-10 1e-12 1e-15)")
+    p.add_argument("--models", nargs="+", choices=MODELS, default=list(MODELS),
+                   help="equations of motion (default: planar 3d)")
+    p.add_argument("--seconds", type=float, default=None,
+                   help="target duration of each throughput point (default 2; --quick 0.05)")
+    p.add_argument("--flops-per-cycle", type=float, default=FLOPS_PER_CYCLE,
+                   help="f64 flops per cycle per core for the peak (default 16: AVX2 + FMA)")
 
-    settings = QUICK if args.quick else FULL
+
+def main():
+    args, started = parse(__doc__.splitlines()[0], _extra)
+    settings = dict(QUICK if args.quick else FULL)
+    if args.members:
+        settings["sizes"] = tuple(sorted(set(args.members)))
+    if args.seconds:
+        settings["seconds"] = args.seconds
+    n_split = settings["split_members"]
     machine = machine_info()
-    system = tso.catalog.system(SYSTEM)
-    print(f"bench_throughput ({'quick' if args.quick else 'full'}): running ...", flush=True)
-    warmup, kernel_rows = bench_kernel(system, settings["sizes"], settings["orbits"],
-                                       args.repeat)
-    baseline_rows = bench_baseline(system, settings["baseline_members"],
-                                   settings["baseline_orbits"])
-    first_runs = bench_first_result(args.arch, args.repeat)
-    thread_rows = (bench_threads(settings["thread_members"], settings["thread_orbits"],
-                                 args.repeat)
-                   if tso.runtime.current_arch() in ("cpu", "x64", "arm64") else [])
-    parameters = {"system": SYSTEM, "theta_p_deg": THETA_P_DEG, "thetadot_range": THETADOT_RANGE,
-                  "rtols": RTOLS, "repeat": args.repeat, **settings}
+    sections = [name for name in SECTIONS if name in args.sections]
+    cpu = on_cpu()
+    print(f"bench_throughput ({'quick' if args.quick else 'full'}; "
+          f"{', '.join(sections)}): running ...", flush=True)
+    points = Points(settings, args.repeat)
+    s = {}
+    if "throughput" in sections:
+        s["throughput"] = bench_throughput(points, args.models, args.rtols, settings["sizes"])
+    if "split" in sections or "flops" in sections:
+        s["rhs_only"] = {m: bench_rhs(points, m, n_split, settings["rhs_seconds"], args.repeat)
+                         for m in args.models}
+    if "split" in sections:
+        s["split"] = time_split(points, s["rhs_only"], args.models, args.rtols, n_split)
+    if "flops" in sections:
+        s["flops"] = flop_rates(points, s["rhs_only"], args.models, args.rtols, n_split,
+                                machine, args.flops_per_cycle)
+    if "threads" in sections and cpu:
+        s["threads"] = bench_threads(points, args.models, n_split, args.repeat)
+    if "window" in sections:
+        s["window"] = bench_window(points, n_split)
+    if "baseline" in sections:
+        s["baseline"] = bench_baseline(settings["baseline_members"], settings["baseline_orbits"],
+                                       args.rtols)
+    if "latency" in sections:
+        s["latency"] = bench_first_result(args.arch, args.repeat, settings["cold_latency"])
+    parameters = {"system": SYSTEM, "elongation": ELONGATION, "theta_p_range": THETA_P_RANGE,
+                  "thetadot_range": THETADOT_RANGE, "escape_distance": ESCAPE_DISTANCE,
+                  "starts": "R2 sequence, plastic number", "rtols": args.rtols,
+                  "models": args.models, "sections": sections, "repeat": args.repeat,
+                  "flops_per_cycle": args.flops_per_cycle, "flops_per_rhs": FLOPS_PER_RHS,
+                  "windows": WINDOWS, **settings}
     result = {"benchmark": "bench_throughput", "quick": bool(args.quick),
               "machine": {**machine, "load_average_1min_end": os.getloadavg()[0]},
-              "parameters": parameters,
-              "warmup_s": warmup, "kernel": kernel_rows, "baseline": baseline_rows,
-              "first_result": first_runs, "threads": thread_rows,
-              "targets": targets(kernel_rows, baseline_rows, first_runs)}
+              "parameters": parameters, "warmup_s": points.warmup_s, "sections": s,
+              "targets": targets(points, s.get("baseline", []), s.get("latency", []),
+                                 args.models, n_split),
+              "total_seconds": time.perf_counter() - started}
     print_report(result)
     path = os.path.join(args.out, "bench_throughput.json")
     with open(path, "w") as f:
         json.dump(result, f, indent=1)
     print(f"[bench_throughput] wrote {path}")
+    rows = s.get("throughput", [])
     save(args, "bench_throughput", figure(result),
-         {key: [r[key] for r in kernel_rows] for key in ("rtol", "members", "member_orbits_per_s")},
+         {key: [r[key] for r in rows] for key in ("model", "rtol", "members",
+                                                  "member_orbits_per_s",
+                                                  "member_orbits_per_cpu_s")},
          {"machine": result["machine"], **parameters},
          {t["target"]: t["value"] for t in result["targets"]}, started)
 
