@@ -75,8 +75,10 @@ over 0.5 orbit, no cold-cache run: every section in about 12 s (CI, not figures)
 load average at start and end is recorded, and other processes' load lowers every
 wall-clock figure).
 
-Targets: >= 1000 member-orbits/s at N = 4096, rtol 1e-12; >= 300x the baseline;
-<= 3 s to the first result from a fresh process with a warm cache.
+Targets (2-core machine): issue 5, >= 20 000 member-orbits/s for the planar model and
+>= 2 000 for the 3-D model at N = 4096, rtol 1e-12 (issue 2 asked >= 1 000); >= 300x the
+baseline; <= 3 s to the first result from a fresh process with a warm cache. (The 64 x 64 x
+500-orbit MEGNO map target is measured by experiments/chaos_maps.py.)
 
 Writes ``<out>/bench_throughput.json`` (every row of every section, machine information and
 the settings), ``bench_throughput.png`` (throughput against N; time split) and
@@ -113,7 +115,7 @@ RTOLS = (1e-10, 1e-12, 1e-15)
 MODELS = ("planar", "3d")
 WINDOWS = (4, 16, 64)
 SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "latency")
-TARGET_RATE = 1000.0              # member-orbits/s at N = 4096, rtol 1e-12
+TARGET_RATE = {"planar": 20000.0, "3d": 2000.0}   # member-orbits/s, N = 4096, rtol 1e-12
 TARGET_SPEEDUP = 300.0            # over the scipy baseline
 TARGET_FIRST_RESULT_S = 3.0       # fresh process, warm offline cache
 SCIPY_MIN_RTOL = 100 * np.finfo(float).eps   # scipy's RK solvers raise smaller rtol to this
@@ -603,8 +605,8 @@ def targets(points, baseline_rows, first_runs, models, n):
         row = points.measured(m, 1e-12, n)
         if row:
             rate = row["member_orbits_per_s"]
-            out.append({"target": f">= {TARGET_RATE:.0f} member-orbits/s, {m}, N = {n}, "
-                                  "rtol 1e-12", "value": rate, "met": rate >= TARGET_RATE})
+            out.append({"target": f">= {TARGET_RATE[m]:.0f} member-orbits/s, {m}, N = {n}, "
+                                  "rtol 1e-12", "value": rate, "met": rate >= TARGET_RATE[m]})
         for b in baseline_rows:
             row = points.measured(m, b["rtol"], n)
             if row:
@@ -761,7 +763,9 @@ def figure(result):
             if b["rtol"] == rtol:
                 ax.axhline(b["member_orbits_per_s"], color=color, ls=":", lw=1,
                            label=f"scipy DOP853, rtol {b['scipy_rtol']:.2g}")
-    ax.axhline(TARGET_RATE, color="k", ls="-.", lw=0.8, label="target (N = 4096, rtol 1e-12)")
+    for model, ls in (("planar", "-."), ("3d", "--")):
+        ax.axhline(TARGET_RATE[model], color="k", ls=ls, lw=0.8,
+                   label=f"{model} target (N = 4096, rtol 1e-12)")
     ax.set_xlabel("members N")
     ax.set_ylabel("member-orbits per second")
     m = result["machine"]
