@@ -33,7 +33,7 @@ from types import SimpleNamespace
 import taichi as ti
 
 from . import eom, planar
-from .eom import NSTATE, state
+from .eom import NSTATE
 from .integrator import (NONFINITE_ERROR, error_norm, make_primitives, stage_matrix_type,
                          step_factor)
 from .potential import mutual, vec3
@@ -329,8 +329,8 @@ def make_kernels(model):
         for i in range(y_nd.shape[0]):
             _store(out, i, model.rhs(par, i, _load(y_nd, i), order, odd))
 
-    return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, NSTATE=NSTATE,
-                           RECORD_WIDTH=1 + NSTATE, model=model)
+    return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, load=_load,
+                           NSTATE=NSTATE, RECORD_WIDTH=1 + NSTATE, model=model)
 
 
 #: The 3-D model's kernels (30-number state) and the planar model's (10 numbers).
@@ -340,12 +340,7 @@ advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs
 
 
-@ti.func
-def _load_spatial(a: ti.template(), k):
-    y = state(0.0)
-    for c in ti.static(range(NSTATE)):
-        y[c] = a[k, c]
-    return y
+_load_spatial = SPATIAL.load
 
 
 @ti.kernel

@@ -30,6 +30,25 @@ EXPONENTS_4 = tuple((l, m, 4 - l - m) for l in range(4, -1, -1) for m in range(4
 ROW_LENGTH = 1 + len(EXPONENTS_2) + len(EXPONENTS_3) + len(EXPONENTS_4)
 
 
+def row_columns(select):
+    """Offsets in :meth:`Body.as_row` of the integrals whose exponents (l, m, n) satisfy
+    ``select`` (the mass at offset 0 is never included)."""
+    cols, off = [], 1
+    for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
+        cols += [off + k for k, e in enumerate(group) if select(e)]
+        off += len(group)
+    return cols
+
+
+def tensor_from_integrals(order, integral):
+    """Full symmetric rank-``order`` moment tensor whose entry i..k is ``integral(l, m, n)``,
+    (l, m, n) counting the indices equal to x, y and z."""
+    tensor = np.zeros((3,) * order)
+    for idx in np.ndindex(*tensor.shape):
+        tensor[idx] = integral(idx.count(0), idx.count(1), idx.count(2))
+    return tensor
+
+
 def _double_factorial(n: int) -> int:
     return 1 if n <= 0 else n * _double_factorial(n - 2)
 
@@ -112,13 +131,9 @@ class Body:
             raise ValueError(f"order must be 0..4 (got {order!r})")
         if order == 0:
             return np.array(self.mass)
-        tensor = np.zeros((3,) * order)
         if order == 1:
-            return tensor
-        for idx in np.ndindex(*tensor.shape):
-            counts = (idx.count(0), idx.count(1), idx.count(2))
-            tensor[idx] = self.integral(*counts)
-        return tensor
+            return np.zeros(3)
+        return tensor_from_integrals(order, self.integral)
 
     def as_row(self) -> np.ndarray:
         """Mass and integrals in the fixed order the kernels read (copy, SI units)."""

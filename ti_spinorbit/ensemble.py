@@ -187,8 +187,9 @@ class Ensemble:
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
                     "indicators": bool(indicators), "separation": float(separation)}
         st = None
+        fingerprint = self._fingerprint(t_stop) if checkpoint is not None else None
         if checkpoint is not None and resume:
-            st = ckpt.load(checkpoint, settings, self._fingerprint(t_stop))
+            st = ckpt.load(checkpoint, settings, fingerprint)
         if st is None:
             st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
         else:
@@ -224,7 +225,7 @@ class Ensemble:
             self.status[finished] = K.DONE
             st["seconds"] = time.perf_counter() - t0
             if checkpoint is not None:
-                ckpt.save(checkpoint, settings, self._fingerprint(t_stop),
+                ckpt.save(checkpoint, settings, fingerprint,
                           dict(st, y=self.y, t=self.t, h=self.h, status=self.status,
                                counters=self.counters), pending)
             pending = {"events": {}, "samples": {}}
@@ -319,9 +320,7 @@ def _choose_model(model, par, y0):
 
 def _odd_columns(row_length):
     """Parameter columns holding integrals with an odd index, for both body rows."""
-    from .bodies import EXPONENTS_3, EXPONENTS_4
-    from .kernels.potential import T3, T4
+    from .bodies import row_columns
 
-    cols = [T3 + k for k in range(len(EXPONENTS_3))]
-    cols += [T4 + k for k, e in enumerate(EXPONENTS_4) if any(x % 2 for x in e)]
+    cols = row_columns(lambda e: any(x % 2 for x in e))
     return cols + [row_length + c for c in cols]

@@ -16,18 +16,10 @@ stays planar for all time: the 3-D model keeps such a start planar to round-off,
 
 import numpy as np
 
-from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
+from .bodies import (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH, row_columns,
+                     tensor_from_integrals)
 
 _SAMPLES = 16   # angles per Fourier fit: exact for trigonometric polynomials of degree < 8
-
-
-def _z_odd_columns():
-    """Body-row offsets of integrals with an odd z exponent (mass at 0, then T2, T3, T4)."""
-    cols, off = [], 1
-    for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
-        cols += [off + k for k, e in enumerate(group) if e[2] % 2]
-        off += len(group)
-    return cols
 
 
 def qualifies(par, y0):
@@ -36,7 +28,7 @@ def qualifies(par, y0):
 
     par = np.atleast_2d(par)
     y0 = np.atleast_2d(y0)
-    cols = _z_odd_columns()
+    cols = row_columns(lambda e: e[2] % 2)           # integrals odd in z
     symmetric = np.all(par[:, [eom.BODY_A + c for c in cols]] == 0.0, axis=1) & \
         np.all(par[:, [eom.BODY_B + c for c in cols]] == 0.0, axis=1)
     out_of_plane = [eom.Y_R + 2, eom.Y_V + 2, eom.Y_W1, eom.Y_W1 + 1, eom.Y_W2, eom.Y_W2 + 1]
@@ -54,10 +46,7 @@ def _moment_tensors(row):
     for order, group in ((2, EXPONENTS_2), (3, EXPONENTS_3), (4, EXPONENTS_4)):
         values = dict(zip(group, row[off:off + len(group)]))
         off += len(group)
-        T = np.zeros((3,) * order)
-        for idx in np.ndindex(*T.shape):
-            T[idx] = values.get((idx.count(0), idx.count(1), idx.count(2)), 0.0)
-        tensors.append(T)
+        tensors.append(tensor_from_integrals(order, lambda *lmn: values.get(lmn, 0.0)))
     return tensors
 
 
