@@ -40,7 +40,11 @@ from .potential import mutual, vec3
 from .tableau import CASH_KARP
 
 RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE = range(6)
-STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite")
+#: Set on the host only, after a run, by the accuracy check (ti_spinorbit.accuracy): a
+#: finished member whose conservation drift exceeds the limit. Its data are kept.
+INACCURATE = 6
+STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite",
+                "inaccurate")
 
 #: Columns of 3-D event and sample records: time (scaled) then the 30-element scaled state
 #: (planar records are converted to this layout on the host).

@@ -24,13 +24,13 @@ from typing import Callable, Optional, Union
 
 import numpy as np
 
-from . import analytic, catalog
+from . import accuracy, analytic, catalog
 from ._validate import require_positive
 from .classify import MIN_POINTS, classify_section
 from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
-from .kernels.ensemble import DONE
+from .kernels.ensemble import INACCURATE
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -51,10 +51,11 @@ def _axis(name, values):
     return arr
 
 
-def _chaotic_fraction(labels, status):
-    """Fraction of finished members ("done") labelled chaotic; NaN if none finished."""
-    done = np.asarray(status) == DONE
-    return float(np.mean(labels[done] == "chaotic")) if done.any() else float("nan")
+def _chaotic_fraction(labels, status, include_inaccurate=False):
+    """Fraction of finished members ("done"; also "inaccurate" ones when
+    ``include_inaccurate``) labelled chaotic; NaN if none counts."""
+    ok = accuracy.usable(status, include_inaccurate)
+    return float(np.mean(labels[ok] == "chaotic")) if ok.any() else float("nan")
 
 
 def _labels(section, megno_chaotic, orbits):
@@ -63,8 +64,9 @@ def _labels(section, megno_chaotic, orbits):
     (at least 8), which only affects the geometric rule used in the 2.5 < ⟨Y⟩ < 4 gap and for
     resonant vs quasi-periodic."""
     min_points = int(min(MIN_POINTS, max(8, np.floor(0.8 * orbits))))
+    # inaccurate members are labelled too (their data are kept); summaries exclude them
     return classify_section(section, megno_chaotic=megno_chaotic, min_points=min_points,
-                            geometric=False).label
+                            geometric=False, include_inaccurate=True).label
 
 
 def _mean_spin(section):
@@ -99,10 +101,20 @@ class ChaosMap:
     seconds: float
     megno_chaotic: float = 4.0
     section: SectionResult = field(default=None, repr=False)
+    energy_drift: np.ndarray = None
+    angmom_drift: np.ndarray = None
+    max_drift: float = float("nan")
+    n_inaccurate: int = 0
+    include_inaccurate: bool = False
 
     @property
     def shape(self):
         return self.megno.shape
+
+    @property
+    def status_counts(self) -> dict:
+        """Members per status name, e.g. {"done": 1020, "inaccurate": 4}."""
+        return accuracy.counts(self.status)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -177,7 +189,8 @@ def _edges(centres, low=None, high=None):
 
 def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
               progress: Optional[Callable[[float], None]] = None, client=None,
-              chunk_size=None, model="auto", checkpoint=None, resume=False) -> ChaosMap:
+              chunk_size=None, model="auto", checkpoint=None, resume=False, max_drift=None,
+              include_inaccurate=False) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -206,6 +219,11 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     checkpoint, resume
         Checkpoint file written after every window, and whether to continue from it
         (single process only; see :mod:`ti_spinorbit.checkpoint`).
+    max_drift : float, optional
+        Drift limit of the accuracy verdict (default ``min(1e-4, 1000 · rtol · orbits)``;
+        :mod:`ti_spinorbit.accuracy`).
+    include_inaccurate : bool
+        Count "inaccurate" members in ``chaotic_fraction`` too (default: excluded).
 
     Returns
     -------
@@ -218,11 +236,13 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     check_orbits(orbits)
     require_positive("rtol", rtol)
     require_positive("megno_chaotic", megno_chaotic)
+    if max_drift is not None:
+        accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
                        indicators=True, progress=progress, model=model, checkpoint=checkpoint,
-                       resume=resume)
+                       resume=resume, max_drift=max_drift)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = tp.shape
@@ -230,8 +250,12 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         theta_p=theta_p, thetadot_p=thetadot_p, megno=section.megno.reshape(shape),
         lyapunov=section.lyapunov.reshape(shape), classification=labels.reshape(shape),
         mean_spin=_mean_spin(section).reshape(shape), status=section.status.reshape(shape),
-        chaotic_fraction=_chaotic_fraction(labels, section.status), orbits=float(orbits),
-        rtol=float(rtol), seconds=seconds, megno_chaotic=float(megno_chaotic), section=section)
+        chaotic_fraction=_chaotic_fraction(labels, section.status, include_inaccurate),
+        orbits=float(orbits), rtol=float(rtol), seconds=seconds,
+        megno_chaotic=float(megno_chaotic), section=section,
+        energy_drift=section.energy_drift.reshape(shape),
+        angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
+        n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate))
 
 
 @dataclass
@@ -242,7 +266,10 @@ class ParameterMap:
     (len(elongations), len(eccentricities)); ``megno``, ``labels``, ``status`` per start,
     shape (len(elongations), len(eccentricities), starts); ``theta_p`` (deg) and
     ``thetadot_p`` (units of n) the starts used at every grid point; ``omega0`` ω0(a/b) of the
-    ellipsoid; ``seconds`` wall time of the one launch."""
+    ellipsoid; ``seconds`` wall time of the one launch; ``energy_drift``, ``angmom_drift``
+    per start and ``max_drift`` the accuracy limit (``ti_spinorbit.accuracy``);
+    ``inaccurate`` the count of "inaccurate" starts per (a/b, e), excluded from
+    ``chaotic_fraction`` unless ``include_inaccurate``."""
 
     elongations: np.ndarray
     eccentricities: np.ndarray
@@ -257,6 +284,19 @@ class ParameterMap:
     rtol: float
     seconds: float
     name: str = ""
+    energy_drift: np.ndarray = None
+    angmom_drift: np.ndarray = None
+    max_drift: float = float("nan")
+    inaccurate: np.ndarray = None
+    include_inaccurate: bool = False
+
+    @property
+    def n_inaccurate(self) -> int:
+        return accuracy.count(self.status, "inaccurate")
+
+    @property
+    def status_counts(self) -> dict:
+        return accuracy.counts(self.status)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -303,7 +343,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
-                  resume=False) -> ParameterMap:
+                  resume=False, max_drift=None, include_inaccurate=False) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -322,7 +362,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         Integrator tolerance.
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
-    progress, client, chunk_size, model, checkpoint, resume
+    progress, client, chunk_size, model, checkpoint, resume, max_drift, include_inaccurate
         As for :func:`chaos_map`.
 
     Returns
@@ -339,6 +379,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         raise ValueError(f"elongations must be >= 1 (got {elongations!r})")
     if np.any((eccentricities < 0.0) | (eccentricities >= 1.0)):
         raise ValueError(f"eccentricities must lie in [0, 1) (got {eccentricities!r})")
+    if max_drift is not None:
+        accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     if isinstance(factory_or_name, str):
         name = factory_or_name
         factory = lambda q, e: catalog.system(name, elongation=q, eccentricity=e)  # noqa: E731
@@ -355,15 +397,19 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     started = time.perf_counter()
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
                        chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
-                       model=model, checkpoint=checkpoint, resume=resume)
+                       model=model, checkpoint=checkpoint, resume=resume, max_drift=max_drift)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = (elongations.size, eccentricities.size, starts)
     labels, status = labels.reshape(shape), section.status.reshape(shape)
-    fraction = np.array([[_chaotic_fraction(labels[i, j], status[i, j])
+    fraction = np.array([[_chaotic_fraction(labels[i, j], status[i, j], include_inaccurate)
                           for j in range(shape[1])] for i in range(shape[0])])
     return ParameterMap(
         elongations=elongations, eccentricities=eccentricities, chaotic_fraction=fraction,
         megno=section.megno.reshape(shape), labels=labels, status=status, theta_p=tp,
         thetadot_p=td, omega0=np.asarray(analytic.omega0(elongations)), orbits=float(orbits),
-        rtol=float(rtol), seconds=seconds, name=name)
+        rtol=float(rtol), seconds=seconds, name=name,
+        energy_drift=section.energy_drift.reshape(shape),
+        angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
+        inaccurate=np.sum(status == INACCURATE, axis=-1),
+        include_inaccurate=bool(include_inaccurate))

@@ -517,7 +517,8 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
                                  megno=megno_arr, parameters=params, **out)
 
 
-def classify_section(result, megno=None, island_shift=True, **thresholds):
+def classify_section(result, megno=None, island_shift=True, include_inaccurate=False,
+                     **thresholds):
     """Classify every member of a :class:`~ti_spinorbit.section.SectionResult`.
 
     Parameters
@@ -530,6 +531,10 @@ def classify_section(result, megno=None, island_shift=True, **thresholds):
     island_shift : bool
         Assign p against the decoupled island centres of each member's system (default) rather
         than against the nominal centres p.
+    include_inaccurate : bool
+        Also classify members whose status is "inaccurate" (conservation drift above the
+        limit, ``ti_spinorbit.accuracy``); by default they are "undetermined" like members
+        that stopped early.
     **thresholds
         ``libration_gap_deg``, ``order_ratio_chaotic``, ``megno_chaotic``, ``megno_regular``,
         ``min_points``, ``center_tolerance_deg``, ``dominant_gap_ratio`` (see
@@ -539,7 +544,9 @@ def classify_section(result, megno=None, island_shift=True, **thresholds):
     -------
     SectionClassification
     """
-    failed = np.array([name != "done" for name in result.status_names])
+    from .accuracy import usable
+
+    failed = ~usable(result.status, include_inaccurate)
     systems = result.systems if island_shift else None
     if megno is None:
         megno = getattr(result, "megno", None)

@@ -16,7 +16,19 @@ Conventions: every flag is checked before any work starts; a bad value, like any
 in the inputs, prints ONE line naming the flag, the value and the allowed range, and exits with
 status 2 (no traceback). Long runs draw a progress bar on stderr (:mod:`ti_spinorbit.progress`);
 ``--quiet`` prints nothing but errors. Data files are self-describing ``.npz``
-(:func:`ti_spinorbit.io.save`); figures are PNG (or PDF/SVG by the extension of ``--out``)."""
+(:func:`ti_spinorbit.io.save`); figures are PNG (or PDF/SVG by the extension of ``--out``).
+
+Outputs: every output path (and the Matplotlib backend) is checked before any work; the data
+file is written before the figure, so a plotting failure never loses a run's numbers.
+
+Accuracy: every member's energy and angular-momentum drift is held against a limit
+(``--max-drift``, default scaled with the tolerance and run length; ti_spinorbit.accuracy).
+Members above it are "inaccurate": kept in the data file, counted on stderr, and the command
+exits with status 3 (EXIT_INACCURATE) unless ``--allow-inaccurate``.
+
+Exit status: 0 success; 1 a check failed (``energy``); 2 bad input or a failed run (one
+line); 3 results written but some members inaccurate; 130 interrupted. ``--debug`` re-raises
+any error with its full traceback instead of the one-line message."""
 
 import argparse
 import math
@@ -26,6 +38,8 @@ import sys
 
 from .section import MAX_ORBITS  # orbits limit shared with the library
 
+#: Exit statuses (README "Statuses, exit codes and accuracy").
+EXIT_OK, EXIT_CHECK_FAILED, EXIT_ERROR, EXIT_INACCURATE, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 #: Accepted --rtol range (the integrator's own limits, ensemble.check_tolerances).
 RTOL_RANGE = (1e-16, 1e-2)
 #: Largest grid side of a chaos map, and most members of any run.
@@ -119,11 +133,27 @@ def _parser():
         "Coupled spin-orbit dynamics of binary asteroids (full two-body problem, 4th-order "
         "mutual potential), ensembles integrated with Taichi."),
         epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    debug_help = "on any error print the full traceback (for bug reports) instead of one line"
+    p.add_argument("--debug", action="store_true", help=debug_help)
+    # --debug before or after the subcommand; SUPPRESS keeps the top-level value when the
+    # subcommand's own flag is absent
+    debug = _Parser(add_help=False)
+    debug.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help=debug_help)
     sub = p.add_subparsers(dest="command", required=True)
 
     def command(name, help):
         return sub.add_parser(name, help=help, description=help, epilog=_help_epilog(name),
-                              formatter_class=argparse.RawDescriptionHelpFormatter)
+                              formatter_class=argparse.RawDescriptionHelpFormatter,
+                              parents=[debug])
+
+    def accuracy_flags(s):
+        s.add_argument("--max-drift", type=float, default=None,
+                       help="largest relative energy or angular-momentum drift of a member "
+                            "counted as accurate, in (0, 1] (default: min(1e-4, 1000 x rtol "
+                            "x orbits)); members above it are 'inaccurate'")
+        s.add_argument("--allow-inaccurate", action="store_true",
+                       help=f"exit with status 0 even when members are inaccurate (default: "
+                            f"status {EXIT_INACCURATE}; they are kept in the data file either way)")
 
     def common(s, out_help, data=True, orbits=300.0, rtol=1e-10, model=True, resume=False):
         if orbits is not None:
@@ -164,7 +194,7 @@ def _parser():
         s.add_argument("--eccentricity", type=float,
                        help="initial osculating eccentricity in [0, 1) (default: catalogue value)")
 
-    s = sub.add_parser("systems", help="list catalogued systems or show one",
+    s = sub.add_parser("systems", help="list catalogued systems or show one", parents=[debug],
                        description="List the catalogued systems (Naidu & Margot 2015, Table 1).",
                        epilog=_help_epilog("systems"),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -179,6 +209,7 @@ def _parser():
     s.add_argument("--thetadot", type=float, nargs="+",
                    help="initial θ̇_p/n values (default: the paper's starts for this system)")
     common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12, resume=True)
+    accuracy_flags(s)
 
     s = command("map", "chaos map over (θ_p, θ̇_p/n): MEGNO, Lyapunov, classes (PNG + .npz)")
     system_flags(s)
@@ -187,6 +218,7 @@ def _parser():
     s.add_argument("--thetadot-range", type=float, nargs=2, default=[0.2, 3.0],
                    metavar=("LO", "HI"), help="θ̇_p/n range, LO < HI (default 0.2 3.0)")
     common(s, "PNG path (default map_<system>.png)", resume=True)
+    accuracy_flags(s)
 
     s = command("overlap", "resonance-overlap scan over a/b, 1:1 and 3:2 (PNG + .npz)")
     system_flags(s, shape=False)
@@ -195,6 +227,7 @@ def _parser():
                    help=f"a/b scan, 1 < START <= STOP <= {MAX_ELONGATION:g}, STEP > 0 "
                         "(default 1.01 1.15 0.01)")
     common(s, "PNG path (default overlap_<system>.png)")
+    accuracy_flags(s)
 
     s = command("libration", "relaxed libration amplitude at the synchronous island centre "
                 "(PNG + .npz)")
@@ -207,6 +240,7 @@ def _parser():
                         "(default 45 over 0.2..1.3)")
     common(s, "PNG path of the centre search, extent vs θ̇_p/n (default libration_<system>.png)",
            orbits=100.0, rtol=1e-12, model=False)
+    accuracy_flags(s)
 
     s = command("energy", "energy and angular-momentum conservation check (PNG + .npz; "
                 "exit status 1 when the drift exceeds --max-drift)")
@@ -233,6 +267,7 @@ def _parser():
     common(s, "JSON path (default benchmark.json)", data=False, orbits=20.0, rtol=1e-12)
 
     s = sub.add_parser("figures", help="reproduce the paper's studies (experiments/study*.py)",
+                       parents=[debug],
                        epilog=_help_epilog("figures"),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     s.add_argument("--quick", action="store_true", help="small runs (minutes in all)")
@@ -269,18 +304,48 @@ def _check_range(flag, value, low, high, low_open=False, high_open=False):
 
 
 def _check_output(flag, path, extensions):
-    """The file's folder must exist and be writable, and its extension be one of ours: a
-    typo should fail before a long run, not after it."""
+    """The output file must be writable where it is asked for, with one of our extensions:
+    a typo, a folder or a read-only file must fail before a long run, not after it. Probes
+    by opening (an existing file for appending, which changes nothing; a new one beside it as
+    a temporary file), because permission bits do not tell for root or read-only mounts."""
+    import tempfile
+
     if path is None:
         return
     ext = os.path.splitext(path)[1].lower()
     if ext not in extensions:
         raise ValueError(f"{flag} must end in {', '.join(extensions)} (got {path!r})")
+    if os.path.isdir(path):
+        raise ValueError(f"{flag}: {path!r} is a folder; give a file name")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise ValueError(f"{flag}: folder {folder!r} does not exist (got {path!r})")
-    if not os.access(folder, os.W_OK):
-        raise ValueError(f"{flag}: folder {folder!r} is not writable (got {path!r})")
+    try:
+        if os.path.exists(path):
+            with open(path, "ab"):
+                pass
+        else:
+            with tempfile.TemporaryFile(dir=folder):
+                pass
+    except OSError as exc:
+        what = "file" if os.path.exists(path) else "folder"
+        raise ValueError(f"{flag}: cannot write {path!r} ({what} not writable: "
+                         f"{exc.strerror or exc})") from None
+
+
+def _check_plotting():
+    """Matplotlib must load with the environment's backend before a run whose figure would
+    otherwise fail at the end (an invalid MPLBACKEND raises at import)."""
+    try:
+        from .plotting import _pyplot
+
+        _pyplot()
+    except Exception as exc:  # noqa: BLE001 - any failure here would lose the figure later
+        backend = os.environ.get("MPLBACKEND")
+        if backend:
+            raise ValueError(f"MPLBACKEND={backend!r} is not a Matplotlib backend that works "
+                             "here; unset it or set MPLBACKEND=Agg") from None
+        raise ValueError(f"Matplotlib cannot start ({_one_line(exc)[:200]})") from None
 
 
 def check_args(args):
@@ -313,9 +378,13 @@ def check_args(args):
             raise ValueError(f"--candidates N must be an integer in [5, 10001] (got {n:g})")
     if args.command in ("benchmark", "systems"):
         _check_output("--out", getattr(args, "out", None), (".json",))
-    elif args.command != "figures":                  # figures: --out is a folder
+    elif args.command == "figures":                  # figures: --out is a folder
+        if os.path.exists(args.out) and not os.path.isdir(args.out):
+            raise ValueError(f"--out: {args.out!r} is a file; give a folder")
+    else:
         _check_output("--out", args.out, FIGURE_EXTENSIONS)
         _check_output("--data", args.data, (".npz",))
+        _check_plotting()
 
 
 # ---- shared steps -----------------------------------------------------------------------
@@ -342,9 +411,13 @@ def _system(args):
 
 
 def _paths(args, prefix, system_name):
-    """(figure path, data path) from --out/--data or the defaults <prefix>_<system>.png/.npz."""
+    """(figure path, data path) from --out/--data or the defaults <prefix>_<system>.png/.npz,
+    both checked writable (defaults included) before any work."""
     out = args.out or f"{prefix}_{system_name.replace(' ', '')}.png"
-    return out, args.data or os.path.splitext(out)[0] + ".npz"
+    data = args.data or os.path.splitext(out)[0] + ".npz"
+    _check_output("--out" if args.out else "the figure (default --out)", out, FIGURE_EXTENSIONS)
+    _check_output("--data" if args.data else "the data file (default --data)", data, (".npz",))
+    return out, data
 
 
 def _progress(args):
@@ -377,6 +450,46 @@ def _save(result, path, extra):
     from .io import save
 
     return save(result, path, extra=extra)
+
+
+class FigureError(RuntimeError):
+    """The data file was written but the figure could not be (exit status 2)."""
+
+
+def _write(result, data, extra, figure, out):
+    """The data file first, then the figure (``figure()`` returns its Axes): a plotting
+    failure never loses the numbers of a run. Returns the paths written."""
+    from .plotting import save_figure
+
+    data = _save(result, data, extra)
+    try:
+        save_figure(figure(), out)
+    except Exception as exc:  # noqa: BLE001 - whatever Matplotlib raises, the data are safe
+        raise FigureError(f"the figure {out!r} could not be written ({_one_line(exc)}); "
+                          f"the data are saved in {data}") from exc
+    return out, data
+
+
+def _accuracy_status(args, status, energy_drift, max_drift, what="members"):
+    """Exit status of a run by its accuracy verdict: prints the count of inaccurate members on
+    stderr (even with --quiet: it qualifies the results) and returns EXIT_INACCURATE unless
+    there are none or --allow-inaccurate."""
+    import numpy as np
+
+    from .kernels.ensemble import INACCURATE
+
+    status = np.asarray(status)
+    bad = int(np.count_nonzero(status == INACCURATE))
+    if not bad:
+        return EXIT_OK
+    worst = float(np.nanmax(np.where(status == INACCURATE, energy_drift, np.nan)))
+    allowed = getattr(args, "allow_inaccurate", False)
+    print(f"ti-spinorbit {args.command}: {bad} of {status.size} {what} inaccurate: "
+          f"conservation drift above {max_drift:.3g} (largest energy drift {worst:.3g}); kept "
+          f"in the data file with status 'inaccurate'"
+          + ("" if allowed else f"; tighten --rtol, or --allow-inaccurate to accept (exit "
+                                f"status {EXIT_INACCURATE})"), file=sys.stderr)
+    return EXIT_OK if allowed else EXIT_INACCURATE
 
 
 def _print(args, *lines):
@@ -425,24 +538,26 @@ def _cmd_section(args):
     _init(args)
     with _progress(args) as bar:
         result = surface_of_section(system, args.theta_p, np.array(starts), orbits=args.orbits,
-                                    rtol=args.rtol, progress=bar, **_run_flags(args, data))
-    save_figure(plot_section(result), out)
-    _save(result, data, {"command": args.command_line})
+                                    rtol=args.rtol, progress=bar, max_drift=args.max_drift,
+                                    **_run_flags(args, data))
+    out, data = _write(result, data, {"command": args.command_line},
+                       lambda: plot_section(result), out)
     _print(args, f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
                  f"{len(starts)} trajectories x {args.orbits:g} orbits in {result.seconds:.2f} s "
-                 f"({result.member_orbits_per_second:.0f} member-orbits/s)")
+                 f"({result.member_orbits_per_second:.0f} member-orbits/s), drift limit "
+                 f"{result.max_drift:.1e}")
     for k, v in enumerate(starts):
         _print(args, f"  thetadot_p/n = {v:5.2f}: {result.count[k]} crossings, status "
-                     f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}")
+                     f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}, "
+                     f"angular-momentum drift {result.angmom_drift[k]:.1e}")
     _print(args, f"wrote {out} and {data}")
-    return 0
+    return _accuracy_status(args, result.status, result.energy_drift, result.max_drift)
 
 
 def _cmd_map(args):
     import numpy as np
 
     from .chaosmap import chaos_map
-    from .plotting import save_figure
 
     system = _system(args)
     nt, nd = args.grid
@@ -452,12 +567,16 @@ def _cmd_map(args):
     theta = (np.arange(nt) + 0.5) * 180.0 / nt
     with _progress(args) as bar:
         cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
-                         rtol=args.rtol, progress=bar, **_run_flags(args, data))
-    save_figure(cmap.plot(), out)
-    _save(cmap, data, {"command": args.command_line})
+                         rtol=args.rtol, progress=bar, max_drift=args.max_drift,
+                         include_inaccurate=args.allow_inaccurate, **_run_flags(args, data))
+    out, data = _write(cmap, data, {"command": args.command_line}, cmap.plot, out)
+    counted = "all finished members" if args.allow_inaccurate else \
+        f"{cmap.n_inaccurate} inaccurate left out"
     _print(args, f"{system.name}: {nt} x {nd} map, {args.orbits:g} orbits: chaotic fraction "
-                 f"{cmap.chaotic_fraction:.3f} in {cmap.seconds:.1f} s; wrote {out} and {data}")
-    return 0
+                 f"{cmap.chaotic_fraction:.3f} ({counted}; statuses {cmap.status_counts}) in "
+                 f"{cmap.seconds:.1f} s; largest energy drift {np.nanmax(cmap.energy_drift):.1e}"
+                 f" (limit {cmap.max_drift:.1e}); wrote {out} and {data}")
+    return _accuracy_status(args, cmap.status, cmap.energy_drift, cmap.max_drift)
 
 
 def _cmd_overlap(args):
@@ -465,7 +584,6 @@ def _cmd_overlap(args):
 
     from . import catalog
     from .overlap import overlap_threshold
-    from .plotting import save_figure
 
     start, stop, step = args.elongations
     system = catalog.system(args.system, eccentricity=args.eccentricity)   # checks name and e
@@ -475,15 +593,17 @@ def _cmd_overlap(args):
     with _progress(args) as bar:
         scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
                                  orbits=args.orbits, rtol=args.rtol, progress=bar,
-                                 model=args.model)
-    save_figure(scan.plot(), out)
-    _save(scan, data, {"command": args.command_line})
+                                 model=args.model, max_drift=args.max_drift,
+                                 include_inaccurate=args.allow_inaccurate)
+    out, data = _write(scan, data, {"command": args.command_line}, scan.plot, out)
     _print(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
                  f"(analytic {scan.elongation_ro:.4f}) in {scan.seconds:.1f} s; wrote {out} and {data}")
     for d in scan.decisions:
         extra = f", connecting <Y> = {d.connecting_megno:.1f}" if d.overlap else ""
+        extra += f", {d.inaccurate} inaccurate trajectories" if d.inaccurate else ""
         _print(args, f"  a/b = {d.elongation:.2f}: {'overlap' if d.overlap else 'separate'}{extra}")
-    return 0
+    sec = scan.sections
+    return _accuracy_status(args, sec.status, sec.energy_drift, scan.max_drift, "trajectories")
 
 
 def _plot_libration(result):
@@ -525,11 +645,10 @@ def _cmd_libration(args):
     import numpy as np
 
     from .libration import relaxed_libration
-    from .plotting import save_figure
 
     system = _system(args)
     out, data = _paths(args, "libration", system.name)
-    kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol)
+    kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol, max_drift=args.max_drift)
     if args.candidates:
         lo, hi, n = args.candidates
         kwargs["candidates"] = np.linspace(lo, hi, int(n))
@@ -541,8 +660,8 @@ def _cmd_libration(args):
         if not args.quiet:
             print(f"ti-spinorbit libration: warning: {w.message}", file=sys.stderr)
     plot = getattr(result, "plot", None)
-    save_figure(plot() if callable(plot) else _plot_libration(result), out)
-    _save(result, data, {"command": args.command_line})
+    out, data = _write(result, data, {"command": args.command_line},
+                       plot if callable(plot) else lambda: _plot_libration(result), out)
     _print(args,
            f"{system.name}: relaxed libration amplitude {result.amplitude:.4f} deg at the "
            f"synchronous centre thetadot_p/n = {result.center_thetadot_p:.8f}",
@@ -550,8 +669,11 @@ def _cmd_libration(args):
            f"coupled psi_A = {result.psi_A_effective:.4f} deg (omega0_eff {result.omega0_effective:.4f})",
            f"  section extent at the centre {result.extent:.2e} deg, {result.iterations} zooms, "
            f"{'converged' if result.converged else 'NOT converged'}, {result.seconds:.1f} s",
+           f"  centre trajectory: status {result.status}, energy drift {result.energy_drift:.1e}"
+           f" (limit {result.max_drift:.1e})",
            f"wrote {out} and {data}")
-    return 0
+    return _accuracy_status(args, np.array([_status_code(result.status)]),
+                            np.array([result.energy_drift]), result.max_drift, "trajectories")
 
 
 def energy_check(ts, member=0):
@@ -602,7 +724,6 @@ def _cmd_energy(args):
     import math as m
 
     from . import catalog, time_series
-    from .plotting import save_figure
 
     system = _system(args)
     out, data = _paths(args, "energy", system.name)
@@ -618,13 +739,13 @@ def _cmd_energy(args):
     _init(args)
     with _progress(args) as bar:
         ts = time_series(system, args.theta_p, thetadot, args.orbits, samples_per_orbit=samples,
-                         rtol=args.rtol, **_with_progress(time_series, bar),
-                         **_run_flags(args, data))
+                         rtol=args.rtol, max_drift=args.max_drift,
+                         **_with_progress(time_series, bar), **_run_flags(args, data))
     numbers, series = energy_check(ts)
-    status = ts.status_names[0] if hasattr(ts, "status_names") else _status_name(ts.status[0])
-    save_figure(_plot_energy(system, series, args.orbits, args.rtol), out)
-    _save(ts, data, {"command": args.command_line, "energy_check": numbers,
-                     "max_drift": args.max_drift, "member_status": status})
+    status = ts.status_names[0]
+    out, data = _write(ts, data, {"command": args.command_line, "energy_check": numbers,
+                                  "member_status": status},
+                       lambda: _plot_energy(system, series, args.orbits, args.rtol), out)
     worst = max(numbers["energy_drift"], numbers["angmom_drift"])
     _print(args,
            f"{system.name}: {args.orbits:g} orbits at rtol {args.rtol:g}, {numbers['samples']} "
@@ -634,21 +755,21 @@ def _cmd_energy(args):
            "  largest exchange, |ΔE_i|/|E0|: orbit {exchange_orbit:.3e}, primary spin "
            "{exchange_primary:.3e}, secondary spin {exchange_secondary:.3e}".format(**numbers),
            f"wrote {out} and {data}")
+    if not worst <= args.max_drift:          # also catches NaN
+        print(f"ti-spinorbit energy: drift {worst:.3e} exceeds --max-drift {args.max_drift:g} "
+              f"(status {status})", file=sys.stderr)
+        return EXIT_CHECK_FAILED
     if status != "done":
         print(f"ti-spinorbit energy: the integration stopped early (status {status})",
               file=sys.stderr)
-        return 1
-    if not worst <= args.max_drift:
-        print(f"ti-spinorbit energy: drift {worst:.3e} exceeds --max-drift {args.max_drift:g}",
-              file=sys.stderr)
-        return 1
-    return 0
+        return EXIT_CHECK_FAILED
+    return EXIT_OK
 
 
-def _status_name(code):
+def _status_code(name):
     from .kernels.ensemble import STATUS_NAMES
 
-    return STATUS_NAMES[code]
+    return STATUS_NAMES.index(name)
 
 
 def _cmd_benchmark(args):
@@ -744,7 +865,8 @@ def _one_line(exc):
 def main(argv=None):
     """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit status:
     0 success, 1 a check failed (energy), 2 bad input or a failed run (one line on stderr),
-    130 interrupted."""
+    3 results written but some members inaccurate (unless --allow-inaccurate), 130
+    interrupted. With --debug every error propagates with its traceback."""
     try:
         args, unknown = _parser().parse_known_args(argv)
         if unknown:       # argparse would blame the top-level parser; name the subcommand
@@ -755,19 +877,22 @@ def main(argv=None):
         return 2
     # recorded in every data file, quoted so that it can be pasted back into a shell
     args.command_line = shlex.join(["ti-spinorbit", *(sys.argv[1:] if argv is None else argv)])
+    if getattr(args, "debug", False):
+        check_args(args)
+        return HANDLERS[args.command](args)
     try:
         check_args(args)
         return HANDLERS[args.command](args)
     except (ValueError, TypeError, RuntimeError, OSError) as exc:
         print(f"ti-spinorbit {args.command}: error: {_one_line(exc)}", file=sys.stderr)
-        return 2
+        return EXIT_ERROR
     except MemoryError:
         print(f"ti-spinorbit {args.command}: error: out of memory; use fewer members "
               "(--grid, --members, --thetadot) or orbits", file=sys.stderr)
-        return 2
+        return EXIT_ERROR
     except KeyboardInterrupt:
         print(f"ti-spinorbit {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

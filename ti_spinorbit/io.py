@@ -46,7 +46,11 @@ SPIN = "mean motion n"                 # spin rates and frequencies in units of 
 STATUS = "status code (metadata status_codes)"
 LABEL = "label"
 _COMMON_UNITS = {"status_names": "name", "system_index": "index into metadata systems",
-                 "rtol": "1", "atol": "1", "orbits": "orbital periods", "seconds": "s"}
+                 "rtol": "1", "atol": "1", "orbits": "orbital periods", "seconds": "s",
+                 # accuracy verdict (ti_spinorbit.accuracy)
+                 "energy_drift": "1 (relative)", "angmom_drift": "1 (relative)",
+                 "max_drift": "1 (relative)", "n_inaccurate": "members",
+                 "include_inaccurate": "bool"}
 #: Units of every array and scalar field, per kind ("1": dimensionless).
 UNITS = {
     "section": {
@@ -68,7 +72,7 @@ UNITS = {
     "parameter_map": {
         "elongations": "1 (a/b)", "eccentricities": "1", "chaotic_fraction": "1",
         "megno": "1", "labels": LABEL, "status": STATUS, "theta_p": "deg",
-        "thetadot_p": SPIN, "omega0": SPIN},
+        "thetadot_p": SPIN, "omega0": SPIN, "inaccurate": "members"},
     "overlap_scan": {
         "eccentricity": "1", "elongations": "1 (a/b)", "overlaps": "bool",
         "first_overlap": "1 (a/b)", "omega0_ro": SPIN, "elongation_ro": "1 (a/b)",
@@ -78,12 +82,13 @@ UNITS = {
         "decisions/connecting_start": SPIN, "decisions/connecting_range": SPIN,
         "decisions/widest_range": SPIN, "decisions/connecting_megno": "1",
         "decisions/connecting_lyapunov": "1/orbit",
-        "decisions/separatrix_chaotic_fraction": "1"},
+        "decisions/separatrix_chaotic_fraction": "1", "decisions/inaccurate": "members",
+        "decisions/max_energy_drift": "1 (relative)"},
     "relaxed_libration": {
         "center_thetadot_p": SPIN, "amplitude": "deg", "extent": "deg", "psi_A": "deg",
         "psi_A_effective": "deg", "omega0": SPIN, "omega0_effective": SPIN,
         "iterations": "launches", "converged": "bool", "candidates": SPIN, "extents": "deg",
-        "samples_per_orbit": "1/orbit", "xtol": SPIN},
+        "samples_per_orbit": "1/orbit", "xtol": SPIN, "status": "name"},
 }
 
 
@@ -157,11 +162,18 @@ def _json_default(x):
 def write_archive(path, arrays, metadata):
     """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``.
 
-    Returns the path written: NumPy appends ``.npz`` to a file name without it."""
-    np.savez_compressed(path, metadata=np.array(json.dumps(metadata, indent=1, default=_json_default)),
-                        **{k: np.asarray(v) for k, v in arrays.items()})
-    if isinstance(path, (str, os.PathLike)) and not os.fspath(path).endswith(".npz"):
-        return os.fspath(path) + ".npz"
+    Returns the path written. A name ending in ``.npz`` in any case (``r.NPZ``) is written
+    as given; NumPy's rule of appending ``.npz`` applies to other names only."""
+    entries = dict(metadata=np.array(json.dumps(metadata, indent=1, default=_json_default)),
+                   **{k: np.asarray(v) for k, v in arrays.items()})
+    if isinstance(path, (str, os.PathLike)):
+        path = os.fspath(path)
+        if not path.lower().endswith(".npz"):
+            path += ".npz"
+        with open(path, "wb") as fh:        # a file object: NumPy keeps the name as it is
+            np.savez_compressed(fh, **entries)
+        return path
+    np.savez_compressed(path, **entries)
     return path
 
 

@@ -44,7 +44,7 @@ from typing import List
 
 import numpy as np
 
-from . import analytic
+from . import accuracy, analytic
 from .classify import horizontal_extent
 from ._validate import require_count, require_finite, require_positive
 from .ensemble import check_tolerances
@@ -64,19 +64,34 @@ MAX_CENTER_EXTENT_DEG = 1.0
 LIBRATION_LIMIT_DEG = 85.0
 
 
-def section_extent(section, members=None):
+def section_extent(section, members=None, include_inaccurate=False):
     """Horizontal half extent of each member's section trace, deg: max |θ_p| with θ_p in
-    (−90°, 90°]; NaN where the member stopped early (collision, escape, ...) or has no point.
+    (−90°, 90°]; NaN where the member stopped early (collision, escape, ...), failed the
+    accuracy check ("inaccurate", unless ``include_inaccurate``) or has no point.
     ``members`` (index array) restricts it to some members of the section."""
-    from .kernels.ensemble import DONE
-
     idx = slice(None) if members is None else members
     extent = np.atleast_1d(horizontal_extent(section.theta_p[idx]))
-    return np.where((section.status[idx] == DONE) & (section.count[idx] > 0), extent, np.nan)
+    ok = accuracy.usable(section.status[idx], include_inaccurate) & (section.count[idx] > 0)
+    return np.where(ok, extent, np.nan)
+
+
+def _amplitudes(ts, include_inaccurate=False):
+    """max |α| (deg) of each member of a time series, α unwrapped with period 180° from
+    α(0); NaN where α circulates, the run stopped early or failed the accuracy check."""
+    ok = accuracy.usable(ts.status, include_inaccurate)
+    amplitude = np.full(len(ts.status), np.nan)
+    for i, alpha in enumerate(ts.alpha):
+        alpha = alpha[np.isfinite(alpha)]
+        if not ok[i] or not len(alpha):
+            continue
+        excursion = np.max(np.abs(np.unwrap(alpha, period=180.0)))
+        if excursion < 90.0:
+            amplitude[i] = excursion
+    return amplitude
 
 
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
-                        rtol=1e-12):
+                        rtol=1e-12, max_drift=None, include_inaccurate=False):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -94,25 +109,20 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         Samples of α per orbital period (α's maximum falls between pericentres).
     rtol : float
         Integrator tolerance.
+    max_drift, include_inaccurate
+        Accuracy limit (default ``min(1e-4, 1000 · rtol · orbits)``,
+        :mod:`ti_spinorbit.accuracy`), and whether members above it still get an amplitude.
 
     Returns
     -------
     float or ndarray
         Amplitude in degrees, one per member (a float for a single member); NaN where α
-        circulates or the integration stopped early (collision, escape, ...).
+        circulates, the integration stopped early (collision, escape, ...) or the member
+        failed the accuracy check (unless ``include_inaccurate``).
     """
-    from .kernels.ensemble import DONE
-
     ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
-                     rtol=rtol)
-    amplitude = np.full(len(ts.status), np.nan)
-    for i, alpha in enumerate(ts.alpha):
-        alpha = alpha[np.isfinite(alpha)]
-        if ts.status[i] != DONE or not len(alpha):
-            continue
-        excursion = np.max(np.abs(np.unwrap(alpha, period=180.0)))
-        if excursion < 90.0:
-            amplitude[i] = excursion
+                     rtol=rtol, max_drift=max_drift)
+    amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
 
@@ -134,7 +144,10 @@ class RelaxedLibration:
     ``candidates`` and ``extents`` the θ̇_p/n tried and their extents (deg), one array per
     launch, the coarse bracket first (extent NaN where the start does not librate);
     ``converged`` whether the final window is narrower than ``xtol`` and the extent at the
-    centre is below ``max_extent``; ``seconds`` wall time."""
+    centre is below ``max_extent`` and the final trajectory passed the accuracy check;
+    ``status`` that trajectory's status ("done", "inaccurate", ...), ``energy_drift`` and
+    ``angmom_drift`` its relative drifts and ``max_drift`` their limit
+    (``ti_spinorbit.accuracy``); ``seconds`` wall time."""
 
     center_thetadot_p: float
     amplitude: float
@@ -153,6 +166,10 @@ class RelaxedLibration:
     xtol: float = 1e-6
     seconds: float = 0.0
     system: BinarySystem = field(default=None, repr=False)
+    status: str = "done"
+    energy_drift: float = float("nan")
+    angmom_drift: float = float("nan")
+    max_drift: float = float("nan")
 
 
 def _fit_v(x, extent, best):
@@ -186,7 +203,8 @@ def _arm_window(x, extent, best, points):
 def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=None,
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
                       samples_per_orbit=256, coarse_arm_points=3,
-                      max_extent=MAX_CENTER_EXTENT_DEG, progress=None) -> RelaxedLibration:
+                      max_extent=MAX_CENTER_EXTENT_DEG, progress=None,
+                      max_drift=None) -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
     Parameters
@@ -220,6 +238,10 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         launches done / (launches done + launches still expected), the zoom launches still
         expected estimated from the window's half-width, ``xtol`` and ``max_iterations``;
         1.0 after the last.
+    max_drift : float, optional
+        Accuracy limit of every trajectory (default ``min(1e-4, 1000 · rtol · orbits)``,
+        :mod:`ti_spinorbit.accuracy`): "inaccurate" candidates take no part in the search,
+        and an inaccurate final trajectory makes the result not converged.
 
     Returns
     -------
@@ -239,6 +261,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                          "synchronous island")
     require_positive("orbits", orbits)
     check_tolerances(rtol, None)
+    limit = accuracy.drift_limit(rtol, orbits, max_drift)
     require_positive("xtol", xtol)
     zoom_candidates = require_count("zoom_candidates", zoom_candidates, 5, 100001)
     if zoom_candidates % 2 == 0:
@@ -274,9 +297,14 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     start = time.perf_counter()
     # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
     half_width = float(np.max(np.diff(x)))
-    extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol))
+    coarse = surface_of_section(system, 0.0, x, orbits, rtol=rtol, max_drift=limit)
+    if coarse.n_inaccurate == len(x):
+        raise RuntimeError(f"every candidate's conservation drift exceeds max_drift {limit:.3g} "
+                           f"(largest energy drift {np.nanmax(coarse.energy_drift):.3g}); "
+                           "tighten rtol")
+    extent = section_extent(coarse)
     launched(1 + zooms_left(half_width, 0) + 2)
-    librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol,
+    librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol, max_drift=limit,
                                                samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT))
     launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
@@ -294,7 +322,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     iterations = 0
     while half_width > xtol and iterations < max_iterations:
         x = center + np.linspace(-half_width, half_width, zoom_candidates)
-        extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol))
+        extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol,
+                                                   max_drift=limit))
         extent[extent >= LIBRATION_LIMIT_DEG] = np.nan
         tried.append(x)
         extents.append(extent)
@@ -311,7 +340,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         launched(zooms_left(half_width, iterations) + 2)
     # 4. the centre itself
     final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
-                                                           rtol=rtol))[0])
+                                                           rtol=rtol, max_drift=limit),
+                                        include_inaccurate=True)[0])
     launched(1)
     # a narrow window is not enough: at a true centre the trace shrinks to a point (a chaotic
     # zone, e.g. 1996 FG3 at a/b = 1.1, also narrows the window but leaves a wide trace)
@@ -321,11 +351,18 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                       f"xtol {xtol:.3g}; extent at the centre {final_extent:.3g} deg, allowed "
                       f"{max_extent:g} deg) after {iterations} launches", RuntimeWarning,
                       stacklevel=2)
-    amplitude = libration_amplitude(system, center, orbits, samples_per_orbit=samples_per_orbit,
-                                    rtol=rtol)
+    ts = time_series(system, 0.0, center, orbits, samples_per_orbit=samples_per_orbit, rtol=rtol,
+                     max_drift=limit)
+    amplitude = float(_amplitudes(ts, include_inaccurate=True)[0])   # kept, flagged below
     launched(0)
     if not np.isfinite(amplitude):
         raise RuntimeError(f"the trajectory from θ̇_p/n = {center:.9g} does not librate")
+    status = ts.status_names[0]
+    if status != "done":
+        converged = False
+        warnings.warn(f"relaxed_libration: the trajectory at the centre is {status} (energy "
+                      f"drift {ts.energy_drift[0]:.3g}, limit {limit:.3g}); its amplitude is "
+                      "not trustworthy: tighten rtol", RuntimeWarning, stacklevel=2)
     omega0_effective = analytic.omega0_effective(system)
     return RelaxedLibration(
         center_thetadot_p=center, amplitude=float(amplitude), extent=final_extent,
@@ -333,4 +370,6 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         omega0=system.omega0, omega0_effective=omega0_effective,
         iterations=iterations, converged=converged, candidates=tried, extents=extents,
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
-        seconds=time.perf_counter() - start, system=system)
+        seconds=time.perf_counter() - start, system=system, status=status,
+        energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
+        max_drift=limit)

@@ -35,7 +35,7 @@ from typing import Callable, List, Optional, Union
 
 import numpy as np
 
-from . import analytic, catalog
+from . import accuracy, analytic, catalog
 from ._validate import require_range
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
@@ -49,7 +49,10 @@ LIBRATION_LIMIT_DEG = 80.0
 @dataclass
 class OverlapDecision:
     """Evidence for one elongation: island centres (units of n), and the trajectory that
-    connects them (index into the separatrix column, its start and its θ̇_p range) or None."""
+    connects them (index into the separatrix column, its start and its θ̇_p range) or None.
+    ``inaccurate``: starts at this elongation whose conservation drift exceeded the limit
+    (excluded from the decision unless the scan includes them); ``max_energy_drift`` the
+    largest relative energy drift among its starts."""
 
     elongation: float
     omega0: float
@@ -63,6 +66,8 @@ class OverlapDecision:
     connecting_megno: float = float("nan")
     connecting_lyapunov: float = float("nan")
     separatrix_chaotic_fraction: float = float("nan")
+    inaccurate: int = 0
+    max_energy_drift: float = float("nan")
 
 
 @dataclass
@@ -71,7 +76,10 @@ class OverlapScan:
 
     ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
     none in the scan); ``elongation_ro``: the analytic a/b at ω0^RO(e); ``omega0_ro``: ω0^RO;
-    ``elongations``, ``overlaps``: the scan; ``decisions``: per-elongation evidence."""
+    ``elongations``, ``overlaps``: the scan; ``decisions``: per-elongation evidence;
+    ``max_drift`` the accuracy limit every trajectory was held against and ``n_inaccurate``
+    the trajectories above it (``ti_spinorbit.accuracy``), left out of the decisions unless
+    ``include_inaccurate``."""
 
     name: str
     eccentricity: float
@@ -84,6 +92,9 @@ class OverlapScan:
     orbits: float
     seconds: float = 0.0
     sections: object = field(default=None, repr=False)
+    max_drift: float = float("nan")
+    n_inaccurate: int = 0
+    include_inaccurate: bool = False
 
     def plot(self, ax=None, title=None):
         """Decision per elongation (overlap blue, separate green) with the numerical and the
@@ -124,7 +135,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                       eccentricity=None, orbits=1000, rtol=1e-10, center_starts=48,
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
                       indicators=True, progress=None, client=None,
-                      chunk_size=None, model="auto") -> OverlapScan:
+                      chunk_size=None, model="auto", max_drift=None,
+                      include_inaccurate=False) -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -149,6 +161,11 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         the members run in chunks on its workers, with an identical result.
     model : {"auto", "planar", "3d"}
         Equations of motion (see :func:`~ti_spinorbit.section.surface_of_section`).
+    max_drift : float, optional
+        Drift limit of the accuracy verdict (default ``min(1e-4, 1000 · rtol · orbits)``;
+        :mod:`ti_spinorbit.accuracy`).
+    include_inaccurate : bool
+        Let "inaccurate" trajectories take part in the decisions (default: left out).
     """
     import time
 
@@ -159,6 +176,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     q = np.round(np.arange(1.01, 1.155, 0.01), 10) if elongations is None else \
         np.asarray(elongations, dtype=np.float64).ravel()
     require_range("elongations", q, 1.0, 10.0, low_open=True, high_open=False)
+    if max_drift is not None:
+        accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     systems = [make(float(x)) for x in q]
     e = systems[0].e
     # θ_p = 0 column for the centres; θ_p = 90° column for the connection
@@ -172,27 +191,30 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     t0 = time.perf_counter()
     sec = sections(client, members, np.array(theta0), np.array(rates), orbits=orbits,
                    chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
-                   model=model)
+                   model=model, max_drift=max_drift)
     per = len(centre_rates) + len(sep_rates)
     decisions = []
     for k, s in enumerate(systems):
         block = slice(k * per, (k + 1) * per)
         decisions.append(_decide(float(q[k]), s, sec, block, centre_rates, sep_rates,
-                                 libration_limit))
+                                 libration_limit, include_inaccurate))
     overlaps = np.array([d.overlap for d in decisions])
     first = next((float(x) for x, o in zip(q, overlaps) if o), None)
     w_ro = float(analytic.omega0_overlap(e))
     return OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
                        elongation_ro=float(analytic.elongation_from_omega0(w_ro)), orbits=orbits,
-                       seconds=time.perf_counter() - t0, sections=sec)
+                       seconds=time.perf_counter() - t0, sections=sec,
+                       max_drift=sec.max_drift, n_inaccurate=sec.n_inaccurate,
+                       include_inaccurate=bool(include_inaccurate))
 
 
-def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
+def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
+            include_inaccurate=False):
     idx = np.arange(sec.count.size)[block]
     nc = len(centre_rates)
     centre_idx, sep_idx = idx[:nc], idx[nc:]
-    extent = section_extent(sec, centre_idx)
+    extent = section_extent(sec, centre_idx, include_inaccurate)
     librating = np.isfinite(extent) & (extent < libration_limit)
 
     def centre_near(nominal, window):
@@ -209,10 +231,14 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
     found = c32 is not None
     if not found:
         c32 = c1 + 0.5
-    lo = np.nanmin(sec.thetadot_p[sep_idx], axis=1)
-    hi = np.nanmax(sec.thetadot_p[sep_idx], axis=1)
+    # only trajectories that passed the accuracy check (and have points) take part
+    usable = accuracy.usable(sec.status[sep_idx], include_inaccurate) & (sec.count[sep_idx] > 0)
+    points = np.where(usable[:, None], sec.thetadot_p[sep_idx], np.nan)
+    with np.errstate(invalid="ignore"):
+        lo = np.array([np.nanmin(p) if np.isfinite(p).any() else np.nan for p in points])
+        hi = np.array([np.nanmax(p) if np.isfinite(p).any() else np.nan for p in points])
     connects = (lo <= c1) & (hi >= c32)
-    widest = int(np.nanargmax(hi - lo))
+    widest = int(np.nanargmax(hi - lo)) if np.isfinite(hi - lo).any() else 0
     k = int(np.argmax(connects)) if connects.any() else None
     megno = sec.megno[sep_idx]
     return OverlapDecision(
@@ -224,7 +250,9 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit):
         connecting_megno=float("nan") if k is None else float(megno[k]),
         connecting_lyapunov=float("nan") if k is None else float(sec.lyapunov[sep_idx][k]),
         separatrix_chaotic_fraction=float(np.mean(megno > MEGNO_CHAOTIC)) if np.isfinite(megno).all()
-        else float("nan"))
+        else float("nan"),
+        inaccurate=accuracy.count(sec.status[idx], "inaccurate"),
+        max_energy_drift=float(np.nanmax(sec.energy_drift[idx], initial=0.0)))
 
 
 def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):

@@ -14,6 +14,7 @@ from typing import List, Sequence, Union
 
 import numpy as np
 
+from . import accuracy
 from ._validate import _as_floats, require_count, require_finite
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
@@ -67,24 +68,17 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
     return members, par, y0, theta_p.copy(), thetadot_p.copy()
 
 
-def _drifts(out: RunOutput):
-    """Relative energy and angular-momentum drift per member, |X(t_end) − X(0)| / |X(0)|."""
-    e0 = out.diag_start[:, :3].sum(1)
-    e1 = out.diag_end[:, :3].sum(1)
-    l0 = out.diag_start[:, 3:6] + out.diag_start[:, 6:9] + out.diag_start[:, 9:12]
-    l1 = out.diag_end[:, 3:6] + out.diag_end[:, 6:9] + out.diag_end[:, 9:12]
-    return (np.abs(e1 - e0) / np.abs(e0),
-            np.linalg.norm(l1 - l0, axis=1) / np.linalg.norm(l0, axis=1))
-
-
 @dataclass
 class SectionResult:
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
     ``t`` s; ``r`` pericentre distance m; ``a``, ``e`` osculating elements (m, -); ``count``
-    crossings per member; ``energy_drift``, ``angmom_drift`` relative drifts over the run;
-    ``status`` codes with ``status_names``; ``accepted``, ``rejected``, ``rhs_calls``;
+    crossings per member; ``energy_drift``, ``angmom_drift`` relative drifts of the total
+    energy and angular-momentum vector from the start to the end of the run; ``max_drift``
+    the limit they were held against (``ti_spinorbit.accuracy``); ``status`` codes with
+    ``status_names`` ("done", "inaccurate" when a drift exceeds ``max_drift``, "non-finite",
+    "collision", ...) and ``status_counts``; ``accepted``, ``rejected``, ``rhs_calls``;
     with ``indicators=True``: ``megno`` (MEGNO ⟨Y⟩ at the end: → 2 quasi-periodic, ≫ 2
     chaotic) and ``lyapunov`` (finite-time maximal Lyapunov exponent, 1/orbit), else NaN."""
 
@@ -111,11 +105,23 @@ class SectionResult:
     seconds: float = 0.0
     megno: np.ndarray = None
     lyapunov: np.ndarray = None
+    max_drift: float = float("nan")
 
     @property
     def status_names(self) -> List[str]:
         from .kernels.ensemble import STATUS_NAMES
         return [STATUS_NAMES[s] for s in self.status]
+
+    @property
+    def status_counts(self) -> dict:
+        """Members per status name, e.g. {"done": 30, "inaccurate": 2}."""
+        return accuracy.counts(self.status)
+
+    @property
+    def n_inaccurate(self) -> int:
+        """Members that finished with a drift above ``max_drift`` (data kept, status
+        "inaccurate")."""
+        return accuracy.count(self.status, "inaccurate")
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -131,7 +137,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
                        atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
                        progress=None, model="auto", checkpoint=None,
-                       resume=False) -> SectionResult:
+                       resume=False, max_drift=None) -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -166,12 +172,17 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
         Write a checkpoint after every window (atomic replace); with ``resume=True`` continue
         from it when it exists. A resumed run equals an uninterrupted one
         (``ti_spinorbit.checkpoint``).
+    max_drift : float, optional
+        Largest relative energy or angular-momentum drift of a member reported "done"; a
+        member above it is "inaccurate" (kept, counted apart). Default:
+        ``min(1e-4, 1000 · rtol · orbits)`` (``ti_spinorbit.accuracy``); a number in (0, 1].
 
     Returns
     -------
     SectionResult
     """
     orbits = check_orbits(orbits)
+    limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
@@ -179,15 +190,18 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"))
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
-    energy_drift, angmom_drift = _drifts(out)
+    energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end)
+    limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
+    status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
     return SectionResult(
         theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=cols["thetadot"],
         t=cols["t"] / n[:, None], r=cols["r"] * a[:, None], a=cols["a"] * a[:, None], e=cols["e"],
         count=np.array([len(ev) for ev in out.events]), energy_drift=energy_drift,
-        angmom_drift=angmom_drift, status=out.status, accepted=out.counters[:, 0],
+        angmom_drift=angmom_drift, status=status, accepted=out.counters[:, 0],
         rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
-        orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov)
+        orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
+        max_drift=limit)
 
 
 def _derived_columns(par, records, names, ensemble=None):
@@ -228,7 +242,10 @@ class TimeSeriesResult:
     spin rate about the orbit normal, units of n; ``r`` m; ``energy`` total, J, and its split
     ``energy_orbit`` (|P|²/2m + V), ``energy_primary``, ``energy_secondary`` (spins), J;
     ``angmom_orbit``, ``angmom_primary``, ``angmom_secondary`` inertial angular momenta,
-    (N, samples, 3), kg m² s⁻¹."""
+    (N, samples, 3), kg m² s⁻¹; ``energy_drift``, ``angmom_drift`` the largest relative drift
+    of the total energy and angular-momentum vector over every sample and the end of the run,
+    held against ``max_drift`` for the ``status`` verdict (``ti_spinorbit.accuracy``);
+    ``rtol``, ``orbits`` the run's tolerance and length (orbital periods)."""
 
     t: np.ndarray
     alpha: np.ndarray
@@ -246,19 +263,41 @@ class TimeSeriesResult:
     systems: list = field(repr=False)
     initial_theta_p: np.ndarray = None
     initial_thetadot_p: np.ndarray = None
+    energy_drift: np.ndarray = None
+    angmom_drift: np.ndarray = None
+    max_drift: float = float("nan")
+    rtol: float = float("nan")
+    orbits: float = float("nan")
+
+    @property
+    def status_names(self) -> List[str]:
+        from .kernels.ensemble import STATUS_NAMES
+        return [STATUS_NAMES[s] for s in self.status]
+
+    @property
+    def status_counts(self) -> dict:
+        """Members per status name, e.g. {"done": 3, "inaccurate": 1}."""
+        return accuracy.counts(self.status)
+
+    @property
+    def n_inaccurate(self) -> int:
+        """Members that finished with a drift above ``max_drift`` (kept, "inaccurate")."""
+        return accuracy.count(self.status, "inaccurate")
 
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
                 rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                 escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
-                resume=False) -> TimeSeriesResult:
+                resume=False, max_drift=None) -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
     initial orbital period), so samples carry the integrator's accuracy. orbits must lie in
-    (0, 1e7] (``MAX_ORBITS``), as for surface_of_section."""
+    (0, 1e7] (``MAX_ORBITS``), as for surface_of_section. The drifts are the largest over
+    every sample (and the end); ``max_drift`` as for surface_of_section."""
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
+    limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
@@ -270,8 +309,37 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])[:, None]
     l_unit = (e_unit / n[:, None])[..., None]
     energies = {k: cols[k] * e_unit for k in ("energy_orbit", "energy_primary", "energy_secondary")}
+    energy_drift, angmom_drift = _sampled_drifts(cols, out)
+    limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
+    status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
     return TimeSeriesResult(
         t=cols["t"] / n[:, None], alpha=np.degrees(cols["alpha"]), theta=np.degrees(cols["theta"]),
         thetadot=cols["thetadot"], r=cols["r"] * a[:, None], energy=sum(energies.values()),
         **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
-        status=out.status, systems=members, initial_theta_p=tp, initial_thetadot_p=td)
+        status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
+        energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
+        orbits=orbits)
+
+
+def _sampled_drifts(cols, out: RunOutput):
+    """Largest relative energy and angular-momentum drift per member over its samples and the
+    end of the run (scaled units, ``_derived_columns`` with an ensemble). A non-finite
+    diagnostic in any recorded sample makes the member's drift NaN, so it can never pass."""
+    end_energy, end_angmom = accuracy.drifts(out.diag_start, out.diag_end)
+    e0 = out.diag_start[:, :3].sum(1)[:, None]
+    l0 = (out.diag_start[:, 3:6] + out.diag_start[:, 6:9] + out.diag_start[:, 9:12])[:, None]
+    recorded = np.isfinite(cols["t"])
+    energy = cols["energy_orbit"] + cols["energy_primary"] + cols["energy_secondary"]
+    angmom = cols["angmom_orbit"] + cols["angmom_primary"] + cols["angmom_secondary"]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        de = np.abs(energy - e0) / np.abs(e0)
+        dl = np.linalg.norm(angmom - l0, axis=-1) / np.linalg.norm(l0, axis=-1)
+    bad = np.any(recorded & ~(np.isfinite(de) & np.isfinite(dl)), axis=1)
+    de = np.where(recorded, de, 0.0).max(axis=1, initial=0.0)
+    dl = np.where(recorded, dl, 0.0).max(axis=1, initial=0.0)
+    energy_drift = np.where(bad, np.nan, np.fmax(de, end_energy))
+    angmom_drift = np.where(bad, np.nan, np.fmax(dl, end_angmom))
+    # fmax ignores a NaN end diagnostic: keep it
+    energy_drift[~np.isfinite(end_energy)] = np.nan
+    angmom_drift[~np.isfinite(end_angmom)] = np.nan
+    return energy_drift, angmom_drift
