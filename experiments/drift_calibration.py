@@ -40,11 +40,11 @@ def main():
             t0 = time.perf_counter()
             s = tso.surface_of_section(system, tp, td, orbits=args.orbits, rtol=rtol, model=model)
             finished = np.isin(s.status_names, ("done", "inaccurate"))
-            e, l = s.energy_drift[finished], s.angmom_drift[finished]
+            e = np.max(s.energy_drift[finished]) if finished.any() else np.nan
+            l = np.max(s.angmom_drift[finished]) if finished.any() else np.nan
             scale = rtol * args.orbits
             print(f"{model:6s} {rtol:7.0e} {finished.sum():4d}/{len(tp):<3d} "
-                  f"{e.max(initial=np.nan):9.2e} {e.max(initial=np.nan) / scale:8.2f} "
-                  f"{l.max(initial=np.nan):9.2e} {l.max(initial=np.nan) / scale:8.2f} "
+                  f"{e:9.2e} {e / scale:8.2f} {l:9.2e} {l / scale:8.2f} "
                   f"{s.max_drift:9.2e} {s.n_inaccurate:7d} {time.perf_counter() - t0:6.1f}",
                   flush=True)
 

@@ -188,7 +188,8 @@ def test_save_result_alias_and_format_0_files(section, tmp_path):
     io.write_archive(tmp_path / "old.npz", arrays, meta)
     old = tso.load(tmp_path / "old.npz")
     assert old.seconds == 0.0                       # format 0 did not record the wall time
-    assert_same(dataclasses.replace(section, seconds=0.0), old)
+    assert math.isnan(old.max_drift)                # nor an accuracy limit: unknown
+    assert_same(dataclasses.replace(section, seconds=0.0, max_drift=float("nan")), old)
 
 
 # ---- self-description -------------------------------------------------------------------
