@@ -369,3 +369,19 @@ def test_without_debug_the_error_is_one_line(monkeypatch, capsys):
 def test_debug_shows_the_traceback_in_a_subprocess(tmp_path):
     p = run_cli("--debug", "systems", "--show", "nowhere", cwd=tmp_path)
     assert p.returncode == 1 and "Traceback" in p.stderr and "unknown system" in p.stderr
+
+
+@pytest.mark.parametrize("status, allow, expected, message", [
+    ([DONE, NONFINITE], False, 3, "1 of 2 members non-finite"),
+    ([DONE, NONFINITE], True, 0, "1 of 2 members non-finite"),
+    ([INACCURATE, NONFINITE], False, 3, "1 of 2 members inaccurate"),
+    ([DONE, COLLISION, ESCAPE, STEP_UNDERFLOW], False, 0, ""),   # outcomes, not failures
+    ([DONE, DONE], False, 0, "")])
+def test_exit_status_counts_untrustworthy_members(status, allow, expected, message, capsys):
+    import argparse
+
+    args = argparse.Namespace(command="map", allow_inaccurate=allow)
+    drift = np.where(np.array(status) == INACCURATE, 0.5, 1e-9)
+    assert cli._accuracy_status(args, np.array(status), drift, 1e-4) == expected
+    err = capsys.readouterr().err
+    assert (message in err) if message else err == ""

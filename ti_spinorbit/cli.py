@@ -471,24 +471,31 @@ def _write(result, data, extra, figure, out):
 
 
 def _accuracy_status(args, status, energy_drift, max_drift, what="members"):
-    """Exit status of a run by its accuracy verdict: prints the count of inaccurate members on
-    stderr (even with --quiet: it qualifies the results) and returns EXIT_INACCURATE unless
-    there are none or --allow-inaccurate."""
+    """Exit status of a run by its accuracy verdict. Members whose numbers cannot be trusted,
+    "inaccurate" (drift above the limit) and "non-finite" (NaN/Inf), are counted on stderr
+    (even with --quiet: it qualifies the results); returns EXIT_INACCURATE when there are any,
+    unless --allow-inaccurate. Collisions, escapes and step underflows are outcomes of a
+    start, reported per member, and do not change the exit status."""
     import numpy as np
 
-    from .kernels.ensemble import INACCURATE
+    from .kernels.ensemble import INACCURATE, NONFINITE
 
     status = np.asarray(status)
-    bad = int(np.count_nonzero(status == INACCURATE))
-    if not bad:
+    inaccurate = int(np.count_nonzero(status == INACCURATE))
+    nonfinite = int(np.count_nonzero(status == NONFINITE))
+    if not inaccurate and not nonfinite:
         return EXIT_OK
-    worst = float(np.nanmax(np.where(status == INACCURATE, energy_drift, np.nan)))
     allowed = getattr(args, "allow_inaccurate", False)
-    print(f"ti-spinorbit {args.command}: {bad} of {status.size} {what} inaccurate: "
-          f"conservation drift above {max_drift:.3g} (largest energy drift {worst:.3g}); kept "
-          f"in the data file with status 'inaccurate'"
-          + ("" if allowed else f"; tighten --rtol, or --allow-inaccurate to accept (exit "
-                                f"status {EXIT_INACCURATE})"), file=sys.stderr)
+    parts = []
+    if inaccurate:
+        worst = float(np.nanmax(np.where(status == INACCURATE, energy_drift, np.nan)))
+        parts.append(f"{inaccurate} of {status.size} {what} inaccurate: conservation drift "
+                     f"above {max_drift:.3g} (largest energy drift {worst:.3g})")
+    if nonfinite:
+        parts.append(f"{nonfinite} of {status.size} {what} non-finite (NaN/Inf)")
+    print(f"ti-spinorbit {args.command}: {'; '.join(parts)}; kept in the data file with their "
+          "status" + ("" if allowed else f"; tighten --rtol, or --allow-inaccurate to accept "
+                                         f"(exit status {EXIT_INACCURATE})"), file=sys.stderr)
     return EXIT_OK if allowed else EXIT_INACCURATE
 
 
