@@ -168,8 +168,11 @@ class ChaosMap:
         ax.set_ylabel(r"$\dot\theta_p / n$")
         if title is None and self.section is not None:
             s = self.section.systems[0]
-            title = (f"{s.name}, {self.orbits:g} orbits, chaotic fraction "
-                     f"{self.chaotic_fraction:.2f}")
+            title = (f"{s.name}, {self.orbits:g} orbits, rtol {self.rtol:.0e}, chaotic "
+                     f"fraction {self.chaotic_fraction:.2f}")
+            if self.n_inaccurate:
+                title += (f" ({self.n_inaccurate} inaccurate members "
+                          f"{'included' if self.include_inaccurate else 'excluded'})")
         if title:
             ax.set_title(title, fontsize=9)
         return ax
@@ -335,6 +338,9 @@ class ParameterMap:
         if title is None:
             title = (f"{self.name}: chaotic fraction of {self.megno.shape[-1]} starts, "
                      f"{self.orbits:g} orbits")
+            if self.n_inaccurate:
+                title += (f" ({self.n_inaccurate} inaccurate starts "
+                          f"{'included' if self.include_inaccurate else 'excluded'})")
         ax.set_title(title, fontsize=9)
         return ax
 

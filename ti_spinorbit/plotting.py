@@ -37,6 +37,8 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
     for k in range(n):
         c = result.count[k]
         label = f"θ̇p/n = {result.initial_thetadot_p[k]:.2f}" if n <= 12 else None
+        if label and result.status_names[k] != "done":     # say which points to distrust
+            label += f" ({result.status_names[k]})"
         ax.plot(result.theta_p[k, :c], result.thetadot_p[k, :c], ".", ms=markersize,
                 color=colors[k], label=label)
     ax.set_xlim(0, 180)
