@@ -385,3 +385,12 @@ def test_exit_status_counts_untrustworthy_members(status, allow, expected, messa
     assert cli._accuracy_status(args, np.array(status), drift, 1e-4) == expected
     err = capsys.readouterr().err
     assert (message in err) if message else err == ""
+
+
+def test_xarray_views_carry_the_drifts(loose_map):
+    pytest.importorskip("xarray")
+    ds = tso.to_xarray(loose_map)
+    np.testing.assert_array_equal(ds.energy_drift.values, loose_map.energy_drift)
+    assert ds.energy_drift.attrs["units"] == "1 (relative)"
+    assert ds.attrs["n_inaccurate"] == 4 and ds.attrs["max_drift"] == loose_map.max_drift
+    assert list(np.unique(ds.status_name.values)) == ["inaccurate"]

@@ -98,6 +98,9 @@ def _time_series(r, units):
                  for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")})
     data["status"] = ("member", r.status)
     data["status_name"] = ("member", io.status_names(r.status))
+    for k in ("energy_drift", "angmom_drift"):          # absent in files from before issue 10
+        if getattr(r, k, None) is not None:
+            data[k] = ("member", getattr(r, k))
     coords = {"member": np.arange(n), "sample": np.arange(width), "component": ["x", "y", "z"],
               "system": ("member", [s.name for s in r.systems])}
     if r.initial_theta_p is not None:
@@ -110,7 +113,8 @@ def _time_series(r, units):
 def _chaos_map(r, units):
     dims = ("theta_p", "thetadot_p")
     data = {k: (dims, _labels(getattr(r, k)))
-            for k in ("megno", "lyapunov", "classification", "mean_spin", "status")}
+            for k in ("megno", "lyapunov", "classification", "mean_spin", "status",
+                      "energy_drift", "angmom_drift") if getattr(r, k) is not None}
     data["status_name"] = (dims, io.status_names(r.status))
     return data, {"theta_p": r.theta_p, "thetadot_p": r.thetadot_p}
 
@@ -121,6 +125,9 @@ def _parameter_map(r, units):
             "megno": (per_start, r.megno), "labels": (per_start, _labels(r.labels)),
             "status": (per_start, r.status), "status_name": (per_start, io.status_names(r.status)),
             "omega0": ("elongation", r.omega0)}
+    for k, dims in (("energy_drift", per_start), ("angmom_drift", per_start), ("inaccurate", grid)):
+        if getattr(r, k) is not None:
+            data[k] = (dims, getattr(r, k))
     coords = {"elongation": r.elongations, "eccentricity": r.eccentricities,
               "start": np.arange(len(r.theta_p)), "theta_p": ("start", r.theta_p),
               "thetadot_p": ("start", r.thetadot_p)}
@@ -140,7 +147,8 @@ def _overlap_scan(r, units):
 
     data = {"overlaps": ("elongation", r.overlaps)}
     for name in ("omega0", "center_1", "center_3_2", "connecting_start", "connecting_megno",
-                 "connecting_lyapunov", "separatrix_chaotic_fraction"):
+                 "connecting_lyapunov", "separatrix_chaotic_fraction", "inaccurate",
+                 "max_energy_drift"):
         data[name] = ("elongation", col(name))
     data["center_3_2_found"] = ("elongation", np.array([x.center_3_2_found for x in d], dtype=bool))
     for name in ("connecting_range", "widest_range"):
