@@ -18,9 +18,13 @@ GIB = 2.0**30
 # Outside them a run is not physics but a unit mistake, and the scaled quantities over- or
 # underflow (Sphere(1e300, ...) overflowed in a**4; a density of 1e-300 gave NaN drifts).
 
-#: Largest |θ̇_p/n| of a start, and largest primary spin rate 2π/(P n): a spin 100 times the
-#: mean motion is no binary, and the step count grows with the spin (1e6 ran for minutes).
+#: Largest |θ̇_p/n| of a start (the command line's --thetadot range): a secondary spinning 100
+#: times per orbit is no binary, and the step count grows with the spin (1e6 ran for minutes).
 MAX_SPIN = 100.0
+#: Largest primary spin rate 2π/(|P| n), units of n: wide binaries spin thousands of times
+#: per orbit (a 2.5 h primary on a two-year orbit: 7000 n); the steps per orbit grow with the
+#: spin, so beyond this one orbit costs minutes per member.
+MAX_PRIMARY_SPIN = 1e5
 #: Densities, kg/m^3: from silica aerogel (~1, anything lower is a unit mistake) to five
 #: times osmium.
 MIN_DENSITY, MAX_DENSITY = 1.0, 1e5

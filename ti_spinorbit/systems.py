@@ -19,7 +19,7 @@ from typing import Optional
 
 import numpy as np
 
-from ._validate import (MAX_MASS_RATIO, MAX_SEMIMAJOR_AXIS, MAX_SPIN, MIN_LENGTH,
+from ._validate import (MAX_MASS_RATIO, MAX_PRIMARY_SPIN, MAX_SEMIMAJOR_AXIS, MIN_LENGTH,
                         MIN_MOMENT_RATIO, require_finite, require_positive_scalar, require_range,
                         require_real, show)
 from .bodies import Body
@@ -50,7 +50,7 @@ class BinarySystem:
     primary_spin_period : float, optional
         Primary's spin period about its short axis, s (None: not spinning; irrelevant for a
         spherical primary); negative for retrograde spin. Its rate 2π/|P| may be at most
-        100 n (``MAX_SPIN``, the bound on θ̇_p/n too): |P| >= orbital period / 100.
+        1e5 n (``MAX_PRIMARY_SPIN``): |P| >= orbital period / 1e5.
     name : str
         Label used in plots and saved files.
     """
@@ -89,12 +89,12 @@ class BinarySystem:
             require_finite("primary_spin_period", self.primary_spin_period)
             if self.primary_spin_period == 0:
                 raise ValueError("primary_spin_period must be non-zero (None for no spin)")
-            shortest = self.orbital_period / MAX_SPIN
+            shortest = self.orbital_period / MAX_PRIMARY_SPIN
             if abs(self.primary_spin_period) < shortest:
                 raise ValueError(
-                    f"primary_spin_period must satisfy |P| >= orbital period / {MAX_SPIN:g} = "
-                    f"{shortest:.6g} s (a spin of at most {MAX_SPIN:g} n; got "
-                    f"{self.primary_spin_period:.6g})")
+                    f"primary_spin_period must satisfy |P| >= orbital period / "
+                    f"{MAX_PRIMARY_SPIN:g} = {shortest:.6g} s (a spin of at most "
+                    f"{MAX_PRIMARY_SPIN:g} n; got {self.primary_spin_period:.6g})")
         contact = self.primary.bounding_radius + self.secondary.bounding_radius
         pericentre = self.a * (1.0 - self.e)
         if pericentre <= contact:
