@@ -17,6 +17,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import _validate
+from ti_spinorbit.overlap import overlap_vs_eccentricity
 
 P = tso.Sphere(600, 1581)
 S = tso.Ellipsoid(245, 163, 150, 2000)
@@ -156,6 +157,8 @@ TYPES = [
      r"^progress must be a callable or None \(got 5\)"),
     ("section-system-number", lambda vh: tso.surface_of_section(5, 0, 1.0, 1), TypeError,
      r"^system_or_systems must be a BinarySystem or a non-empty list of them \(got 5\)"),
+    ("section-window-text", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, window_orbits="16"),
+     TypeError, r"^window_orbits must be a number \(got '16'\)"),
     ("time-series-orbits-none", lambda vh: tso.time_series(vh, 0, 1.0, None), TypeError,
      r"^orbits must be a number \(got None\)"),
     ("time-series-samples-bool",
@@ -199,6 +202,9 @@ TYPES = [
      r"^elongations must be a real number, not complex"),
     ("overlap-libration-limit-range", lambda vh: _ov(vh, libration_limit=120), ValueError,
      r"^libration_limit must lie in \(0, 90\] deg \(got 120\)"),
+    ("overlap-vs-eccentricity-complex",
+     lambda vh: overlap_vs_eccentricity("1991 VH", [0.1j], elongations=[1.02], orbits=1),
+     TypeError, r"^eccentricities must be a real number, not complex"),
     ("overlap-system-number", lambda vh: tso.overlap_threshold(5, elongations=[1.02], orbits=1),
      TypeError, r"^system_name_or_factory must be a catalogue name or a callable"),
     # relaxed_libration / libration_amplitude
@@ -272,6 +278,44 @@ def test_long_arrays_are_shown_by_shape_not_printed():
     assert str(err.value) == "theta_p must be finite (got array of shape (40, 40))"
 
 
+def test_refusals_come_before_taichi_starts(tmp_path):
+    """In a fresh interpreter, a run of refused calls leaves Taichi uninitialised: the checks
+    come before any kernel work."""
+    script = tmp_path / "refuse.py"
+    script.write_text(
+        "import ti_spinorbit as tso\n"
+        "from ti_spinorbit import runtime\n"
+        "vh = tso.catalog.system('1991 VH')\n"
+        "calls = [lambda: tso.surface_of_section(vh, 0, 1e6, 1),\n"
+        "         lambda: tso.surface_of_section(vh, 0, 1.0, 1, rtol='x'),\n"
+        "         lambda: tso.surface_of_section(vh, 0, 1.0, 1, window_orbits='x'),\n"
+        "         lambda: tso.time_series(vh, 1j, 1.0, 1),\n"
+        "         lambda: tso.chaos_map(vh, [0.0], [1e9], 1),\n"
+        "         lambda: tso.relaxed_libration(vh, orbits=[5]),\n"
+        "         lambda: tso.overlap_threshold('1991 VH', elongations=[1.02], orbits=1, rtol=[1]),\n"
+        "         lambda: tso.mutual_potential(vh.primary, vh.secondary, [3000, 0, 0],\n"
+        "                                      [[1, 0, 0], [0, 1, 0], [0, 0, -1]])]\n"
+        "for call in calls:\n"
+        "    try:\n"
+        "        call()\n"
+        "    except (TypeError, ValueError):\n"
+        "        pass\n"
+        "    else:\n"
+        "        raise SystemExit('not refused')\n"
+        "print('arch', runtime.current_arch())\n")
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         timeout=120, env=_env())
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.strip().splitlines()[-1] == "arch None"
+
+
+def _env():
+    """The environment with this checkout first on PYTHONPATH (for subprocesses)."""
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [os.path.dirname(os.path.dirname(os.path.abspath(tso.__file__)))]
+        + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+
+
 # ---- 3 (part). spin rates and the primary's spin are bounded as on the command line -------
 
 SPIN = [
@@ -342,10 +386,7 @@ API_NAMES = r"(?<![-\w])(elongations?|secondary_density|thetadot_p|theta_p|eccen
 
 @pytest.mark.parametrize("argv, message", CLI, ids=[" ".join(a) for a, _ in CLI])
 def test_cli_names_the_flag(argv, message, tmp_path):
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [os.path.dirname(os.path.dirname(os.path.abspath(tso.__file__)))]
-        + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
-    run = subprocess.run([sys.executable, "-m", "ti_spinorbit", *argv], cwd=tmp_path, env=env,
+    run = subprocess.run([sys.executable, "-m", "ti_spinorbit", *argv], cwd=tmp_path, env=_env(),
                          capture_output=True, text=True, timeout=120)
     lines = run.stderr.strip().splitlines()
     assert run.returncode == 2, run.stderr

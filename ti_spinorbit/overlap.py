@@ -247,7 +247,7 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     """Overlap scans of a catalogued system at several eccentricities (same kwargs as
     :func:`overlap_threshold`, ``client`` included). Returns (eccentricities, numerical
     first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
-    ecc = np.asarray(eccentricities, dtype=np.float64).ravel()
+    ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
     scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
              for e in ecc]

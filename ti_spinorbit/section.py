@@ -36,12 +36,13 @@ def check_orbits(orbits):
     return value
 
 
-def _check_run_inputs(rtol, atol, order, progress):
-    """Tolerances, order and progress callback, checked before any Taichi work."""
+def _check_run_inputs(rtol, atol, order, progress, window_orbits):
+    """Tolerances, order, window and progress callback, checked before any Taichi work."""
     from .ensemble import check_tolerances
 
     check_tolerances(rtol, atol)
     require_order(order)
+    require_count("window_orbits", window_orbits, 1, 10**6)      # as Ensemble.run
     require_callable("progress", progress)
 
 
@@ -187,7 +188,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     SectionResult
     """
     orbits = check_orbits(orbits)
-    _check_run_inputs(rtol, atol, order, progress)
+    _check_run_inputs(rtol, atol, order, progress, window_orbits)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
@@ -275,7 +276,7 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     (0, 1e7] (``MAX_ORBITS``), as for surface_of_section."""
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
-    _check_run_inputs(rtol, atol, order, progress)
+    _check_run_inputs(rtol, atol, order, progress, window_orbits)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
