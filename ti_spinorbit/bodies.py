@@ -79,8 +79,8 @@ class Body:
     bounding_radius : float
         Radius (m) of a sphere about the centre of mass that contains the body; used for the
         collision test and the overlap check at start. In [1e-3, 1e10] m (``MIN_LENGTH``,
-        ``MAX_LENGTH``) and at least the body's RMS radius sqrt((T^200 + T^020 + T^002)/mass),
-        since no mass distribution fits in a smaller sphere.
+        ``MAX_LENGTH``) and no smaller than the integrals allow: a body inside a sphere of
+        radius ρ has (T^200 + T^020 + T^002) <= mass ρ² and |T^lmn| <= mass ρ^(l+m+n).
     name : str
         Free text used in plots and saved files.
     """
@@ -118,12 +118,16 @@ class Body:
             if self.integrals.get(k, 0.0) < 0:
                 raise ValueError(f"integrals[{k}] must be >= 0: a second moment ∫ x_i² dm "
                                  f"(got {self.integrals[k]!r})")
-        rms = math.sqrt(trace / float(self.mass))
-        if float(self.bounding_radius) < rms * (1.0 - 1e-12):
+        # a body inside a sphere of radius ρ has ∫ r² dm <= M ρ² and |T^lmn| <= M ρ^(l+m+n)
+        mass = float(self.mass)
+        rms = math.sqrt(trace / mass)
+        smallest = max([rms] + [(abs(v) / mass) ** (1.0 / sum(k))
+                                for k, v in self.integrals.items() if v])
+        if float(self.bounding_radius) < smallest * (1.0 - 1e-12):
             raise ValueError(
-                f"bounding_radius must be >= the body's RMS radius sqrt((T^200 + T^020 + "
-                f"T^002)/mass) = {rms:.6g} m: no body fits in a smaller sphere "
-                f"(got {float(self.bounding_radius):.6g})")
+                f"bounding_radius must be >= {smallest:.6g} m, the smallest sphere the integrals "
+                f"allow (RMS radius sqrt((T^200 + T^020 + T^002)/mass) = {rms:.6g} m, and "
+                f"|T^lmn| <= mass radius^(l+m+n)) (got {float(self.bounding_radius):.6g})")
         row = [self.mass]
         for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
             row += [float(self.integrals.get(k, 0.0)) for k in group]
@@ -174,6 +178,9 @@ class Body:
         if points.ndim != 2 or points.shape[1] != 3 or masses.shape != points.shape[:1]:
             raise ValueError("points must have shape (n, 3) and masses shape (n,)")
         require_finite("points", points)
+        if points.size and np.abs(points).max() > MAX_LENGTH:
+            raise ValueError(f"points must lie within {MAX_LENGTH:g} m of the origin (got a "
+                             f"coordinate of {np.abs(points).max():g} m)")
         if np.any(masses <= 0) or not np.all(np.isfinite(masses)):
             raise ValueError("masses must all be finite and > 0")
         total = masses.sum()
