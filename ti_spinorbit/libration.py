@@ -199,8 +199,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     rtol : float
         Integrator tolerance.
     candidates : array, optional
-        Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending; default
-        45 values over 0.2-1.3.
+        Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending, each in
+        [-100, 100] (``_validate.MAX_SPIN``); default 45 values over 0.2-1.3.
     zoom_candidates : int
         Candidates per zoom launch (odd, so the window's centre is one of them).
     xtol : float

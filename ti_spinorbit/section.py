@@ -56,8 +56,11 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
     if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
         raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
                          f"(got {escape_distance!r})")
-    systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else \
-        list(system_or_systems) if isinstance(system_or_systems, (list, tuple)) else []
+    try:
+        systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else \
+            list(system_or_systems)
+    except TypeError:                       # not iterable (a number, None)
+        systems = []
     if not systems or not all(isinstance(s, BinarySystem) for s in systems):
         raise TypeError("system_or_systems must be a BinarySystem or a non-empty list of them "
                         f"(got {show(system_or_systems)})")
