@@ -298,7 +298,7 @@ def test_ellipsoid_needs_exactly_one_of_density_and_mass():
         Sphere(1.0)
 
 
-GOOD_SECOND = {(2, 0, 0): 3.0, (0, 2, 0): 2.0, (0, 0, 2): 1.0}
+GOOD_SECOND = {(2, 0, 0): 0.3, (0, 2, 0): 0.2, (0, 0, 2): 0.1}   # fits in a sphere of radius 1
 
 
 @pytest.mark.parametrize("value", BAD_NUMBERS)

@@ -4,6 +4,7 @@ Each error names the parameter, the value received and the allowed range, so a r
 can fix the call without reading the source."""
 
 import math
+import numbers
 import os
 
 import numpy as np
@@ -12,6 +13,129 @@ import numpy as np
 #: left for the interpreter, Taichi and the operating system).
 MEMORY_FRACTION = 0.8
 GIB = 2.0**30
+
+# ---- physical bounds, shared by the library and the command line -------------------------
+# Outside them a run is not physics but a unit mistake, and the scaled quantities over- or
+# underflow (Sphere(1e300, ...) overflowed in a**4; a density of 1e-300 gave NaN drifts).
+
+#: Largest |θ̇_p/n| of a start (the command line's --thetadot range): a secondary spinning 100
+#: times per orbit is no binary, and the step count grows with the spin (1e6 ran for minutes).
+MAX_SPIN = 100.0
+#: Largest primary spin rate 2π/(|P| n), units of n: wide binaries spin thousands of times
+#: per orbit (a 2.5 h primary on a two-year orbit: 7000 n); the steps per orbit grow with the
+#: spin, so beyond this one orbit costs minutes per member.
+MAX_PRIMARY_SPIN = 1e5
+#: Densities, kg/m^3: from silica aerogel (~1, anything lower is a unit mistake) to five
+#: times osmium.
+MIN_DENSITY, MAX_DENSITY = 1.0, 1e5
+#: Lengths of a body (semi-axes, radius, bounding radius), m: a millimetre to ten solar radii.
+MIN_LENGTH, MAX_LENGTH = 1e-3, 1e10
+#: Mass of a body, kg: a microgram to 5e4 solar masses.
+MIN_MASS, MAX_MASS = 1e-9, 1e35
+#: Largest semimajor axis of the mutual orbit, m (67 au); the smallest is set by contact.
+MAX_SEMIMAJOR_AXIS = 1e13
+#: Largest mass ratio m1/m2 or m2/m1 of a binary: beyond it the lighter body's terms drown
+#: in round-off of the scaled (m1 + m2 = 1) quantities.
+MAX_MASS_RATIO = 1e12
+#: Smallest principal moment of a body relative to its largest: a body collapsed onto a line
+#: has a zero moment and its spin equations divide by it (two point masses gave NaN).
+MIN_MOMENT_RATIO = 1e-6
+
+
+def show(value, limit=80):
+    """A one-line, bounded text of ``value`` for error messages: short sequences as lists,
+    long arrays by their shape, text cut at ``limit`` characters."""
+    if isinstance(value, np.ndarray):
+        if value.size > 8:
+            return f"array of shape {value.shape}"
+        text = repr(value.tolist())
+    elif isinstance(value, (list, tuple)) and len(value) > 8:
+        return f"{type(value).__name__} of length {len(value)}"
+    else:
+        text = repr(value)
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _fmt(x):
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def require_real(name, value):
+    """``value`` as a float, or TypeError naming the parameter unless it is ONE real number
+    (int, float, NumPy real scalar or 0-d array): not text, None, bool, complex, a list or an
+    array of several values."""
+    if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+        return float(value)
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        return float(value)
+    if isinstance(value, (list, tuple, np.ndarray)):
+        raise TypeError(f"{name} must be a single number, not a {type(value).__name__} "
+                        f"(got {show(value)})")
+    if isinstance(value, (bool, np.bool_)):
+        what = "a number, not a bool"
+    elif isinstance(value, (complex, np.complexfloating)):
+        what = "a real number, not complex"
+    else:
+        what = "a number"
+    raise TypeError(f"{name} must be {what} (got {show(value)})")
+
+
+def require_scalar(name, value, low=-math.inf, high=math.inf, *, low_open=False,
+                   high_open=False, unit=""):
+    """``value`` as a float: one real number (:func:`require_real`, else TypeError), finite,
+    in the interval (ends as flagged, else ValueError "<name> must lie in [low, high] <unit>
+    (got ...)"). Infinite ends only check finiteness."""
+    number = require_real(name, value)
+    ok = math.isfinite(number)
+    ok = ok and (number > low if low_open else number >= low)
+    ok = ok and (number < high if high_open else number <= high)
+    if not ok:
+        if low == -math.inf and high == math.inf:
+            raise ValueError(f"{name} must be finite (got {show(value)})")
+        lb = "(" if low_open else "["
+        hb = ")" if high_open else "]"
+        unit = f" {unit}" if unit else ""
+        raise ValueError(f"{name} must lie in {lb}{_fmt(low)}, {_fmt(high)}{hb}{unit} "
+                         f"(got {show(value)})")
+    return number
+
+
+def require_positive_scalar(name, value, low, high, unit=""):
+    """One real number (TypeError otherwise) that is finite and > 0 (require_positive's
+    message) and lies in [low, high] (require_scalar's message); returns it as a float."""
+    require_real(name, value)
+    require_positive(name, value)
+    return require_scalar(name, value, low, high, unit=unit)
+
+
+def require_order(order):
+    """The truncation order of the mutual potential as an int: one of 0, 2, 3, 4."""
+    if isinstance(order, (bool, np.bool_, str, bytes)) or np.ndim(order) != 0:
+        raise TypeError(f"order must be one of the integers 0, 2, 3, 4 (got {show(order)})")
+    if order not in (0, 2, 3, 4):
+        raise ValueError(f"order must be 0, 2, 3 or 4 (got {show(order)})")
+    return int(order)
+
+
+def require_callable(name, value):
+    """None or a callable, else TypeError naming the parameter (a progress callback that is
+    not callable would fail only after the first window of a long run)."""
+    if value is not None and not callable(value):
+        raise TypeError(f"{name} must be a callable or None (got {show(value)})")
+    return value
+
+
+def require_spin(name, value):
+    """Spin rates in units of n (scalar or array): finite with |value| <= MAX_SPIN."""
+    arr = _as_floats(name, value)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} must be finite (got {show(value)})")
+    if np.any(np.abs(arr) > MAX_SPIN):
+        worst = float(arr.flat[np.argmax(np.abs(arr))])
+        raise ValueError(f"{name} must lie in [{-MAX_SPIN:g}, {MAX_SPIN:g}] (units of the mean "
+                         f"motion n; got {worst:g})")
+    return value
 
 
 class InsufficientMemoryError(ValueError, MemoryError):
@@ -22,19 +146,25 @@ class InsufficientMemoryError(ValueError, MemoryError):
 def _as_floats(name, value):
     """``value`` as a float64 array, or TypeError naming the parameter (text is not a number,
     even where NumPy would parse it)."""
-    if isinstance(value, (str, bytes)) or np.asarray(value).dtype.kind in "USV":
-        raise TypeError(f"{name} must be a number (got {value!r})")
+    try:
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):                    # ragged nesting
+        kind = "O"
+    if value is None or isinstance(value, (str, bytes)) or kind in "USV":
+        raise TypeError(f"{name} must be a number (got {show(value)})")
+    if kind == "c":
+        raise TypeError(f"{name} must be a real number, not complex (got {show(value)})")
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number (got {value!r})") from None
+        raise TypeError(f"{name} must be a number (got {show(value)})") from None
 
 
 def require_finite(name, value):
     """Raise ValueError unless every element of ``value`` is a finite number."""
     arr = _as_floats(name, value)
     if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} must be finite (got {value!r})")
+        raise ValueError(f"{name} must be finite (got {show(value)})")
     return value
 
 
@@ -42,7 +172,7 @@ def require_positive(name, value):
     """Raise ValueError unless ``value`` (scalar or array) is finite and > 0."""
     arr = _as_floats(name, value)
     if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"{name} must be a finite number > 0 (got {value!r})")
+        raise ValueError(f"{name} must be a finite number > 0 (got {show(value)})")
     return value
 
 
@@ -55,7 +185,7 @@ def require_range(name, value, low, high, *, low_open=False, high_open=True):
     if not np.all(ok):
         lb = "(" if low_open else "["
         hb = ")" if high_open else "]"
-        raise ValueError(f"{name} must lie in {lb}{low}, {high}{hb} (got {value!r})")
+        raise ValueError(f"{name} must lie in {lb}{low}, {high}{hb} (got {show(value)})")
     return value
 
 
@@ -63,8 +193,8 @@ def require_count(name, value, minimum=1, maximum=math.inf):
     """Raise ValueError unless ``value`` is an integer in [minimum, maximum]."""
     arr = _as_floats(name, value)
     number = float(arr) if arr.ndim == 0 else math.nan
-    if isinstance(value, bool) or not number.is_integer() or not minimum <= number <= maximum:
-        raise ValueError(f"{name} must be an integer in [{minimum}, {maximum}] (got {value!r})")
+    if isinstance(value, (bool, np.bool_)) or not number.is_integer() or not minimum <= number <= maximum:
+        raise ValueError(f"{name} must be an integer in [{minimum}, {maximum}] (got {show(value)})")
     return int(value)
 
 

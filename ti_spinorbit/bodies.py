@@ -20,7 +20,9 @@ from typing import Dict, Tuple
 
 import numpy as np
 
-from ._validate import require_finite, require_positive
+from ._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LENGTH, MIN_MASS,
+                        MIN_MOMENT_RATIO, require_finite,
+                        require_positive_scalar, require_real, show, _as_floats)
 
 # Fixed orders of the monomials, shared with the kernels (kernels/potential.py unrolls them).
 EXPONENTS_2 = ((2, 0, 0), (0, 2, 0), (0, 0, 2))
@@ -66,14 +68,19 @@ class Body:
     Parameters
     ----------
     mass : float
-        Mass in kg (> 0).
+        Mass in kg, in [1e-9, 1e35] (``MIN_MASS``, ``MAX_MASS`` of ``ti_spinorbit._validate``).
     integrals : dict
         ``{(l, m, n): T^{lmn}}`` for l + m + n in {2, 3, 4}, SI units (kg m^{l+m+n}).
         Missing entries are zero. Second-order off-diagonal terms must vanish: the frame is
-        the principal-axis frame.
+        the principal-axis frame. The second moments T^200, T^020, T^002 must be >= 0. (A
+        body collapsed onto a line has a zero principal moment: its potential is fine, but
+        :class:`~ti_spinorbit.systems.BinarySystem` refuses it, since the spin equations
+        divide by the moments.)
     bounding_radius : float
         Radius (m) of a sphere about the centre of mass that contains the body; used for the
-        collision test and the overlap check at start.
+        collision test and the overlap check at start. In [1e-3, 1e10] m (``MIN_LENGTH``,
+        ``MAX_LENGTH``) and no smaller than the integrals allow: a body inside a sphere of
+        radius ρ has (T^200 + T^020 + T^002) <= mass ρ² and |T^lmn| <= mass ρ^(l+m+n).
     name : str
         Free text used in plots and saved files.
     """
@@ -85,12 +92,18 @@ class Body:
     _row: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        require_positive("mass", self.mass)
-        require_positive("bounding_radius", self.bounding_radius)
+        require_positive_scalar("mass", self.mass, MIN_MASS, MAX_MASS, "kg")
+        require_positive_scalar("bounding_radius", self.bounding_radius, MIN_LENGTH, MAX_LENGTH, "m")
+        if not isinstance(self.integrals, dict):
+            raise TypeError(f"integrals must be a dict {{(l, m, n): T^lmn}} (got "
+                            f"{type(self.integrals).__name__} {show(self.integrals)})")
+        if not isinstance(self.name, str):
+            raise TypeError(f"name must be a string (got {show(self.name)})")
         for key, value in self.integrals.items():
             if not isinstance(key, tuple) or len(key) != 3 or sum(key) not in (2, 3, 4) or min(key) < 0:
                 raise ValueError(
                     f"integrals: key {key!r} is not (l, m, n) with l + m + n in 2..4")
+            require_real(f"integrals[{key}]", value)
             require_finite(f"integrals[{key}]", value)
         trace = sum(self.integrals.get(k, 0.0) for k in EXPONENTS_2)
         if not trace > 0.0:
@@ -101,6 +114,20 @@ class Body:
                     f"integrals[{k}] = {self.integrals[k]!r}: the body frame must be its "
                     "principal-axis frame (off-diagonal second-order integrals must be 0); "
                     "Body.from_point_masses rotates a mass distribution into it")
+        for k in EXPONENTS_2:
+            if self.integrals.get(k, 0.0) < 0:
+                raise ValueError(f"integrals[{k}] must be >= 0: a second moment ∫ x_i² dm "
+                                 f"(got {self.integrals[k]!r})")
+        # a body inside a sphere of radius ρ has ∫ r² dm <= M ρ² and |T^lmn| <= M ρ^(l+m+n)
+        mass = float(self.mass)
+        rms = math.sqrt(trace / mass)
+        smallest = max([rms] + [(abs(v) / mass) ** (1.0 / sum(k))
+                                for k, v in self.integrals.items() if v])
+        if float(self.bounding_radius) < smallest * (1.0 - 1e-12):
+            raise ValueError(
+                f"bounding_radius must be >= {smallest:.6g} m, the smallest sphere the integrals "
+                f"allow (RMS radius sqrt((T^200 + T^020 + T^002)/mass) = {rms:.6g} m, and "
+                f"|T^lmn| <= mass radius^(l+m+n)) (got {float(self.bounding_radius):.6g})")
         row = [self.mass]
         for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
             row += [float(self.integrals.get(k, 0.0)) for k in group]
@@ -146,11 +173,14 @@ class Body:
         its principal axes (x = smallest moment, i.e. the long axis).
 
         Returns ``(body, rotation)``: ``rotation`` takes the input frame to the body frame."""
-        points = np.asarray(points, dtype=np.float64)
-        masses = np.asarray(masses, dtype=np.float64)
+        points = _as_floats("points", points)
+        masses = _as_floats("masses", masses)
         if points.ndim != 2 or points.shape[1] != 3 or masses.shape != points.shape[:1]:
             raise ValueError("points must have shape (n, 3) and masses shape (n,)")
         require_finite("points", points)
+        if points.size and np.abs(points).max() > MAX_LENGTH:
+            raise ValueError(f"points must lie within {MAX_LENGTH:g} m of the origin (got a "
+                             f"coordinate of {np.abs(points).max():g} m)")
         if np.any(masses <= 0) or not np.all(np.isfinite(masses)):
             raise ValueError("masses must all be finite and > 0")
         total = masses.sum()
@@ -177,12 +207,22 @@ class Body:
 def Ellipsoid(a, b, c, density=None, *, mass=None, name="ellipsoid") -> Body:
     """Uniform triaxial ellipsoid with semi-axes a ≥ b ≥ c (m) along x, y, z.
 
-    Give exactly one of ``density`` (kg m^-3) or ``mass`` (kg). x is the long axis and z the
-    short one (the spin axis of a principal-axis rotator)."""
+    Give exactly one of ``density`` (kg m^-3, in [1, 1e5]: ``MIN_DENSITY``, ``MAX_DENSITY``)
+    or ``mass`` (kg, in [1e-9, 1e35]). Semi-axes lie in [1e-3, 1e10] m (``MIN_LENGTH``,
+    ``MAX_LENGTH``) and the body may not be a needle: (b² + c²)/(a² + b²) >= 1e-6 (its
+    smallest principal moment over its largest). x is the long axis and z the short one (the
+    spin axis of a principal-axis rotator)."""
     for label, value in (("a", a), ("b", b), ("c", c)):
-        require_positive(label, value)
+        require_positive_scalar(label, value, MIN_LENGTH, MAX_LENGTH, "m")
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a string (got {show(name)})")
     if not a >= b >= c:
         raise ValueError(f"semi-axes must satisfy a >= b >= c (got a={a}, b={b}, c={c})")
+    a, b, c = float(a), float(b), float(c)
+    if (b * b + c * c) < MIN_MOMENT_RATIO * (a * a + b * b):
+        raise ValueError(f"semi-axes a={a:g}, b={b:g}, c={c:g} make a needle: (b² + c²)/(a² + b²) "
+                         f"must be >= {MIN_MOMENT_RATIO:g} (its smallest principal moment over "
+                         f"its largest)")
     volume = 4.0 / 3.0 * math.pi * a * b * c
     mass = _mass_from(volume, density, mass)
     integrals = {}
@@ -203,8 +243,9 @@ def Sphere(radius, density=None, *, mass=None, name="sphere") -> Body:
     """Uniform sphere of ``radius`` (m); give ``density`` (kg m^-3) or ``mass`` (kg).
 
     Its exterior field is exactly that of a point mass; the integrals are kept anyway so the
-    same kernels serve every body."""
-    require_positive("radius", radius)
+    same kernels serve every body. ``radius`` in [1e-3, 1e10] m; density and mass bounds as
+    for :func:`Ellipsoid`."""
+    require_positive_scalar("radius", radius, MIN_LENGTH, MAX_LENGTH, "m")
     return Ellipsoid(radius, radius, radius, density, mass=mass, name=name)
 
 
@@ -212,7 +253,7 @@ def _mass_from(volume, density, mass):
     if (density is None) == (mass is None):
         raise ValueError("give exactly one of density (kg/m^3) or mass (kg)")
     if mass is not None:
-        require_positive("mass", mass)
-        return float(mass)
-    require_positive("density", density)
-    return float(density) * volume
+        return require_positive_scalar("mass", mass, MIN_MASS, MAX_MASS, "kg")
+    density = require_positive_scalar("density", density, MIN_DENSITY, MAX_DENSITY, "kg/m^3")
+    return require_positive_scalar("mass (density × volume)", density * volume, MIN_MASS, MAX_MASS,
+                                   "kg")

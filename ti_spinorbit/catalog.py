@@ -11,7 +11,8 @@ import math
 from functools import lru_cache
 from importlib import resources
 
-from ._validate import require_positive, require_range
+from ._validate import (MAX_DENSITY, MIN_DENSITY, require_positive_scalar, require_range,
+                        require_real)
 from .bodies import Ellipsoid, Sphere
 from .systems import BinarySystem
 
@@ -45,14 +46,34 @@ def _resolve(name):
 
 
 def system(name, elongation=None, secondary_density=None, eccentricity=None) -> BinarySystem:
-    """A catalogued system as a BinarySystem, optionally with the elongation a/b (>= 1),
-    secondary density ρ_s (kg m^-3) or eccentricity (0 <= e < 1) changed.
+    """A catalogued system as a BinarySystem, optionally with the elongation a/b (in [1, 10],
+    and small enough that b >= c), secondary density ρ_s (kg m^-3, in [1, 1e5]: ``MIN_DENSITY``,
+    ``MAX_DENSITY`` of ``ti_spinorbit._validate``) or eccentricity (0 <= e < 1, and small
+    enough that the bodies clear each other at pericentre) changed.
 
     The energy-test case ("test") has fixed shapes; only its eccentricity may change."""
     key = _resolve(name)
     d = _data()[key]
     e = d["e"] if eccentricity is None else eccentricity
+    require_real("eccentricity", e)
     require_range("eccentricity", e, 0.0, 1.0)
+    for label, value in (("elongation", elongation), ("secondary_density", secondary_density)):
+        if value is not None:
+            require_real(label, value)
+    try:
+        return _system(key, d, e, elongation, secondary_density)
+    except ValueError as exc:
+        if eccentricity is None or not str(exc).startswith("bodies overlap at pericentre"):
+            raise
+        system = _system(key, d, 0.0, elongation, secondary_density)
+        contact = system.primary.bounding_radius + system.secondary.bounding_radius
+        raise ValueError(f"eccentricity must lie in [0, {1.0 - contact / system.a:.4g}) for {key}: "
+                         f"at {eccentricity:g} the bodies overlap at pericentre (a(1-e) = "
+                         f"{system.a * (1 - eccentricity):.6g} m, sum of bounding radii "
+                         f"{contact:.6g} m)") from None
+
+
+def _system(key, d, e, elongation, secondary_density):
     if key == "test":
         if elongation is not None or secondary_density is not None:
             raise ValueError("the 'test' system has fixed shapes: only eccentricity may be changed")
@@ -64,7 +85,7 @@ def system(name, elongation=None, secondary_density=None, eccentricity=None) -> 
     q = d["elongation"] if elongation is None else elongation
     require_range("elongation", q, 1.0, 10.0, high_open=False)
     rho_s = d["rho_s"] if secondary_density is None else secondary_density
-    require_positive("secondary_density", rho_s)
+    require_positive_scalar("secondary_density", rho_s, MIN_DENSITY, MAX_DENSITY, "kg/m^3")
     a_s, b_s, c_s = math.sqrt(d["ab"] * q), math.sqrt(d["ab"] / q), d["c"]
     if c_s > b_s:
         raise ValueError(f"elongation {q} makes b = {b_s:.4g} m < c = {c_s} m for {key}: "

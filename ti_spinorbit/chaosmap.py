@@ -25,7 +25,8 @@ from typing import Callable, Optional, Union
 import numpy as np
 
 from . import accuracy, analytic, catalog
-from ._validate import require_positive
+from ._validate import (_as_floats, require_callable, require_positive, require_real,
+                        require_spin)
 from .classify import MIN_POINTS, classify_section
 from .distributed import sections
 from .section import SectionResult, check_orbits
@@ -40,8 +41,9 @@ PARAMETER_MAP_THETADOT_P = tuple(np.linspace(0.6, 2.0, 12))
 
 
 def _axis(name, values):
-    """A 1-D float array of finite values with at least one element, or ValueError."""
-    arr = np.asarray(values, dtype=np.float64)
+    """A 1-D float array of finite values with at least one element, or ValueError (TypeError
+    for text, complex values or None)."""
+    arr = _as_floats(name, values)
     if arr.ndim == 0:
         arr = arr.reshape(1)
     if arr.ndim != 1 or arr.size < 1:
@@ -49,6 +51,16 @@ def _axis(name, values):
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must be finite (got {values!r})")
     return arr
+
+
+def _check_map_inputs(rtol, megno_chaotic, progress):
+    """Scalars of chaos_map and parameter_map, checked before any member is built."""
+    from .ensemble import check_tolerances
+
+    check_tolerances(rtol, None)
+    require_real("megno_chaotic", megno_chaotic)
+    require_positive("megno_chaotic", megno_chaotic)
+    require_callable("progress", progress)
 
 
 def _chaotic_fraction(labels, status, include_inaccurate=False):
@@ -202,7 +214,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     theta_p : 1-D array
         Initial θ_p values, deg (x axis of the map).
     thetadot_p : 1-D array
-        Initial θ̇_p/n values, units of n (y axis).
+        Initial θ̇_p/n values, units of n (y axis), in [-100, 100] (``_validate.MAX_SPIN``).
     orbits : float
         Integration time in orbital periods, > 0. ⟨Y⟩ of a chaotic orbit grows ≈ λ t / 2, so
         with λ ≈ 0.5/orbit a few tens of orbits separate the classes; weak chaos needs more.
@@ -235,10 +247,9 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     if not isinstance(system, BinarySystem):
         raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
     theta_p = _axis("theta_p", theta_p)
-    thetadot_p = _axis("thetadot_p", thetadot_p)
+    thetadot_p = require_spin("thetadot_p", _axis("thetadot_p", thetadot_p))
     check_orbits(orbits)
-    require_positive("rtol", rtol)
-    require_positive("megno_chaotic", megno_chaotic)
+    _check_map_inputs(rtol, megno_chaotic, progress)
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
@@ -378,9 +389,9 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     elongations = _axis("elongations", elongations)
     eccentricities = _axis("eccentricities", eccentricities)
     theta_p = _axis("theta_p", theta_p)
-    thetadot_p = _axis("thetadot_p", thetadot_p)
+    thetadot_p = require_spin("thetadot_p", _axis("thetadot_p", thetadot_p))
     check_orbits(orbits)
-    require_positive("rtol", rtol)
+    _check_map_inputs(rtol, megno_chaotic, progress)
     if np.any(elongations < 1.0):
         raise ValueError(f"elongations must be >= 1 (got {elongations!r})")
     if np.any((eccentricities < 0.0) | (eccentricities >= 1.0)):

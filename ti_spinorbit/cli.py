@@ -36,6 +36,7 @@ import os
 import shlex
 import sys
 
+from ._validate import MAX_DENSITY, MAX_SPIN, MIN_DENSITY  # bounds shared with the library
 from .section import MAX_ORBITS  # orbits limit shared with the library
 
 #: Exit statuses (README "Statuses, exit codes and accuracy").
@@ -45,20 +46,18 @@ RTOL_RANGE = (1e-16, 1e-2)
 #: Largest grid side of a chaos map, and most members of any run.
 MAX_GRID = 1024
 MAX_MEMBERS = 2**20
-#: Largest |θ̇_p/n| accepted for a start (a spin 100 times the mean motion is no binary).
-MAX_SPIN = 100.0
 #: Largest elongation a/b (the catalogue's own limit) and scan length.
 MAX_ELONGATION = 10.0
 MAX_SCAN_STEPS = 1001
-#: Largest --density, kg/m^3 (five times osmium: anything above is a unit mistake).
-MAX_DENSITY = 1e5
+#: Smallest --elongations STEP (a/b is rounded to 10 digits; finer steps are meaningless).
+MIN_ELONGATION_STEP = 1e-6
 #: dest -> (flag, low, high, low_open, high_open): the allowed interval of every plain
 #: numeric flag, whichever subcommand has it.
 FLAG_RANGES = {
     "orbits": ("--orbits", 0.0, MAX_ORBITS, True, False),
     "rtol": ("--rtol", RTOL_RANGE[0], RTOL_RANGE[1], False, False),
     "elongation": ("--elongation", 1.0, MAX_ELONGATION, False, False),
-    "density": ("--density", 0.0, MAX_DENSITY, True, False),
+    "density": ("--density", MIN_DENSITY, MAX_DENSITY, False, False),
     "eccentricity": ("--eccentricity", 0.0, 1.0, False, True),
     "theta_p": ("--theta-p", -360.0, 360.0, False, False),
     "thetadot": ("--thetadot", -MAX_SPIN, MAX_SPIN, False, False),
@@ -190,7 +189,7 @@ def _parser():
             s.add_argument("--elongation", type=float,
                            help=f"secondary a/b in [1, {MAX_ELONGATION:g}] (default: catalogue value)")
             s.add_argument("--density", type=float,
-                           help=f"secondary density, kg/m^3, in (0, {MAX_DENSITY:g}] (default: catalogue value)")
+                           help=f"secondary density, kg/m^3, in [{MIN_DENSITY:g}, {MAX_DENSITY:g}] (default: catalogue value)")
         s.add_argument("--eccentricity", type=float,
                        help="initial osculating eccentricity in [0, 1) (default: catalogue value)")
 
@@ -366,16 +365,23 @@ def check_args(args):
         start, stop, step = args.elongations
         _check_range("--elongations START", start, 1.0, MAX_ELONGATION, low_open=True)
         _check_range("--elongations STOP", stop, start, MAX_ELONGATION)
-        _check_range("--elongations STEP", step, 0.0, MAX_ELONGATION, low_open=True)
+        _check_range("--elongations STEP", step, MIN_ELONGATION_STEP, MAX_ELONGATION)
         if (stop - start) / step + 1 > MAX_SCAN_STEPS:
             raise ValueError(f"--elongations: at most {MAX_SCAN_STEPS} elongations per scan "
                              f"(got {start:g} {stop:g} {step:g}); use a larger STEP")
+        import numpy as np
+
+        scan = np.round(np.arange(start, stop + step / 2, step), 10)      # as _cmd_overlap
+        if scan.size and scan.max() > MAX_ELONGATION:
+            raise ValueError(f"--elongations {start:g} {stop:g} {step:g} steps to a/b = "
+                             f"{scan.max():g}, past {MAX_ELONGATION:g}: lower STOP or change STEP")
     if getattr(args, "candidates", None):
         lo, hi, n = args.candidates
         _check_range("--candidates LO", lo, -MAX_SPIN, MAX_SPIN)
         _check_range("--candidates HI", hi, lo, MAX_SPIN, low_open=True)
         if not (float(n).is_integer() and 5 <= n <= 10001):
             raise ValueError(f"--candidates N must be an integer in [5, 10001] (got {n:g})")
+    _check_system_flags(args)
     if args.command in ("benchmark", "systems"):
         _check_output("--out", getattr(args, "out", None), (".json",))
     elif args.command == "figures":                  # figures: --out is a folder
@@ -385,6 +391,49 @@ def check_args(args):
         _check_output("--out", args.out, FIGURE_EXTENSIONS)
         _check_output("--data", args.data, (".npz",))
         _check_plotting()
+
+
+def _check_system_flags(args):
+    """Build the catalogued system the flags ask for (cheap: no integration), so that a value
+    inside its flag's range that the system still refuses (an unknown --system, an
+    --elongation making b < c, an --eccentricity making the bodies touch at pericentre)
+    fails before any work, naming the flag rather than the library's argument."""
+    import re
+
+    from . import catalog
+
+    name = args.show if args.command == "systems" else getattr(args, "system", None)
+    if name is None or args.command == "figures":
+        return
+    flag = "--show" if args.command == "systems" else "--system"
+    try:
+        catalog.entry(name)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{flag}: {_one_line(exc)}") from None
+    shape_flag = "--elongations" if args.command == "overlap" else "--elongation"
+    flags = {"elongation": shape_flag, "secondary_density": "--density",
+             "eccentricity": "--eccentricity"}
+    elongation = getattr(args, "elongation", None)
+    if getattr(args, "elongations", None):
+        import numpy as np
+
+        start, stop, step = args.elongations
+        scan = np.round(np.arange(start, stop + step / 2, step), 10)      # as _cmd_overlap
+        elongation = float(scan.max()) if scan.size else None   # the most elongated is the worst
+    given = {"elongation": elongation, "secondary_density": getattr(args, "density", None),
+             "eccentricity": getattr(args, "eccentricity", None)}
+    try:
+        system = catalog.system(name, **given)
+    except (TypeError, ValueError) as exc:
+        message = re.sub(r"^(elongation|secondary_density|eccentricity)\b",
+                         lambda m: flags[m.group(1)], _one_line(exc))
+        if not message.startswith("--"):      # blame the first flag that changed the system
+            culprit = next((flags[k] for k, v in given.items() if v is not None), flag)
+            message = f"{culprit}: {message}"
+        raise ValueError(message) from None
+    if args.command == "libration" and not system.omega0 > 0:
+        raise ValueError(f"--elongation must be > 1 for libration: a round secondary has no "
+                         f"synchronous island (got {args.elongation:g})")
 
 
 # ---- shared steps -----------------------------------------------------------------------

@@ -19,7 +19,8 @@ from typing import Callable, List, Optional
 import numpy as np
 
 from . import planar, runtime
-from ._validate import require_count, require_memory, require_positive, require_range
+from ._validate import (require_count, require_memory, require_positive, require_range,
+                        require_real)
 
 #: Default tolerance floor: atol = rtol unless given (the scaled state is O(1)).
 DEFAULT_WINDOW_ORBITS = 16
@@ -59,6 +60,9 @@ class RunOutput:
 
 def check_tolerances(rtol, atol):
     """Validate rtol/atol; returns floats (atol defaults to rtol)."""
+    require_real("rtol", rtol)
+    if atol is not None:
+        require_real("atol", atol)
     require_range("rtol", rtol, 1e-16, 1e-2, low_open=False, high_open=False)
     atol = rtol if atol is None else atol
     require_positive("atol", atol)

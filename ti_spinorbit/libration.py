@@ -46,9 +46,10 @@ import numpy as np
 
 from . import accuracy, analytic
 from .classify import horizontal_extent
-from ._validate import require_count, require_finite, require_positive
+from ._validate import (require_callable, require_count, require_positive,
+                        require_real, require_scalar, require_spin)
 from .ensemble import check_tolerances
-from .section import SystemLike, surface_of_section, time_series
+from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
@@ -216,8 +217,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     rtol : float
         Integrator tolerance.
     candidates : array, optional
-        Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending; default
-        45 values over 0.2-1.3.
+        Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending, each in
+        [-100, 100] (``_validate.MAX_SPIN``); default 45 values over 0.2-1.3.
     zoom_candidates : int
         Candidates per zoom launch (odd, so the window's centre is one of them).
     xtol : float
@@ -259,10 +260,15 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     if not system.omega0 > 0:
         raise ValueError("the secondary must be elongated (B > A, omega0 > 0) to have a "
                          "synchronous island")
+    require_real("orbits", orbits)
     require_positive("orbits", orbits)
+    check_orbits(orbits)
     check_tolerances(rtol, None)
+    require_real("xtol", xtol)
     limit = accuracy.drift_limit(rtol, orbits, max_drift)
     require_positive("xtol", xtol)
+    require_scalar("max_extent", max_extent, 0.0, 90.0, low_open=True, unit="deg")
+    require_callable("progress", progress)
     zoom_candidates = require_count("zoom_candidates", zoom_candidates, 5, 100001)
     if zoom_candidates % 2 == 0:
         raise ValueError(f"zoom_candidates must be odd (got {zoom_candidates})")
@@ -270,8 +276,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     coarse_arm_points = require_count("coarse_arm_points", coarse_arm_points, 2, 100000)
     x = DEFAULT_CANDIDATES.copy() if candidates is None else \
-        np.asarray(candidates, dtype=np.float64).ravel()
-    require_finite("candidates", x)
+        np.asarray(require_spin("candidates", candidates), dtype=np.float64).ravel()
     if len(x) < 5 or np.any(np.diff(x) <= 0):
         raise ValueError(f"candidates must hold at least 5 ascending values (got {candidates!r})")
 

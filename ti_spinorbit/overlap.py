@@ -36,7 +36,8 @@ from typing import Callable, List, Optional, Union
 import numpy as np
 
 from . import accuracy, analytic, catalog
-from ._validate import require_range
+from ._validate import (_as_floats, require_callable, require_count, require_range,
+                        require_scalar, show)
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
 from .distributed import sections
@@ -153,7 +154,9 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     rtol : float
         Integrator tolerance (chaos detection needs no more than ~1e-10).
     center_starts, separatrix_starts : int
-        Starts per elongation in the θ_p = 0 and θ_p = 90° columns.
+        Starts per elongation in the θ_p = 0 and θ_p = 90° columns, each in [2, 100000].
+    libration_limit : float
+        Section extent (deg, in (0, 90]) below which a θ_p = 0 trace counts as librating.
     indicators : bool
         Integrate MEGNO / Lyapunov shadows too (about twice the cost) for the evidence.
     progress, client, chunk_size
@@ -169,12 +172,25 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     """
     import time
 
+    from .ensemble import check_tolerances
+    from .section import check_orbits
+
+    # every scalar before any system is built or integrated
+    check_orbits(orbits)
+    check_tolerances(rtol, None)
+    center_starts = require_count("center_starts", center_starts, 2, 100000)
+    separatrix_starts = require_count("separatrix_starts", separatrix_starts, 2, 100000)
+    require_scalar("libration_limit", libration_limit, 0.0, 90.0, low_open=True, unit="deg")
+    require_callable("progress", progress)
+    if not (isinstance(system_name_or_factory, str) or callable(system_name_or_factory)):
+        raise TypeError(f"system_name_or_factory must be a catalogue name or a callable "
+                        f"(elongation) -> BinarySystem (got {type(system_name_or_factory).__name__})")
     make, name = _factory(system_name_or_factory, eccentricity)
     if elongations is not None and (np.ndim(elongations) != 1 or np.size(elongations) == 0):
         raise ValueError(f"elongations must be a non-empty 1-D array of a/b values in (1, 10] "
-                         f"(got {elongations!r})")
+                         f"(got {show(elongations)})")
     q = np.round(np.arange(1.01, 1.155, 0.01), 10) if elongations is None else \
-        np.asarray(elongations, dtype=np.float64).ravel()
+        _as_floats("elongations", elongations).ravel()
     require_range("elongations", q, 1.0, 10.0, low_open=True, high_open=False)
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
@@ -259,7 +275,7 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     """Overlap scans of a catalogued system at several eccentricities (same kwargs as
     :func:`overlap_threshold`, ``client`` included). Returns (eccentricities, numerical
     first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
-    ecc = np.asarray(eccentricities, dtype=np.float64).ravel()
+    ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
     scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
              for e in ecc]

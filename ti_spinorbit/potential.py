@@ -8,7 +8,7 @@ primary's frame, the truncated mutual potential of physics.md §2 (Ashenberg 200
 import numpy as np
 
 from . import runtime
-from ._validate import require_finite
+from ._validate import require_finite, require_order
 from .bodies import Body
 
 
@@ -21,7 +21,8 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     R : array (..., 3)
         Secondary's centre of mass relative to the primary's, m, primary frame.
     S : array (..., 3, 3)
-        Rotation taking secondary-frame vectors to the primary frame.
+        Rotation taking secondary-frame vectors to the primary frame: orthonormal
+        (|S^T S − 1| <= 1e-9) and proper (det S = +1; a reflection is no rigid motion).
     order : {0, 2, 3, 4}
         Truncation order.
 
@@ -41,8 +42,7 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
         if not isinstance(body, Body):
             raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body) "
                             f"(got {type(body).__name__})")
-    if order not in (0, 2, 3, 4):
-        raise ValueError(f"order must be 0, 2, 3 or 4 (got {order!r})")
+    order = require_order(order)
     # checked before the conversion, so text is a TypeError naming R or S
     R = np.asarray(require_finite("R", R), dtype=np.float64)
     S = np.asarray(require_finite("S", S), dtype=np.float64)
@@ -51,6 +51,10 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
                          f"(got {R.shape} and {S.shape})")
     if not np.allclose(np.einsum("...ji,...jk->...ik", S, S), np.eye(3), atol=1e-9):
         raise ValueError("S must be a rotation matrix (S^T S = 1)")
+    det = np.linalg.det(S) if S.size else np.ones(0)
+    if np.any(det < 0):
+        raise ValueError(f"S must be a proper rotation matrix, det S = +1 (got det S = "
+                         f"{float(np.min(det)):.6g}: a reflection)")
     # the expansion converges only outside the bodies' bounding spheres (R = 0 gave NaN)
     contact = primary.bounding_radius + secondary.bounding_radius
     closest = float(np.min(np.linalg.norm(R, axis=-1))) if R.size else np.inf

@@ -15,7 +15,8 @@ from typing import List, Sequence, Union
 import numpy as np
 
 from . import accuracy
-from ._validate import _as_floats, require_count, require_finite
+from ._validate import (_as_floats, require_callable, require_count, require_finite,
+                        require_order, require_real, require_spin, show)
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 
@@ -28,12 +29,22 @@ MAX_ORBITS = 1e7
 
 def check_orbits(orbits):
     """``orbits`` as a float, or ValueError unless it is finite and lies in (0, MAX_ORBITS]."""
-    value = float(orbits)
+    value = require_real("orbits", orbits)
     if not np.isfinite(value) or value <= 0:
         raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
     if value > MAX_ORBITS:
         raise ValueError(f"orbits must lie in (0, {MAX_ORBITS:g}] (got {value:g})")
     return value
+
+
+def _check_run_inputs(rtol, atol, order, progress, window_orbits):
+    """Tolerances, order, window and progress callback, checked before any Taichi work."""
+    from .ensemble import check_tolerances
+
+    check_tolerances(rtol, atol)
+    require_order(order)
+    require_count("window_orbits", window_orbits, 1, 10**6)      # as Ensemble.run
+    require_callable("progress", progress)
 
 
 def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
@@ -46,13 +57,20 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
     if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
         raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
                          f"(got {escape_distance!r})")
-    systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else list(system_or_systems)
+    try:
+        systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else \
+            list(system_or_systems)
+    except TypeError:                       # not iterable (a number, None)
+        systems = []
     if not systems or not all(isinstance(s, BinarySystem) for s in systems):
-        raise TypeError("system_or_systems must be a BinarySystem or a non-empty list of them")
-    theta_p = np.asarray(theta_p, dtype=np.float64)
-    thetadot_p = np.asarray(thetadot_p, dtype=np.float64)
-    require_finite("theta_p", theta_p)
-    require_finite("thetadot_p", thetadot_p)
+        raise TypeError("system_or_systems must be a BinarySystem or a non-empty list of them "
+                        f"(got {show(system_or_systems)})")
+    # checked before the conversion, so complex values and text are refused, not cast
+    theta_p = np.asarray(require_finite("theta_p", theta_p), dtype=np.float64)
+    thetadot_p = np.asarray(require_spin("thetadot_p", thetadot_p), dtype=np.float64)
+    if theta_p.size == 0 or thetadot_p.size == 0:
+        raise ValueError(f"theta_p and thetadot_p must hold at least one start each (got "
+                         f"shapes {theta_p.shape} and {thetadot_p.shape})")
     index = np.arange(len(systems)) if len(systems) > 1 else np.zeros((), dtype=int)
     try:
         index, theta_p, thetadot_p = np.broadcast_arrays(index, theta_p, thetadot_p)
@@ -147,7 +165,8 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     theta_p : float or array
         Initial angle of the secondary's long axis from the line of centres, degrees.
     thetadot_p : float or array
-        Initial spin rate of the secondary, units of the mean motion n.
+        Initial spin rate of the secondary, units of the mean motion n, in [-100, 100]
+        (``_validate.MAX_SPIN``, the bound of the command line's --thetadot).
     orbits : float
         Integration time in initial orbital periods 2π/n (each member its own n); orbits
         must lie in (0, 1e7] (``MAX_ORBITS``).
@@ -182,6 +201,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     SectionResult
     """
     orbits = check_orbits(orbits)
+    _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
@@ -297,6 +317,7 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     every sample (and the end); ``max_drift`` as for surface_of_section."""
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
+    _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)

@@ -19,7 +19,9 @@ from typing import Optional
 
 import numpy as np
 
-from ._validate import require_finite, require_positive, require_range
+from ._validate import (MAX_MASS_RATIO, MAX_PRIMARY_SPIN, MAX_SEMIMAJOR_AXIS, MIN_LENGTH,
+                        MIN_MOMENT_RATIO, require_finite, require_positive_scalar, require_range,
+                        require_real, show)
 from .bodies import Body
 
 #: Newtonian constant of gravitation, m^3 kg^-1 s^-2 (CODATA 2018).
@@ -37,13 +39,18 @@ class BinarySystem:
     ----------
     primary, secondary : Body
         e.g. ``Sphere(600, 1581)``, ``Ellipsoid(245, 163, 190, 2618)``.
+        The mass ratio m1/m2 must lie in [1e-12, 1e12] (``MAX_MASS_RATIO``) and each body's
+        principal moments must be at least 1e-6 of its largest (``MIN_MOMENT_RATIO``: the
+        spin equations divide by them, so a body collapsed onto a line is refused).
     a : float
-        Initial osculating semimajor axis of the mutual orbit, m.
+        Initial osculating semimajor axis of the mutual orbit, m, in [1e-3, 1e13]
+        (``MAX_SEMIMAJOR_AXIS``) and beyond contact at pericentre.
     e : float
         Initial osculating eccentricity, 0 <= e < 1.
     primary_spin_period : float, optional
         Primary's spin period about its short axis, s (None: not spinning; irrelevant for a
-        spherical primary).
+        spherical primary); negative for retrograde spin. Its rate 2π/|P| may be at most
+        1e5 n (``MAX_PRIMARY_SPIN``): |P| >= orbital period / 1e5.
     name : str
         Label used in plots and saved files.
     """
@@ -60,12 +67,34 @@ class BinarySystem:
             if not isinstance(body, Body):
                 raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body), "
                                 f"got {type(body).__name__}")
-        require_positive("a", self.a)
+        require_positive_scalar("a", self.a, MIN_LENGTH, MAX_SEMIMAJOR_AXIS, "m")
+        require_real("e", self.e)
         require_range("e", self.e, 0.0, 1.0)
+        if not isinstance(self.name, str):
+            raise TypeError(f"name must be a string (got {show(self.name)})")
+        ratio = self.primary.mass / self.secondary.mass
+        if not 1.0 / MAX_MASS_RATIO <= ratio <= MAX_MASS_RATIO:
+            raise ValueError(f"mass ratio m1/m2 must lie in [{1 / MAX_MASS_RATIO:g}, "
+                             f"{MAX_MASS_RATIO:g}] (got {ratio:.6g}: primary {self.primary.mass:.6g} "
+                             f"kg, secondary {self.secondary.mass:.6g} kg)")
+        for label, body in (("primary", self.primary), ("secondary", self.secondary)):
+            moments = body.moments
+            if not moments.min() >= MIN_MOMENT_RATIO * moments.max():
+                raise ValueError(
+                    f"{label}: each principal moment must be at least {MIN_MOMENT_RATIO:g} of the "
+                    f"largest (got A, B, C = {', '.join(f'{m:.6g}' for m in moments)} kg m^2): "
+                    "a body collapsed onto a line or a point cannot spin")
         if self.primary_spin_period is not None:
+            require_real("primary_spin_period", self.primary_spin_period)
             require_finite("primary_spin_period", self.primary_spin_period)
             if self.primary_spin_period == 0:
                 raise ValueError("primary_spin_period must be non-zero (None for no spin)")
+            shortest = self.orbital_period / MAX_PRIMARY_SPIN
+            if abs(self.primary_spin_period) < shortest:
+                raise ValueError(
+                    f"primary_spin_period must satisfy |P| >= orbital period / "
+                    f"{MAX_PRIMARY_SPIN:g} = {shortest:.6g} s (a spin of at most "
+                    f"{MAX_PRIMARY_SPIN:g} n; got {self.primary_spin_period:.6g})")
         contact = self.primary.bounding_radius + self.secondary.bounding_radius
         pericentre = self.a * (1.0 - self.e)
         if pericentre <= contact:
