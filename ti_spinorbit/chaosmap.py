@@ -177,7 +177,8 @@ def _edges(centres, low=None, high=None):
 
 def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
               progress: Optional[Callable[[float], None]] = None, client=None,
-              chunk_size=None, model="auto", checkpoint=None, resume=False) -> ChaosMap:
+              chunk_size=None, model="auto", checkpoint=None, resume=False,
+              overwrite_checkpoint=False) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -203,9 +204,10 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         Members per chunk with ``client`` (default: a few chunks per worker).
     model : {"auto", "planar", "3d"}
         Equations of motion (see :func:`~ti_spinorbit.section.surface_of_section`).
-    checkpoint, resume
-        Checkpoint file written after every window, and whether to continue from it
-        (single process only; see :mod:`ti_spinorbit.checkpoint`).
+    checkpoint, resume, overwrite_checkpoint
+        Checkpoint directory written after every window, whether to continue from it, and
+        whether to replace a checkpoint already there when not resuming (refused by
+        default; single process only; see :mod:`ti_spinorbit.checkpoint`).
 
     Returns
     -------
@@ -222,7 +224,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
                        indicators=True, progress=progress, model=model, checkpoint=checkpoint,
-                       resume=resume)
+                       resume=resume, overwrite_checkpoint=overwrite_checkpoint)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = tp.shape
@@ -303,7 +305,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
-                  resume=False) -> ParameterMap:
+                  resume=False, overwrite_checkpoint=False) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -322,7 +324,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         Integrator tolerance.
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
-    progress, client, chunk_size, model, checkpoint, resume
+    progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint
         As for :func:`chaos_map`.
 
     Returns
@@ -355,7 +357,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     started = time.perf_counter()
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
                        chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
-                       model=model, checkpoint=checkpoint, resume=resume)
+                       model=model, checkpoint=checkpoint, resume=resume,
+                       overwrite_checkpoint=overwrite_checkpoint)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = (elongations.size, eccentricities.size, starts)
