@@ -186,6 +186,16 @@ def _clean(path, names):
             os.remove(os.path.join(path, name))
 
 
+def _refuse_foreign(path):
+    """A directory without a state that holds files no run of ours wrote is not ours to
+    write into (a fresh start would delete records-*.npz files there)."""
+    foreign = [n for n in os.listdir(path) if not _is_checkpoint_file(n)]
+    if foreign:
+        raise CheckpointError(
+            f"checkpoint {path!r} is not a {FORMAT} directory (no {STATE}; holds "
+            f"{_one_line(', '.join(sorted(foreign)[:5]))}); choose another path or delete it")
+
+
 def holds_checkpoint(path):
     """True when the directory ``path`` holds a checkpoint (a state file) of some run."""
     return os.path.isfile(os.path.join(os.fspath(path), STATE))
@@ -202,6 +212,8 @@ def check_target(path, resume=False, overwrite=False, cli=False):
     if os.path.exists(path) and not os.path.isdir(path):
         raise CheckpointError(f"checkpoint {path!r} is a file, not a {FORMAT} directory; "
                               "choose another path or delete it")
+    if os.path.isdir(path) and not holds_checkpoint(path):
+        _refuse_foreign(path)
     if not resume and not overwrite and holds_checkpoint(path):
         raise CheckpointExists(
             f"checkpoint {path!r} already holds a checkpoint of an earlier run; pass {how} "
@@ -299,11 +311,7 @@ def load(path, settings, fingerprint):
         raise CheckpointError(f"checkpoint {path!r} is not a {FORMAT} directory (a file); "
                               "choose another path or delete it")
     if not holds_checkpoint(path):
-        foreign = [n for n in os.listdir(path) if not _is_checkpoint_file(n)]
-        if foreign:
-            raise CheckpointError(
-                f"checkpoint {path!r} is not a {FORMAT} directory (no {STATE}; holds "
-                f"{_one_line(', '.join(sorted(foreign)[:5]))}); choose another path or delete it")
+        _refuse_foreign(path)
         return None            # killed before its first state: start afresh
     arrays = _read(os.path.join(path, STATE), STATE)
     try:
@@ -352,7 +360,7 @@ def load(path, settings, fingerprint):
     bad += [k for k in ("shadow", "shadow_f", "ind")
             if state[k].ndim != 2 or len(state[k]) not in (1, n)]
     bad += [k for k in _ARRAYS if state[k].dtype != _DTYPES.get(k, np.float64)]
-    if state["y"].shape != (n, width - 1):
+    if state["y"].shape != (n, width - 1) and "y" not in bad:
         bad.append("y")
     table = arrays["records_sha256"]
     if table.dtype != np.dtype("S32") or table.shape != (launches,):
@@ -371,6 +379,10 @@ def load(path, settings, fingerprint):
         if not os.path.exists(file):
             raise _damaged(path, f"{_records_name(launch)} is missing")
         rec = _read(file, _records_name(launch), digests[launch])
+        lacks = [f"{name}_{part}" for name in _RECORDS for part in ("members", "counts", "data")
+                 if f"{name}_{part}" not in rec]
+        if lacks:
+            raise _damaged(path, f"{_records_name(launch)} lacks {', '.join(lacks)}")
         for name in _RECORDS:
             try:
                 members = rec[name + "_members"]
