@@ -106,17 +106,20 @@ def _one_line(text, limit=200):
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
-def _atomic_savez(path, **arrays):
-    """Write an .npz beside ``path`` and move it over; returns the SHA-256 of its bytes."""
+def _atomic_savez(path, digest=False, **arrays):
+    """Write an .npz beside ``path`` and move it over; returns the SHA-256 (hex) of the bytes
+    written when ``digest`` (read back: zipfile seeks while writing), else None."""
     tmp = f"{path}.tmp-{os.getpid()}"
     with open(tmp, "wb") as fh:
         np.savez(fh, **arrays)
         fh.flush()
         os.fsync(fh.fileno())
-    with open(tmp, "rb") as fh:
-        digest = hashlib.sha256(fh.read()).hexdigest()
+    sha = None
+    if digest:
+        with open(tmp, "rb") as fh:
+            sha = hashlib.sha256(fh.read()).hexdigest()
     os.replace(tmp, path)
-    return digest
+    return sha
 
 
 def _pack(chunks_by_member, width):
@@ -147,7 +150,8 @@ def save(path, settings, fingerprint, state, new_records):
             _pack(new_records[name], width)
     digests = state["records_sha256"]
     del digests[launch:]            # a window redone after a resume replaces its file
-    digests.append(_atomic_savez(os.path.join(path, _records_name(launch)), **records))
+    digests.append(_atomic_savez(os.path.join(path, _records_name(launch)), digest=True,
+                                 **records))
     # 32 bytes per window: tiny beside the per-member arrays, rewritten with them
     table = np.array([bytes.fromhex(d) for d in digests], dtype="S32")
     header = {"format": FORMAT, "format_version": FORMAT_VERSION, "version": __version__,

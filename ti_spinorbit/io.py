@@ -25,6 +25,11 @@ Layout decisions (the README's "Saved files" section documents them for users):
   for readers without the package; :func:`load` ignores it.
 * Format versions: 1 is this layout; 0 is the layout :func:`save_result` wrote before
   ``format_version`` existed (sections and time series only), which :func:`load` still reads.
+* Reading trusts nothing in the file: :func:`load` reads only the entries the metadata names,
+  checks each entry's sizes (zip directory against the ``.npy`` header, deflate's largest
+  ratio) before allocating, and turns every fault of a malformed file into one
+  :class:`ArchiveError` (a ValueError) with a one-line message; a missing path stays
+  FileNotFoundError.
 """
 
 import dataclasses
