@@ -166,17 +166,13 @@ class Ensemble:
         checkpoint is refused (``CheckpointExists``, nothing touched) unless
         ``overwrite_checkpoint=True`` replaces it.
         """
-        import time
-
         from . import checkpoint as ckpt
-        from .kernels import ensemble as K
 
         kern = self.kernels
         n = self.n
         t_stop = np.broadcast_to(np.asarray(t_stop, dtype=np.float64), (n,)).copy()
         require_positive("t_stop", t_stop)
         window_orbits = require_count("window_orbits", window_orbits, 1, 10**6)
-        window = 2.0 * np.pi * window_orbits
         cap = window_orbits + 4
         sampling = sample_dt is not None
         if sampling:
