@@ -531,7 +531,7 @@ MALFORMED = {
     "bad npy header": (lambda p, o: (shutil.copy(p, o),
                                      rewrite_zip(o, replace={"theta_p.npy": b"\x93NUMPY\x01\x00"
                                                              b"\x10\x00{'descr': zzz}   \n"})),
-                       "is damaged or malformed: ValueError"),
+                       "is damaged: entry 'theta_p.npy' has a bad .npy header (ValueError)"),
     "object dtype": (lambda p, o: (shutil.copy(p, o), rewrite_zip(
         o, replace={"theta_p.npy": fake_npy((2,), descr="|O", payload=bytes(16))})),
         "holds Python objects"),

@@ -277,9 +277,10 @@ def _damaged(path, what):
                              "start the run afresh")
 
 
-def _read(path, what, digest=None):
-    """The arrays of one checkpoint file, sizes checked before reading (io.ArchiveError
-    rules), its SHA-256 compared with ``digest`` first when given."""
+def _read(path, what, names, digest=None):
+    """The arrays ``names`` of one checkpoint file (those present; no other entry is ever
+    decompressed), sizes checked before reading (io.ArchiveError rules), its SHA-256
+    compared with ``digest`` first when given."""
     from .io import _DAMAGE, _Entries
 
     folder = os.path.dirname(path)
@@ -293,7 +294,7 @@ def _read(path, what, digest=None):
                                        "edited, swapped or corrupted)")
         with zipfile.ZipFile(path) as zf:
             entries = _Entries(path, zf)
-            return {k: entries[k] for k in entries.files}
+            return {k: entries[k] for k in names if k in entries}
     except CheckpointDamaged:
         raise
     except _DAMAGE as exc:  # zip, header, size or key errors all mean the same thing
@@ -317,7 +318,7 @@ def load(path, settings, fingerprint):
     if not holds_checkpoint(path):
         _refuse_foreign(path)
         return None            # killed before its first state: start afresh
-    arrays = _read(os.path.join(path, STATE), STATE)
+    arrays = _read(os.path.join(path, STATE), STATE, ("header", "records_sha256") + _ARRAYS)
     try:
         header = json.loads(str(arrays.pop("header")))
         if not isinstance(header, dict):
@@ -382,7 +383,9 @@ def load(path, settings, fingerprint):
         file = os.path.join(path, _records_name(launch))
         if not os.path.exists(file):
             raise _damaged(path, f"{_records_name(launch)} is missing")
-        rec = _read(file, _records_name(launch), digests[launch])
+        rec = _read(file, _records_name(launch),
+                    [f"{n}_{part}" for n in _RECORDS for part in ("members", "counts", "data")],
+                    digests[launch])
         lacks = [f"{name}_{part}" for name in _RECORDS for part in ("members", "counts", "data")
                  if f"{name}_{part}" not in rec]
         if lacks:

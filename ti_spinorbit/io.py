@@ -415,16 +415,22 @@ class _Entries:
                                f"{limit} bytes allowed for it")
         fmt = np.lib.format
         with self.zf.open(info) as fh:
-            version = fmt.read_magic(fh)
-            if version == (1, 0):
-                shape, fortran, dtype = fmt.read_array_header_1_0(fh)
-            elif version == (2, 0):
-                shape, fortran, dtype = fmt.read_array_header_2_0(fh)
-            else:
-                reader = getattr(fmt, "_read_array_header", None)
-                if reader is None:
-                    raise ArchiveError(f"{where} has .npy format version {version}")
-                shape, fortran, dtype = reader(fh, version)
+            try:
+                version = fmt.read_magic(fh)
+                if version == (1, 0):
+                    shape, fortran, dtype = fmt.read_array_header_1_0(fh)
+                elif version == (2, 0):
+                    shape, fortran, dtype = fmt.read_array_header_2_0(fh)
+                else:
+                    reader = getattr(fmt, "_read_array_header", None)
+                    if reader is None:
+                        raise ArchiveError(f"{where} has .npy format version {version}")
+                    shape, fortran, dtype = reader(fh, version)
+            except (ValueError, SyntaxError, TypeError) as exc:
+                if isinstance(exc, ArchiveError):
+                    raise
+                raise ArchiveError(f"{where} has a bad .npy header "
+                                   f"({type(exc).__name__})") from None
             header = fh.tell()
             if dtype.hasobject:
                 raise ArchiveError(f"{where} holds Python objects (pickles are never loaded)")
