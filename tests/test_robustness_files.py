@@ -167,6 +167,42 @@ def test_cli_second_writer_is_refused_with_one_line(ckpt, tmp_path):
                                      f"locked by another run: pid {p.pid} on ")
 
 
+RUNNING = """
+import sys
+import ti_spinorbit as tso
+def progress(fraction):
+    if fraction < 1:
+        print("held", flush=True)
+        sys.stdin.readline()
+tso.surface_of_section(tso.catalog.system("1991 VH"), 0.0, {starts}, checkpoint=sys.argv[1],
+                       progress=progress, **{args})
+"""
+
+
+def test_a_running_integration_holds_the_lock_between_windows(vh, tmp_path, whole):
+    """Two real runs on one directory: the second is refused while the first is between
+    windows, and the first then finishes to the uninterrupted result."""
+    ckpt = tmp_path / "two.ckpt"
+    code = RUNNING.format(starts=STARTS, args=ARGS)
+    p = subprocess.Popen([sys.executable, "-c", code, str(ckpt)], stdin=subprocess.PIPE,
+                         stdout=subprocess.PIPE, text=True, env=env())
+    try:
+        wait_held(p)
+        owner = json.loads((ckpt / C.OWNER).read_text())
+        assert owner["pid"] == p.pid and owner["command"].startswith("-c")
+        for resume in (True, False):
+            with pytest.raises(C.CheckpointLocked, match=rf"locked by another run: pid {p.pid} "):
+                run(vh, ckpt, resume=resume, overwrite_checkpoint=True)
+        p.stdin.write("\n" * WINDOWS)
+        p.stdin.close()
+        assert p.wait(timeout=300) == 0
+    finally:
+        p.kill()
+        p.wait()
+    assert not (ckpt / C.OWNER).exists()
+    assert_same(run(vh, ckpt, resume=True), whole)
+
+
 @pytest.mark.parametrize("exc", [RuntimeError, KeyboardInterrupt])
 def test_lock_released_when_the_run_raises(vh, tmp_path, whole, exc):
     ckpt = tmp_path / "r.ckpt"
