@@ -327,7 +327,7 @@ def test_cli_data_name_in_upper_case_is_written_as_given(tmp_path):
 
 
 def test_io_save_keeps_an_upper_case_extension(tight, tmp_path):
-    assert tso.save(tight, tmp_path / "a.NPZ") == str(tmp_path / "a.NPZ")
+    assert tso.save(tight, tmp_path / "a.NPZ") == tmp_path / "a.NPZ"
     assert tso.save(tight, tmp_path / "b") == str(tmp_path / "b.npz")
     assert sorted(os.listdir(tmp_path)) == ["a.NPZ", "b.npz"]
 

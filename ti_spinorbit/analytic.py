@@ -124,9 +124,10 @@ def omega0_effective(system):
     The torque on the secondary scales with G m1 while n² a³ = G (m1 + m2), so written with the
     true mean motion the decoupled equation carries the primary's mass fraction (physics.md §8,
     physics-derivations.md §4.7). ``system`` is a :class:`~ti_spinorbit.systems.BinarySystem`;
-    A, B, C are its secondary's moments about x, y, z."""
+    A, B, C are its secondary's moments about x, y, z, and ω0 is ``system.omega0`` (which
+    also covers a secondary whose long axis is y)."""
     fraction = system.primary.mass / system.total_mass
-    return omega0_from_moments(*system.secondary.moments) * math.sqrt(fraction)
+    return system.omega0 * math.sqrt(fraction)
 
 
 def elongation_from_omega0(omega0):

@@ -204,7 +204,8 @@ def _edges(centres, low=None, high=None):
 
 def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
               progress: Optional[Callable[[float], None]] = None, client=None,
-              chunk_size=None, model="auto", checkpoint=None, resume=False, max_drift=None,
+              chunk_size=None, model="auto", checkpoint=None, resume=False,
+              overwrite_checkpoint=False, max_drift=None,
               include_inaccurate=False) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
@@ -231,9 +232,10 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         Members per chunk with ``client`` (default: a few chunks per worker).
     model : {"auto", "planar", "3d"}
         Equations of motion (see :func:`~ti_spinorbit.section.surface_of_section`).
-    checkpoint, resume
-        Checkpoint file written after every window, and whether to continue from it
-        (single process only; see :mod:`ti_spinorbit.checkpoint`).
+    checkpoint, resume, overwrite_checkpoint
+        Checkpoint directory written after every window, whether to continue from it, and
+        whether to replace a checkpoint already there when not resuming (refused by
+        default; single process only; see :mod:`ti_spinorbit.checkpoint`).
     max_drift : float, optional
         Drift limit of the accuracy verdict (default ``min(1e-4, 1000 · rtol · orbits)``;
         :mod:`ti_spinorbit.accuracy`).
@@ -256,7 +258,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
                        indicators=True, progress=progress, model=model, checkpoint=checkpoint,
-                       resume=resume, max_drift=max_drift)
+                       resume=resume, overwrite_checkpoint=overwrite_checkpoint,
+                       max_drift=max_drift)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = tp.shape
@@ -360,7 +363,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
-                  resume=False, max_drift=None, include_inaccurate=False) -> ParameterMap:
+                  resume=False, overwrite_checkpoint=False, max_drift=None,
+                  include_inaccurate=False) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -379,7 +383,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         Integrator tolerance.
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
-    progress, client, chunk_size, model, checkpoint, resume, max_drift, include_inaccurate
+    progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint,
+    max_drift, include_inaccurate
         As for :func:`chaos_map`.
 
     Returns
@@ -414,7 +419,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     started = time.perf_counter()
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
                        chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
-                       model=model, checkpoint=checkpoint, resume=resume, max_drift=max_drift)
+                       model=model, checkpoint=checkpoint, resume=resume,
+                       overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = (elongations.size, eccentricities.size, starts)

@@ -181,6 +181,9 @@ def _parser():
             s.add_argument("--resume", action="store_true",
                            help="continue an interrupted run from its checkpoint (same "
                                 "results as an uninterrupted run; starts afresh if none)")
+            s.add_argument("--overwrite-checkpoint", action="store_true",
+                           help="without --resume, replace a checkpoint already in the "
+                                "--checkpoint directory (refused by default)")
 
     def system_flags(s, default="1991 VH", shape=True):
         s.add_argument("--system", default=default,
@@ -461,11 +464,14 @@ def _system(args):
 
 def _paths(args, prefix, system_name):
     """(figure path, data path) from --out/--data or the defaults <prefix>_<system>.png/.npz,
-    both checked writable (defaults included) before any work."""
+    both checked writable (defaults included), and the checkpoint directory checked, before
+    any work."""
     out = args.out or f"{prefix}_{system_name.replace(' ', '')}.png"
     data = args.data or os.path.splitext(out)[0] + ".npz"
     _check_output("--out" if args.out else "the figure (default --out)", out, FIGURE_EXTENSIONS)
     _check_output("--data" if args.data else "the data file (default --data)", data, (".npz",))
+    if hasattr(args, "checkpoint"):       # a checkpoint that would be refused: before any work
+        _run_flags(args, data)
     return out, data
 
 
@@ -487,10 +493,15 @@ def _run_flags(args, data):
     data path with .ckpt when --resume is given alone)."""
     import os
 
+    from .checkpoint import check_target
+
     checkpoint = args.checkpoint
     if checkpoint is None and args.resume:
         checkpoint = os.path.splitext(data)[0] + ".ckpt"
-    return {"model": args.model, "checkpoint": checkpoint, "resume": args.resume}
+    if checkpoint is not None:   # refused before any work, naming the flags
+        check_target(checkpoint, args.resume, args.overwrite_checkpoint, cli=True)
+    return {"model": args.model, "checkpoint": checkpoint, "resume": args.resume,
+            "overwrite_checkpoint": args.overwrite_checkpoint}
 
 
 def _save(result, path, extra):

@@ -148,7 +148,7 @@ class Ensemble:
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
             indicators=False, separation=SHADOW_SEPARATION,
             progress: Optional[Callable[[float], None]] = None, checkpoint=None,
-            resume=False) -> RunOutput:
+            resume=False, overwrite_checkpoint=False) -> RunOutput:
         """Integrate every member to ``t_stop`` (scaled; scalar or per member).
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
@@ -164,19 +164,19 @@ class Ensemble:
         window, with atomic replaces (``ti_spinorbit.checkpoint``); with ``resume=True`` a run
         continues from it when it exists and gives the same results as an uninterrupted run.
         A checkpoint written for other inputs or settings, or a damaged one, raises
-        ValueError.
+        ValueError (``checkpoint.CheckpointError``; damage: ``CheckpointDamaged``, "checkpoint
+        damaged: ..."). The run holds the directory's lock throughout; a second run on it is
+        refused at once (``CheckpointLocked``). Without ``resume`` a directory that holds a
+        checkpoint is refused (``CheckpointExists``, nothing touched) unless
+        ``overwrite_checkpoint=True`` replaces it.
         """
-        import time
-
         from . import checkpoint as ckpt
-        from .kernels import ensemble as K
 
         kern = self.kernels
         n = self.n
         t_stop = np.broadcast_to(np.asarray(t_stop, dtype=np.float64), (n,)).copy()
         require_positive("t_stop", t_stop)
         window_orbits = require_count("window_orbits", window_orbits, 1, 10**6)
-        window = 2.0 * np.pi * window_orbits
         cap = window_orbits + 4
         sampling = sample_dt is not None
         if sampling:
@@ -190,6 +190,26 @@ class Ensemble:
                     "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
                     "indicators": bool(indicators), "separation": float(separation)}
+        args = (t_stop, window_orbits, sample_dt, indicators, separation, progress, checkpoint,
+                resume, settings)
+        if checkpoint is None:
+            return self._windows(*args)
+        with ckpt.claim(checkpoint, resume=resume, overwrite=overwrite_checkpoint):
+            return self._windows(*args)
+
+    def _windows(self, t_stop, window_orbits, sample_dt, indicators, separation, progress,
+                 checkpoint, resume, settings) -> RunOutput:
+        """The windows of :meth:`run` (inputs checked, checkpoint directory owned)."""
+        import time
+
+        from . import checkpoint as ckpt
+        from .kernels import ensemble as K
+
+        kern = self.kernels
+        n = self.n
+        window = 2.0 * np.pi * window_orbits
+        cap = window_orbits + 4
+        sampling = sample_dt is not None
         st = None
         fingerprint = self._fingerprint(t_stop) if checkpoint is not None else None
         if checkpoint is not None and resume:
@@ -199,6 +219,7 @@ class Ensemble:
         else:
             for name in ("y", "t", "h", "status", "counters"):
                 setattr(self, name, st.pop(name))
+        st.setdefault("records_sha256", [])   # digests of the records files (checkpoint.save)
         scap = int(np.ceil(window / sample_dt)) + 4 if sampling else 1
         events_buf = np.zeros((n, cap, kern.RECORD_WIDTH))
         samples_buf = np.zeros((n, scap, kern.RECORD_WIDTH))

@@ -25,13 +25,20 @@ Layout decisions (the README's "Saved files" section documents them for users):
   for readers without the package; :func:`load` ignores it.
 * Format versions: 1 is this layout; 0 is the layout :func:`save_result` wrote before
   ``format_version`` existed (sections and time series only), which :func:`load` still reads.
+* Reading trusts nothing in the file: :func:`load` reads only the entries the metadata names,
+  checks each entry's sizes (zip directory against the ``.npy`` header, deflate's largest
+  ratio) before allocating, and turns every fault of a malformed file into one
+  :class:`ArchiveError` (a ValueError) with a one-line message; a missing path stays
+  FileNotFoundError.
 """
 
 import dataclasses
 import datetime
 import json
 import os
+import struct
 import zipfile
+import zlib
 
 import numpy as np
 
@@ -167,9 +174,8 @@ def write_archive(path, arrays, metadata):
     entries = dict(metadata=np.array(json.dumps(metadata, indent=1, default=_json_default)),
                    **{k: np.asarray(v) for k, v in arrays.items()})
     if isinstance(path, (str, os.PathLike)):
-        path = os.fspath(path)
-        if not path.lower().endswith(".npz"):
-            path += ".npz"
+        if not os.fspath(path).lower().endswith(".npz"):
+            path = os.fspath(path) + ".npz"
         with open(path, "wb") as fh:        # a file object: NumPy keeps the name as it is
             np.savez_compressed(fh, **entries)
         return path
@@ -344,38 +350,173 @@ def save_result(result, path, kind=None, extra=None):
 
 
 # ---- reading ----------------------------------------------------------------------------
+class ArchiveError(ValueError):
+    """A file that :func:`load` (or :func:`read_metadata`) cannot read as a ti_spinorbit
+    archive: not an ``.npz``, damaged (truncated, flipped bytes, renamed or missing entries,
+    bad ``.npy`` headers), malformed metadata (wrong types, absurd nesting), an unknown kind
+    or an unreadable ``format_version``. The message is one line naming the file and what is
+    wrong. A subclass of ValueError, so ``except ValueError`` still catches it."""
+
+
+#: Largest ratio of uncompressed to compressed size that deflate can reach (≈ 1032:1), with
+#: margin: an entry whose zip directory claims more is damaged, and is refused before reading.
+_MAX_DEFLATE_RATIO = 1100
+#: Largest metadata entry read (bytes uncompressed): real metadata is kilobytes to megabytes.
+_MAX_METADATA_BYTES = 256 * 2**20
+#: Errors that reading or decoding a damaged or hostile file can raise (never a bug of ours
+#: with a valid file): each becomes an ArchiveError naming the file.
+_DAMAGE = (KeyError, IndexError, TypeError, AttributeError, ValueError, RecursionError,
+           OverflowError, MemoryError, EOFError, OSError, UnicodeError, zipfile.BadZipFile,
+           zlib.error, struct.error, NotImplementedError)
+
+
+def _one_line(exc):
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 300 else text[:297] + "..."
+
+
+class _Entries:
+    """The arrays of an ``.npz``, read one by one on first use with every size checked
+    against the zip directory before anything is allocated; entries never asked for are
+    never decompressed (a small file cannot make :func:`load` allocate gigabytes)."""
+
+    def __init__(self, path, zf):
+        self.path, self.zf, self._cache = path, zf, {}
+        self._names = {}
+        for info in zf.infolist():
+            key = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+            self._names[key] = info
+
+    @property
+    def files(self):
+        return list(self._names)
+
+    def __contains__(self, key):
+        return key in self._cache or key in self._names
+
+    def __iter__(self):
+        return iter(dict.fromkeys([*self._names, *self._cache]))
+
+    def __setitem__(self, key, value):
+        self._cache[key] = value
+
+    def __getitem__(self, key):
+        if key in self._cache:
+            return self._cache[key]
+        if not isinstance(key, str) or key not in self._names:
+            raise ArchiveError(f"{self.path!r} is damaged: its metadata names the array "
+                               f"{key!r}, which is not in the file")
+        self._cache[key] = value = self._read(key, self._names[key])
+        return value
+
+    def _read(self, key, info, limit=None):
+        where = f"{self.path!r} is damaged: entry {info.filename!r}"
+        if info.compress_type == zipfile.ZIP_STORED:
+            ok = info.file_size == info.compress_size
+        elif info.compress_type == zipfile.ZIP_DEFLATED:
+            ok = info.file_size <= _MAX_DEFLATE_RATIO * info.compress_size + 1024
+        else:
+            raise ArchiveError(f"{where} uses zip compression method {info.compress_type}; "
+                               "NumPy archives use stored or deflated entries")
+        if not ok:
+            raise ArchiveError(f"{where} claims {info.file_size} bytes from "
+                               f"{info.compress_size} compressed bytes (impossible)")
+        if limit is not None and info.file_size > limit:
+            raise ArchiveError(f"{where} holds {info.file_size} bytes, more than the "
+                               f"{limit} bytes allowed for it")
+        fmt = np.lib.format
+        with self.zf.open(info) as fh:
+            try:
+                version = fmt.read_magic(fh)
+                if version == (1, 0):
+                    shape, fortran, dtype = fmt.read_array_header_1_0(fh)
+                elif version == (2, 0):
+                    shape, fortran, dtype = fmt.read_array_header_2_0(fh)
+                else:
+                    reader = getattr(fmt, "_read_array_header", None)
+                    if reader is None:
+                        raise ArchiveError(f"{where} has .npy format version {version}")
+                    shape, fortran, dtype = reader(fh, version)
+            except (ValueError, SyntaxError, TypeError) as exc:
+                if isinstance(exc, ArchiveError):
+                    raise
+                raise ArchiveError(f"{where} has a bad .npy header "
+                                   f"({type(exc).__name__})") from None
+            header = fh.tell()
+            if dtype.hasobject:
+                raise ArchiveError(f"{where} holds Python objects (pickles are never loaded)")
+            count = 1
+            for n in shape:
+                count *= int(n)
+            if count * dtype.itemsize != info.file_size - header:
+                raise ArchiveError(f"{where} has a header for shape {tuple(shape)} of {dtype} "
+                                   f"({count * dtype.itemsize} bytes) but holds "
+                                   f"{info.file_size - header} bytes of data")
+        with self.zf.open(info) as fh:   # sizes agree: reading allocates what the file holds
+            return fmt.read_array(fh, allow_pickle=False)
+
+    def metadata(self):
+        info = self._names.get("metadata")
+        if info is None:
+            return None
+        return self._read("metadata", info, limit=_MAX_METADATA_BYTES)
+
+
 def _open(path):
-    """np.load of an archive with clear errors; returns (NpzFile, metadata dict or None)."""
+    """The entries of an archive and its metadata dict, with clear errors; returns
+    (zipfile.ZipFile, _Entries, metadata). The caller closes the ZipFile."""
     p = os.fspath(path)
     if not os.path.isfile(p):
         hint = f" (did you mean {p + '.npz'!r}?)" if os.path.isfile(p + ".npz") else ""
         raise FileNotFoundError(f"no saved result at {p!r}{hint}")
     try:
-        data = np.load(p, allow_pickle=False)
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
-        raise ValueError(f"{p!r} is not a ti_spinorbit archive: not a NumPy .npz file ({exc})") from None
-    if not isinstance(data, np.lib.npyio.NpzFile):
-        raise ValueError(f"{p!r} is not a ti_spinorbit archive: a single .npy array, not an .npz")
-    if "metadata" not in data.files:
-        data.close()
-        raise ValueError(f"{p!r} is not a ti_spinorbit archive: it has no 'metadata' entry "
-                         f"(entries: {', '.join(data.files) or 'none'})")
+        with open(p, "rb") as fh:
+            magic = fh.read(6)
+    except OSError as exc:
+        raise ArchiveError(f"{p!r} cannot be read: {_one_line(exc)}") from None
+    if magic == b"\x93NUMPY":
+        raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: a single .npy array, not an .npz")
+    if not magic.startswith(b"PK"):
+        raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: not a NumPy .npz file "
+                           "(no zip signature)")
     try:
-        meta = json.loads(str(data["metadata"]))
-    except (ValueError, TypeError) as exc:
-        data.close()
-        raise ValueError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not JSON "
-                         f"({exc})") from None
-    if not isinstance(meta, dict):
-        data.close()
-        raise ValueError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not a JSON object")
-    return data, meta
+        zf = zipfile.ZipFile(p)
+    except _DAMAGE as exc:
+        raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: not a NumPy .npz file "
+                           f"({_one_line(exc)})") from None
+    try:
+        entries = _Entries(p, zf)
+        if "metadata" not in entries:
+            raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: it has no 'metadata' "
+                               f"entry (entries: {', '.join(entries.files) or 'none'})")
+        try:
+            text = entries.metadata()
+        except ArchiveError:
+            raise
+        except _DAMAGE as exc:
+            raise ArchiveError(f"{p!r} is damaged: its 'metadata' entry cannot be read "
+                               f"({type(exc).__name__}: {_one_line(exc)})") from None
+        if text.dtype.kind != "U" or text.shape != ():
+            raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not "
+                               "JSON text")
+        try:
+            meta = json.loads(str(text))
+        except (ValueError, TypeError, RecursionError) as exc:
+            raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not "
+                               f"JSON ({type(exc).__name__}: {_one_line(exc)})") from None
+        if not isinstance(meta, dict):
+            raise ArchiveError(f"{p!r} is not a ti_spinorbit archive: its 'metadata' is not a "
+                               "JSON object")
+    except BaseException:
+        zf.close()
+        raise
+    return zf, entries, meta
 
 
 def read_metadata(path):
-    """The JSON metadata of a saved result, as a dict."""
-    data, meta = _open(path)
-    data.close()
+    """The JSON metadata of a saved result, as a dict (ArchiveError for a malformed file)."""
+    zf, _, meta = _open(path)
+    zf.close()
     return meta
 
 
@@ -385,44 +526,74 @@ def load(path):
     Arrays come back identical (dtype and values, NaN padding included), scalar fields
     equal, and systems rebuilt with :meth:`BinarySystem.from_description` (identical
     parameter rows and initial states; members that shared a system share it again).
+    Only the entries the metadata refers to are read, each after its sizes are checked.
 
     Raises
     ------
     FileNotFoundError
         No file at ``path``.
-    ValueError
-        Not a ti_spinorbit archive (not an .npz, no metadata, no ``kind``), an unknown kind,
-        or a ``format_version`` this version of the package cannot read.
+    ArchiveError
+        (a ValueError) Not a ti_spinorbit archive (not an .npz, no metadata, no ``kind``), an
+        unknown kind, a ``format_version`` this version of the package cannot read, or a
+        damaged or malformed file of any sort; one line naming the file and the fault.
     """
     from . import __version__
-    from .systems import BinarySystem
 
     p = os.fspath(path)
-    data, meta = _open(p)
-    with data:
+    zf, entries, meta = _open(p)
+    with zf:
         if "kind" not in meta:
-            raise ValueError(
+            raise ArchiveError(
                 f"{p!r} is not a ti_spinorbit result archive: its metadata has no 'kind' (it was "
                 "written by write_archive directly, e.g. by an experiment script; read it with "
                 "numpy.load and ti_spinorbit.io.read_metadata)")
         version = meta.get("format_version", 0)
-        if type(version) is not int or version not in READABLE_FORMAT_VERSIONS:
-            raise ValueError(
+        readable = ", ".join(map(str, READABLE_FORMAT_VERSIONS))
+        if type(version) is int and version > max(READABLE_FORMAT_VERSIONS):
+            raise ArchiveError(
                 f"{p!r} has archive format_version {version!r}; ti_spinorbit {__version__} reads "
-                f"format versions {', '.join(map(str, READABLE_FORMAT_VERSIONS))} (a newer "
-                "package wrote it: upgrade ti_spinorbit)")
+                f"format versions {readable} (a newer package wrote it: upgrade ti_spinorbit)")
+        if type(version) is not int or version not in READABLE_FORMAT_VERSIONS:
+            raise ArchiveError(
+                f"{p!r} has archive format_version {version!r}, which no ti_spinorbit writes "
+                f"(format versions are integers; this package reads {readable}): the file is "
+                "damaged")
         kind = meta["kind"]
-        if kind not in _kinds():
-            raise ValueError(f"{p!r} holds unknown kind {kind!r}; known kinds: "
-                             f"{', '.join(_kinds())}")
-        arrays = {k: data[k] for k in data.files if k != "metadata"}
-    if version == 0:
-        meta = _upgrade_v0(p, meta, arrays)
-    systems = [BinarySystem.from_description(d) for d in meta.get("systems", [])]
-    return _decode(meta, arrays, "", systems)
+        if not isinstance(kind, str) or kind not in _kinds():
+            raise ArchiveError(f"{p!r} holds unknown kind {kind!r}; known kinds: "
+                               f"{', '.join(_kinds())}")
+        try:
+            if version == 0:
+                meta = _upgrade_v0(p, meta, entries)
+            return _decode_file(meta, entries)
+        except ArchiveError:
+            raise
+        except _DAMAGE as exc:
+            raise ArchiveError(f"{p!r} is damaged or malformed: {type(exc).__name__}: "
+                               f"{_one_line(exc)}") from None
+
+
+def _decode_file(meta, entries):
+    from .systems import BinarySystem
+
+    descriptions = meta.get("systems", [])
+    if not isinstance(descriptions, list):
+        raise TypeError(f"metadata 'systems' is a {type(descriptions).__name__}, not a list")
+    systems = [BinarySystem.from_description(d) for d in descriptions]
+    return _decode(meta, entries, "", systems)
+
+
+def _system(systems, index):
+    """systems[index] for a stored index (an int in range, never a negative one)."""
+    if isinstance(index, (bool, np.bool_)) or not isinstance(index, (int, np.integer)) \
+            or not 0 <= index < len(systems):
+        raise IndexError(f"system index {index!r} is not in 0..{len(systems) - 1}")
+    return systems[int(index)]
 
 
 def _decode(block, arrays, prefix, systems):
+    if not isinstance(block, dict):
+        raise TypeError(f"a result block is a {type(block).__name__}, not a JSON object")
     cls = _kinds()[block["kind"]]
     kwargs = dict(block.get("fields", {}))
     for name in block.get("arrays", []):
@@ -432,9 +603,9 @@ def _decode(block, arrays, prefix, systems):
         kwargs[name] = [arrays[f"{prefix}{name}/{k}"] for k in range(count)]
     for name, ref in block.get("system_refs", {}).items():
         if "index" in ref:
-            kwargs[name] = systems[ref["index"]]
+            kwargs[name] = _system(systems, ref["index"])
         else:
-            kwargs[name] = [systems[i] for i in arrays[prefix + ref["array"]]]
+            kwargs[name] = [_system(systems, i) for i in arrays[prefix + ref["array"]].tolist()]
     for name, rec in block.get("records", {}).items():
         rtype = _record_types()[rec["type"]] if rec["type"] else None
         kwargs[name] = [rtype(**{k: tuple(v) if k in rec["tuples"] and v is not None else v
@@ -483,4 +654,4 @@ def to_xarray(result_or_path):
 
 __all__ = ["save", "load", "to_xarray", "save_result", "read_metadata", "write_archive",
            "provenance", "describe_system", "units", "status_codes", "status_names", "kind_of",
-           "FORMAT_VERSION"]
+           "FORMAT_VERSION", "ArchiveError"]

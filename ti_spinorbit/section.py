@@ -155,7 +155,8 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
                        atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
                        progress=None, model="auto", checkpoint=None,
-                       resume=False, max_drift=None) -> SectionResult:
+                       resume=False, overwrite_checkpoint=False,
+                       max_drift=None) -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -190,7 +191,13 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     checkpoint : path, optional
         Write a checkpoint after every window (atomic replace); with ``resume=True`` continue
         from it when it exists. A resumed run equals an uninterrupted one
-        (``ti_spinorbit.checkpoint``).
+        (``ti_spinorbit.checkpoint``). The run locks the directory: a second run on it is
+        refused (``CheckpointLocked``).
+    resume : bool
+        Continue from ``checkpoint`` (a fresh start when it holds none).
+    overwrite_checkpoint : bool
+        Without ``resume``, replace a checkpoint already in the directory; False (default)
+        refuses it (``CheckpointExists``, a ValueError) and leaves it untouched.
     max_drift : float, optional
         Largest relative energy or angular-momentum drift of a member reported "done"; a
         member above it is "inaccurate" (kept, counted apart). Default:
@@ -206,7 +213,8 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
-                  progress=progress, checkpoint=checkpoint, resume=resume)
+                  progress=progress, checkpoint=checkpoint, resume=resume,
+                  overwrite_checkpoint=overwrite_checkpoint)
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"))
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
@@ -308,7 +316,8 @@ class TimeSeriesResult:
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
                 rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                 escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
-                resume=False, max_drift=None) -> TimeSeriesResult:
+                resume=False, overwrite_checkpoint=False,
+                max_drift=None) -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
@@ -323,7 +332,8 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
                   sample_dt=2.0 * np.pi / samples_per_orbit, progress=progress,
-                  checkpoint=checkpoint, resume=resume)
+                  checkpoint=checkpoint, resume=resume,
+                  overwrite_checkpoint=overwrite_checkpoint)
     cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r"), ensemble=ens)
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])

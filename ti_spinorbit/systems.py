@@ -125,9 +125,15 @@ class BinarySystem:
 
     @property
     def omega0(self) -> float:
-        """Secondary's libration frequency in units of n: sqrt(3 (B − A) / C) (physics.md §1)."""
+        """Secondary's free libration frequency in units of n: sqrt(3 |B − A| / C)
+        (physics.md §1), A, B, C the moments about the body's x, y, z axes (kg m²).
+
+        The secondary spins about its z axis; its long axis in the xy plane (x when A <= B,
+        y when B < A) librates about the line of centres with this small-amplitude
+        frequency, so a body whose long axis is y has the same ω0 as the same body turned
+        by 90° about z. 0 for a body symmetric about z (A = B)."""
         A, B, C = self.secondary.moments
-        return math.sqrt(3.0 * (B - A) / C)
+        return math.sqrt(3.0 * abs(B - A) / C)
 
     # ---- scaled member rows -------------------------------------------------------------
     def scaled_body_row(self, body: Body) -> np.ndarray:
