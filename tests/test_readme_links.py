@@ -1,0 +1,46 @@
+"""Every file the README (and the experiments README) links, figures included, is in the
+repository: checked against ``git ls-files`` where the checkout is a git clone (a file in the
+working tree but ignored by .gitignore would pass a plain existence check and still be
+missing for everyone else), else against the file system."""
+
+import os
+import re
+import subprocess
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+READMES = ["README.md", "experiments/README.md", "docs/design.md", "docs/dask.md"]
+
+
+def _links(readme):
+    text = open(os.path.join(ROOT, readme), encoding="utf-8").read()
+    base = os.path.dirname(readme)
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"[a-z]+:", target) or target.startswith("#"):
+            continue                                   # web links and anchors
+        yield os.path.normpath(os.path.join(base, target.split("#")[0]))
+
+
+def _tracked():
+    try:
+        out = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True,
+                             check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return set(out.splitlines()) or None
+
+
+@pytest.mark.parametrize("readme", READMES)
+def test_every_linked_file_is_in_the_repository(readme):
+    links = sorted(set(_links(readme)))
+    tracked = _tracked()
+    missing = [p for p in links if (p not in tracked if tracked is not None
+                                    else not os.path.exists(os.path.join(ROOT, p)))]
+    assert not missing, f"{readme} links files that are not in the repository: {missing}"
+
+
+def test_the_gallery_is_linked():
+    links = list(_links("README.md"))
+    assert "docs/dask.md" in links and "experiments/README.md" in links   # the parser works
+    assert len([p for p in links if p.startswith("docs/figures/")]) >= 12
