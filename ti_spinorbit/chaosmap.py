@@ -24,7 +24,7 @@ from typing import Callable, Optional, Union
 
 import numpy as np
 
-from . import analytic, catalog
+from . import analytic, catalog, resources
 from ._validate import require_positive
 from .classify import MIN_POINTS, classify_section
 from .distributed import sections
@@ -218,6 +218,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     check_orbits(orbits)
     require_positive("rtol", rtol)
     require_positive("megno_chaotic", megno_chaotic)
+    resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
+                           advice="use a coarser grid or fewer orbits")
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
@@ -348,6 +350,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         raise TypeError("factory_or_name must be a catalogue name or a callable (q, e) -> system")
     tp, td = (x.ravel() for x in np.meshgrid(theta_p, thetadot_p, indexing="ij"))
     starts = tp.size
+    resources.check_memory("parameter_map", elongations.size * eccentricities.size * starts,
+                           orbits, advice="use a coarser grid, fewer starts or fewer orbits")
     grid = [factory(float(q), float(e)) for q in elongations for e in eccentricities]
     if not name:
         name = grid[0].name

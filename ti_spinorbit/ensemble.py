@@ -294,13 +294,14 @@ class Ensemble:
 
 
 def _record_bytes(t_stop, sample_dt, width, cap):
-    """Bytes the recorded crossings (≈ 1.25 per orbit, generous for near-circular orbits) and
-    samples of a run will occupy, plus the window buffers."""
-    orbits = np.asarray(t_stop) / (2.0 * np.pi)
-    rows = np.sum(1.25 * orbits + cap)
-    if sample_dt is not None:
-        rows += np.sum(np.asarray(t_stop) / sample_dt + 1) + len(orbits) * cap
-    return float(rows) * width * 8 * 2          # lists, then the concatenated copy
+    """Peak bytes of a run and of the observables derived from its records
+    (:func:`ti_spinorbit.resources.estimate_bytes`, the model the entry points check before
+    building members). ``width`` is unused (the peak holds 3-D rows whatever the model)."""
+    from . import resources
+
+    spo = None if sample_dt is None else 2.0 * np.pi / float(sample_dt)
+    orbits = np.asarray(t_stop, dtype=np.float64) / (2.0 * np.pi)
+    return resources.estimate_bytes(len(orbits), orbits, spo, window_orbits=cap - 4)
 
 
 def _choose_model(model, par, y0):

@@ -35,7 +35,7 @@ from typing import Callable, List, Optional, Union
 
 import numpy as np
 
-from . import analytic, catalog
+from . import analytic, catalog, resources
 from ._validate import require_range
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
@@ -159,6 +159,13 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     q = np.round(np.arange(1.01, 1.155, 0.01), 10) if elongations is None else \
         np.asarray(elongations, dtype=np.float64).ravel()
     require_range("elongations", q, 1.0, 10.0, low_open=True, high_open=False)
+    try:
+        per_elongation = int(center_starts) + int(separatrix_starts)
+    except (TypeError, ValueError):
+        per_elongation = None                  # named by the checks that build the columns
+    if per_elongation is not None and per_elongation > 0:
+        resources.check_memory("overlap_threshold", q.size * per_elongation, orbits,
+                               advice="scan fewer elongations or starts, or fewer orbits")
     systems = [make(float(x)) for x in q]
     e = systems[0].e
     # θ_p = 0 column for the centres; θ_p = 90° column for the connection
