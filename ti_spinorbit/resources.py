@@ -20,8 +20,10 @@ sample; 8-byte floats):
 Counting those arrays gives about 150 floats per row; measured peak RSS growth
 (``experiments/memory_estimate.py``) is 1 200-1 300 bytes per row for both sections and time
 series, planar and 3-D, which is what :data:`ROW_BYTES` uses. A member costs
-:data:`MEMBER_BYTES` on top (its parameter row, states, window buffers, Python lists and one
-small array per window with records).
+:data:`MEMBER_BYTES` on top (its parameter row, result arrays, Python lists and one small
+array per window with records). With many members and few orbits the integration itself can
+be the peak (window buffers of ``window_orbits + 4`` rows per member): the estimate is the
+larger of the two phases.
 """
 
 import math
@@ -34,9 +36,12 @@ from ._validate import GIB, require_memory
 ROW_BYTES = 1300.0
 #: Pericentre crossings per initial orbit (coupling changes the mean motion a little).
 CROSSINGS_PER_ORBIT = 1.0
-#: Bytes per member besides its records: parameter rows, states, RHS, shadow, buffers
-#: (NSTATE-wide kernel state ~ 10 arrays), labels and Python objects.
-MEMBER_BYTES = 6000.0
+#: Bytes per member besides its records at the peak: parameter rows, states, result
+#: arrays, labels and Python objects (measured: a 128 x 128 map of 10 orbits).
+MEMBER_BYTES = 2500.0
+#: Bytes per member alive only during the integration: kernel states, RHS, shadow, errors
+#: (about ten NSTATE-wide rows).
+RUN_MEMBER_BYTES = 2500.0
 #: Bytes per member and window that produced records (one small array and a list slot).
 CHUNK_BYTES = 160.0
 #: Window buffer rows per member besides the window's own records (ensemble.Ensemble.run).
@@ -53,7 +58,7 @@ def record_rows(orbits, samples_per_orbit=None):
     return rows
 
 
-def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16):
+def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16, width=31):
     """Peak memory, bytes, of an entry point integrating ``members`` members for ``orbits``
     initial orbits each (a scalar, or an array with one value per member), with
     ``samples_per_orbit`` dense samples per orbit (a time series) or none (a section): its
@@ -68,9 +73,13 @@ def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16):
     mean_orbits = float(np.mean(orbits))
     windows = math.ceil(mean_orbits / max(window_orbits, 1))
     per_window = 1 + (samples_per_orbit is not None)        # chunk arrays per window
-    buffers = (window_orbits + BUFFER_SLACK) * (1 + (samples_per_orbit or 0)) * 31 * 8
-    per_member = MEMBER_BYTES + CHUNK_BYTES * windows * per_window + buffers
-    return ROW_BYTES * total_rows + per_member * members
+    per_member = MEMBER_BYTES + CHUNK_BYTES * windows * per_window
+    # during the integration: window buffers (events, samples) of the kernels' record width
+    # and the records so far; after it: the observables (the usual peak, ROW_BYTES)
+    buffer_rows = window_orbits + BUFFER_SLACK + \
+        (math.ceil(window_orbits * samples_per_orbit) + BUFFER_SLACK if samples_per_orbit else 1)
+    running = (buffer_rows * width * 8 + RUN_MEMBER_BYTES) * members + total_rows * width * 8
+    return max(ROW_BYTES * total_rows, running) + per_member * members
 
 
 def check_memory(what, members, orbits, samples_per_orbit=None, window_orbits=16,
