@@ -8,7 +8,9 @@ Decisions:
 * A window is ``window_orbits`` initial orbital periods (scaled time 2π per orbit for every
   member, since each member's time unit is its own 1/n). Event buffers hold
   ``window_orbits + 4`` crossings; a member that fills its buffer pauses and resumes in the
-  next launch, so the window length changes launch overhead, never results.
+  next launch, so the window length changes launch overhead, never results. Windows start at
+  one orbit and adapt to the launch's wall time (``PROGRESS_SECONDS``), never longer than
+  ``window_orbits``, so progress comes every few seconds even for slow ensembles.
 * Arrays are numpy and handed to the kernels as external ndarrays; on the CPU Taichi uses
   them in place.
 """
@@ -223,6 +225,7 @@ class Ensemble:
                          self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
                          float(separation), self.order, self.odd, sampling, bool(indicators))
             st["launches"] += 1
+            # the kernel's time only: draining and checkpointing do not shrink with the span
             span = _next_span(span, time.perf_counter() - launched, window)
             for name, store, buf, count in (("events", events, events_buf, n_events),
                                             ("samples", samples, samples_buf, n_samples)):
