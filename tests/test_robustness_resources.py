@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import _validate, cli, ensemble, resources, runtime, section
+from ti_spinorbit import _validate, cli, ensemble, overlap, resources, runtime, section
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXPERIMENT = os.path.join(ROOT, "experiments", "memory_estimate.py")
@@ -136,6 +136,17 @@ def test_refusal_follows_the_available_memory(vh, monkeypatch):
     monkeypatch.setattr(_validate, "available_memory", lambda: 64 * GIB)
     from ti_spinorbit.kernels.ensemble import DONE
     assert tso.time_series(vh, 0.0, 1.0, 2, samples_per_orbit=4).status.tolist() == [DONE]
+
+
+def test_overlap_scans_at_several_eccentricities_are_sized_together(monkeypatch):
+    """Each scan keeps its sections: three that fit one by one (~0.47 GiB each at 300 orbits)
+    are refused together with 1 GiB available, before the first scan starts."""
+    one = resources.estimate_bytes(15 * 80, 300)
+    assert one < 0.8 * GIB < 3 * one
+    monkeypatch.setattr(_validate, "available_memory", lambda: GIB)
+    monkeypatch.setattr(section, "build_members", _no_members)
+    with pytest.raises(_validate.InsufficientMemoryError, match=r"^overlap_vs_eccentricity needs "):
+        overlap.overlap_vs_eccentricity("1991 VH", [0.05, 0.1, 0.15], orbits=300)
 
 
 def test_inputs_that_do_not_broadcast_are_left_to_build_members(vh):

@@ -240,6 +240,19 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
     ecc = np.asarray(eccentricities, dtype=np.float64).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
+    # every scan keeps its sections: size all of them together, before the first
+    import inspect
+    default = {k: v.default for k, v in inspect.signature(overlap_threshold).parameters.items()}
+    args = dict(default, **kwargs)
+    try:
+        per_scan = (15 if elongations is None else np.size(elongations)) * \
+            (int(args["center_starts"]) + int(args["separatrix_starts"]))
+        orbits = float(args["orbits"])
+    except (TypeError, ValueError):
+        per_scan = None                        # named by overlap_threshold's own checks
+    if per_scan and np.isfinite(orbits) and orbits > 0:
+        resources.check_memory("overlap_vs_eccentricity", ecc.size * per_scan, orbits,
+                               advice="use fewer eccentricities, elongations, starts or orbits")
     scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
              for e in ecc]
     first = np.array([np.nan if s.first_overlap is None else s.first_overlap for s in scans])
