@@ -4,7 +4,6 @@ is built, progress comes every few seconds even inside a long window without cha
 of the results, and a read-only HOME (unwritable kernel cache) no longer crashes at exit."""
 
 import dataclasses
-import json
 import os
 import subprocess
 import sys
@@ -36,12 +35,13 @@ def vh():
 def test_estimate_within_factor_1_5_of_measured_peak_rss(entry, kw):
     """The estimate the entry point computes before any work against the peak RSS growth of
     the run, in a fresh process that has initialised Taichi and run a tiny case first
-    (experiments/memory_estimate.py --case)."""
-    p = subprocess.run([sys.executable, EXPERIMENT, "--case", json.dumps({"entry": entry, "kw": kw})],
-                       capture_output=True, text=True, timeout=300,
-                       env=dict(os.environ, MPLBACKEND="Agg"), cwd=os.path.dirname(EXPERIMENT))
-    assert p.returncode == 0, p.stderr[-2000:]
-    r = json.loads(p.stdout.strip().splitlines()[-1])
+    (experiments/memory_estimate.py, measure)."""
+    sys.path.insert(0, os.path.dirname(EXPERIMENT))
+    try:
+        import memory_estimate
+    finally:
+        sys.path.pop(0)
+    r = memory_estimate.measure(entry, kw)
     assert r["growth"] > 10 * 2**20, r          # the case is large against allocator noise
     assert 1 / 1.5 <= r["estimate"] / r["growth"] <= 1.5, r
 
