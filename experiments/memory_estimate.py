@@ -38,6 +38,8 @@ QUICK = [
 FULL = [
     ("section 8x20000", "surface_of_section", dict(members=8, orbits=20000)),
     ("section 256x300", "surface_of_section", dict(members=256, orbits=300)),
+    ("section 3d 16384x2", "surface_of_section", dict(members=16384, orbits=2, model="3d")),
+    ("section 65536x1", "surface_of_section", dict(members=65536, orbits=1)),
     ("time_series 4x500x64", "time_series", dict(members=4, orbits=500, samples_per_orbit=64)),
     ("time_series 16x4000x40 (issue 10)", "time_series",
      dict(members=16, orbits=4000, samples_per_orbit=40)),
@@ -96,11 +98,13 @@ def run_case(entry, kw):
     vh = tso.catalog.system("1991 VH")
 
     def call(scale):
-        orbits = max(kw["orbits"] * scale, 2)
+        orbits = max(kw["orbits"] * scale, 2) if scale < 1 else kw["orbits"]
+        members = kw.get("members", 1) if scale == 1 else min(kw.get("members", 1), 4)
         if entry == "surface_of_section":
-            tso.surface_of_section(vh, 0.0, np.linspace(0.9, 1.3, kw["members"]), orbits)
+            tso.surface_of_section(vh, 0.0, np.linspace(0.9, 1.3, members), orbits,
+                                   model=kw.get("model", "auto"))
         elif entry == "time_series":
-            tso.time_series(vh, 0.0, np.linspace(0.9, 1.3, kw["members"]), orbits,
+            tso.time_series(vh, 0.0, np.linspace(0.9, 1.3, members), orbits,
                             samples_per_orbit=kw["samples_per_orbit"], model=kw.get("model", "auto"))
         elif entry == "energy":
             out = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"memory_estimate_{os.getpid()}")

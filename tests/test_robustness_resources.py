@@ -240,6 +240,24 @@ def test_read_only_home_runs_and_exits_true(tmp_path):
     assert not [f for f in os.listdir(tmp_path) if f.startswith("ti_spinorbit-cache-")]
 
 
+def test_read_only_home_with_the_disk_cache_off_exits_true(tmp_path):
+    """init(offline_cache=False) used to crash at exit too: Taichi touches its default cache
+    path (~/.cache/taichi/ticache) either way."""
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("")
+    env = dict(os.environ, HOME=str(blocker / "home"), XDG_CACHE_HOME=str(blocker / "cache"),
+               TMPDIR=str(tmp_path))
+    env.pop(runtime.CACHE_ENV, None)
+    script = ("import ti_spinorbit as tso; tso.init(offline_cache=False); "
+              "r = tso.surface_of_section(tso.catalog.system('1991 VH'), 0.0, 1.0, 1); "
+              "print(r.status_names[0])")
+    p = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert p.stdout.strip().splitlines()[-1] == "done"
+    assert sum("is not writable (Not a directory)" in line for line in p.stderr.splitlines()) == 1
+
+
 def test_cache_folder_from_platformdirs_and_the_variable(monkeypatch, tmp_path):
     monkeypatch.delenv(runtime.CACHE_ENV, raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))

@@ -219,7 +219,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     require_positive("rtol", rtol)
     require_positive("megno_chaotic", megno_chaotic)
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
-                           advice="use a coarser grid or fewer orbits")
+                           advice="use a coarser grid or fewer orbits",
+                           width=resources.record_width(system, model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,

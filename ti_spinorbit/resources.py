@@ -34,7 +34,8 @@ from ._validate import GIB, require_memory
 
 #: Peak bytes per recorded row (crossing or sample), measured: see the module docstring.
 ROW_BYTES = 1300.0
-#: Pericentre crossings per initial orbit (coupling changes the mean motion a little).
+#: Pericentre crossings per initial orbit (coupling changes the mean motion a little: 1.013
+#: measured for 1991 VH).
 CROSSINGS_PER_ORBIT = 1.0
 #: Bytes per member besides its records at the peak: parameter rows, states, result
 #: arrays, labels and Python objects (measured: a 128 x 128 map of 10 orbits).
@@ -52,7 +53,7 @@ def record_rows(orbits, samples_per_orbit=None):
     """Rows one member records over ``orbits`` orbits: crossings, plus samples (the initial
     state is the first) when ``samples_per_orbit`` is given. Scalars or arrays."""
     orbits = np.asarray(orbits, dtype=np.float64)
-    rows = np.ceil(CROSSINGS_PER_ORBIT * orbits) + 1
+    rows = np.ceil(CROSSINGS_PER_ORBIT * orbits)       # the start is not a crossing
     if samples_per_orbit is not None:
         rows = rows + np.ceil(orbits * samples_per_orbit) + 1
     return rows
@@ -73,22 +74,45 @@ def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16, wi
     mean_orbits = float(np.mean(orbits))
     windows = math.ceil(mean_orbits / max(window_orbits, 1))
     per_window = 1 + (samples_per_orbit is not None)        # chunk arrays per window
-    per_member = MEMBER_BYTES + CHUNK_BYTES * windows * per_window
-    # during the integration: window buffers (events, samples) of the kernels' record width
-    # and the records so far; after it: the observables (the usual peak, ROW_BYTES)
+    chunks = CHUNK_BYTES * windows * per_window * members
+    # after the integration: the observables (the usual peak, ROW_BYTES per row); during it:
+    # the window buffers (events, samples) of the kernels' record width, the kernel states
+    # and the records so far (the peak of many members with few orbits)
+    derived = ROW_BYTES * total_rows + MEMBER_BYTES * members
     buffer_rows = window_orbits + BUFFER_SLACK + \
         (math.ceil(window_orbits * samples_per_orbit) + BUFFER_SLACK if samples_per_orbit else 1)
     running = (buffer_rows * width * 8 + RUN_MEMBER_BYTES) * members + total_rows * width * 8
-    return max(ROW_BYTES * total_rows, running) + per_member * members
+    return max(derived, running) + chunks
 
 
 def check_memory(what, members, orbits, samples_per_orbit=None, window_orbits=16,
-                 advice="use fewer members or orbits, or sample less densely", available=None):
+                 advice="use fewer members or orbits, or sample less densely", available=None,
+                 width=31):
     """:func:`~ti_spinorbit._validate.require_memory` for :func:`estimate_bytes`: raises
     InsufficientMemoryError (a ValueError and a MemoryError) with "<what> needs X GiB, Y GiB
     available; <advice>". Returns the estimate in bytes."""
-    nbytes = estimate_bytes(members, orbits, samples_per_orbit, window_orbits)
+    nbytes = estimate_bytes(members, orbits, samples_per_orbit, window_orbits, width)
     return require_memory(what, nbytes, advice, available=available)
+
+
+def record_width(system, model="auto"):
+    """Width of the kernels' record rows for members of ``system`` under ``model``: the
+    planar model's (11) when "auto" will choose it (a BinarySystem whose start is planar and
+    bodies equatorially symmetric) or "planar" is asked, else the 3-D one (31; also when
+    ``system`` is a list, not yet known)."""
+    from . import planar
+    from .kernels import ensemble as K
+    from .systems import BinarySystem
+
+    if model == "planar":
+        return K.PLANAR.RECORD_WIDTH
+    if model != "auto" or not isinstance(system, BinarySystem):
+        return K.SPATIAL.RECORD_WIDTH
+    try:
+        ok = planar.qualifies(system.parameter_row(), system.initial_state(0.0, 1.0))
+    except (ValueError, TypeError, ArithmeticError):
+        return K.SPATIAL.RECORD_WIDTH
+    return K.PLANAR.RECORD_WIDTH if np.all(ok) else K.SPATIAL.RECORD_WIDTH
 
 
 def member_count(shape, *arrays):

@@ -96,24 +96,24 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         # per-member scheduling costs nothing.
         kwargs.update(make_cpu_multithreading_loop=False, cpu_block_dim_adaptive=False,
                       default_cpu_block_dim=1)
-    if offline_cache:
-        # Taichi's cache key ignores the loop settings above, so kernels compiled with other
-        # settings (another program, an older version of this package) must not be reused:
-        # our own folder unless TI_OFFLINE_CACHE_FILE_PATH names one (Taichi reads it).
-        folder = cache_folder()
-        problem = _unwritable(folder)
-        if problem is None:
-            if not os.environ.get(CACHE_ENV):
-                kwargs["offline_cache_file_path"] = folder
-        else:
-            # Taichi crashes at exit (SIGSEGV, status 139) when its cache folder cannot be
-            # written, even with offline_cache=False: compile in memory, with a temporary
-            # folder (removed at exit) as the path Taichi touches
-            kwargs["offline_cache"] = False
-            kwargs["offline_cache_file_path"] = _temporary_cache()
-            print(f"ti_spinorbit: kernel cache folder {folder} is not writable ({problem}); "
-                  f"compiling without a disk cache (set {CACHE_ENV} to a writable folder)",
-                  file=sys.stderr)
+    # Taichi's cache key ignores the loop settings above, so kernels compiled with other
+    # settings (another program, an older version of this package) must not be reused: our
+    # own folder unless TI_OFFLINE_CACHE_FILE_PATH names one (Taichi reads it). Checked even
+    # with offline_cache=False: Taichi touches its cache path at exit either way.
+    folder = cache_folder()
+    problem = _unwritable(folder)
+    if problem is None:
+        if offline_cache and not os.environ.get(CACHE_ENV):
+            kwargs["offline_cache_file_path"] = folder
+    else:
+        # Taichi crashes at exit (SIGSEGV, status 139) when its cache folder cannot be
+        # written, even with offline_cache=False: compile in memory, with a temporary
+        # folder (removed at exit) as the path Taichi touches
+        kwargs["offline_cache"] = False
+        kwargs["offline_cache_file_path"] = _temporary_cache()
+        print(f"ti_spinorbit: kernel cache folder {folder} is not writable ({problem}); "
+              f"compiling without a disk cache (set {CACHE_ENV} to a writable folder)",
+              file=sys.stderr)
     if _STATE["arch"] is not None:
         ti.reset()
     saved = None

@@ -35,7 +35,8 @@ def check_orbits(orbits):
     return value
 
 
-def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit=None):
+def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit=None,
+               model="auto"):
     """Refuse a run whose estimated peak memory (``resources.estimate_bytes``) exceeds what
     is available, from the input sizes alone: before any member is built. Inputs that do
     not broadcast are left to :func:`build_members`, which names them."""
@@ -45,7 +46,8 @@ def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per
         (len(system_or_systems),) if hasattr(system_or_systems, "__len__") else None
     n = None if systems is None else resources.member_count(systems, theta_p, thetadot_p)
     if n is not None:
-        resources.check_memory(what, n, orbits, samples_per_orbit)
+        resources.check_memory(what, n, orbits, samples_per_orbit,
+                               width=resources.record_width(system_or_systems, model))
 
 
 def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
@@ -185,7 +187,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     SectionResult
     """
     orbits = check_orbits(orbits)
-    check_size("surface_of_section", system_or_systems, theta_p, thetadot_p, orbits)
+    check_size("surface_of_section", system_or_systems, theta_p, thetadot_p, orbits, model=model)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
@@ -273,7 +275,8 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     (0, 1e7] (``MAX_ORBITS``), as for surface_of_section."""
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
-    check_size("time_series", system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit)
+    check_size("time_series", system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit,
+               model)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
