@@ -74,6 +74,14 @@ def test_many_members_few_orbits_count_the_window_buffers():
     assert resources.estimate_bytes(n, 1.0) >= buffers
 
 
+@pytest.mark.parametrize("model, systems, width", [
+    ("auto", "one", 11), ("planar", "one", 11), ("3d", "one", 31), ("auto", "list", 31)])
+def test_record_width_of_the_model_a_run_will_use(vh, model, systems, width):
+    """The early check sizes the kernels' buffers with the model's record width (planar
+    11, 3-D 31); a list of systems is not inspected (3-D, the larger)."""
+    assert resources.record_width(vh if systems == "one" else [vh, vh], model) == width
+
+
 # ---- 2. absurd sizes are refused before any member is built ---------------------------------
 
 def _no_members(*args, **kwargs):
