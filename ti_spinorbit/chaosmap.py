@@ -24,7 +24,7 @@ from typing import Callable, Optional, Union
 
 import numpy as np
 
-from . import accuracy, analytic, catalog
+from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_positive, require_real,
                         require_spin)
 from .classify import MIN_POINTS, classify_section
@@ -254,6 +254,9 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     _check_map_inputs(rtol, megno_chaotic, progress)
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
+    resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
+                           advice="use a coarser grid or fewer orbits",
+                           width=resources.record_width(system, model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
@@ -412,6 +415,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         raise TypeError("factory_or_name must be a catalogue name or a callable (q, e) -> system")
     tp, td = (x.ravel() for x in np.meshgrid(theta_p, thetadot_p, indexing="ij"))
     starts = tp.size
+    resources.check_memory("parameter_map", elongations.size * eccentricities.size * starts,
+                           orbits, advice="use a coarser grid, fewer starts or fewer orbits")
     grid = [factory(float(q), float(e)) for q in elongations for e in eccentricities]
     if not name:
         name = grid[0].name

@@ -115,6 +115,7 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         system_or_systems, theta_p, thetadot_p, orbits, **kwargs)
     call.apply_defaults()
     section.check_orbits(orbits)
+    section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits)
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "

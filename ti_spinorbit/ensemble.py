@@ -8,7 +8,9 @@ Decisions:
 * A window is ``window_orbits`` initial orbital periods (scaled time 2π per orbit for every
   member, since each member's time unit is its own 1/n). Event buffers hold
   ``window_orbits + 4`` crossings; a member that fills its buffer pauses and resumes in the
-  next launch, so the window length changes launch overhead, never results.
+  next launch, so the window length changes launch overhead, never results. Windows start at
+  one orbit and adapt to the launch's wall time (``PROGRESS_SECONDS``), never longer than
+  ``window_orbits``, so progress comes every few seconds even for slow ensembles.
 * Arrays are numpy and handed to the kernels as external ndarrays; on the CPU Taichi uses
   them in place.
 """
@@ -25,6 +27,12 @@ from ._validate import (require_count, require_memory, require_positive, require
 #: Default tolerance floor: atol = rtol unless given (the scaled state is O(1)).
 DEFAULT_WINDOW_ORBITS = 16
 MIN_STEP = 1e-10  # scaled time (1/n): below this a member stops with "step underflow"
+#: Wall-clock seconds a window should take, so that progress (and a checkpoint) comes at
+#: least every few seconds: a window that took more than twice this is shortened
+#: proportionally, one that took less than half of it is doubled, never beyond
+#: ``window_orbits`` (which sizes the buffers) nor below MIN_WINDOW_ORBITS.
+PROGRESS_SECONDS = 1.0
+MIN_WINDOW_ORBITS = 1.0 / 64
 #: Shadow-trajectory separation (scaled-state norm): large against round-off (1e-16 · O(1)
 #: components gives 1e-8 relative noise per step), small enough to stay linear.
 SHADOW_SEPARATION = 1e-8
@@ -153,7 +161,9 @@ class Ensemble:
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
         called after every window. Window ends are soft (no step is shortened for them), so
-        the window length changes launch overhead only, never results.
+        the window length changes launch overhead only, never results; a window is
+        ``window_orbits`` orbits at most and shorter when launches take seconds (so that
+        progress comes every ~PROGRESS_SECONDS, see :func:`_next_span`).
 
         ``indicators`` integrates a shadow trajectory with the same steps, started
         ``separation`` away (scaled-state Euclidean norm) along a fixed planar direction and
@@ -230,14 +240,18 @@ class Ensemble:
         pending = {"events": {}, "samples": {} if st["launches"] else
                    {i: list(s) for i, s in enumerate(samples) if s}}
         t0 = time.perf_counter() - st["seconds"]
+        span = min(window, 2.0 * np.pi)  # first window: one orbit, then adapted to wall time
         while np.any(self.status == K.RUNNING):
-            t_end = np.minimum(t_stop, self.t + window)
+            t_end = np.minimum(t_stop, self.t + span)
+            launched = time.perf_counter()
             kern.advance(self.kpar, self.y, st["yc"], st["f"], self.t, st["tc"], self.h, t_end,
                          t_stop, self.status, self.counters, events_buf, n_events, samples_buf,
                          n_samples, st["next_sample"], st["shadow"], st["shadow_f"], st["ind"],
                          self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
                          float(separation), self.order, self.odd, sampling, bool(indicators))
             st["launches"] += 1
+            # the kernel's time only: draining and checkpointing do not shrink with the span
+            span = _next_span(span, time.perf_counter() - launched, window)
             for name, store, buf, count in (("events", events, events_buf, n_events),
                                             ("samples", samples, samples_buf, n_samples)):
                 for i in np.nonzero(count)[0]:
@@ -318,14 +332,28 @@ class Ensemble:
         return np.concatenate([rec[:, :1], planar.to_spatial(rec[:, 1:])], axis=1)
 
 
+def _next_span(span, seconds, window):
+    """Scaled length of the next window after one of ``span`` took ``seconds``: shortened
+    when it took over 2·PROGRESS_SECONDS, lengthened (doubled) below PROGRESS_SECONDS/2,
+    within [MIN_WINDOW_ORBITS orbits, window]. Window ends are soft, so this changes when
+    progress is reported, never the results."""
+    if seconds > 2.0 * PROGRESS_SECONDS:
+        span = span * PROGRESS_SECONDS / seconds
+    elif seconds < 0.5 * PROGRESS_SECONDS:
+        span = 2.0 * span
+    return float(min(max(span, 2.0 * np.pi * MIN_WINDOW_ORBITS), window))
+
+
 def _record_bytes(t_stop, sample_dt, width, cap):
-    """Bytes the recorded crossings (≈ 1.25 per orbit, generous for near-circular orbits) and
-    samples of a run will occupy, plus the window buffers."""
-    orbits = np.asarray(t_stop) / (2.0 * np.pi)
-    rows = np.sum(1.25 * orbits + cap)
-    if sample_dt is not None:
-        rows += np.sum(np.asarray(t_stop) / sample_dt + 1) + len(orbits) * cap
-    return float(rows) * width * 8 * 2          # lists, then the concatenated copy
+    """Peak bytes of a run and of the observables derived from its records
+    (:func:`ti_spinorbit.resources.estimate_bytes`, the model the entry points check before
+    building members), with the kernels' record ``width`` (11 planar, 31 3-D)."""
+    from . import resources
+
+    spo = None if sample_dt is None else 2.0 * np.pi / float(sample_dt)
+    orbits = np.asarray(t_stop, dtype=np.float64) / (2.0 * np.pi)
+    return resources.estimate_bytes(len(orbits), orbits, spo, window_orbits=cap - 4,
+                                    width=width)
 
 
 def _choose_model(model, par, y0):

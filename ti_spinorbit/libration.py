@@ -44,7 +44,7 @@ from typing import List
 
 import numpy as np
 
-from . import accuracy, analytic
+from . import accuracy, analytic, resources
 from .classify import horizontal_extent
 from ._validate import (require_callable, require_count, require_positive,
                         require_real, require_scalar, require_spin)
@@ -279,6 +279,15 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         np.asarray(require_spin("candidates", candidates), dtype=np.float64).ravel()
     if len(x) < 5 or np.any(np.diff(x) <= 0):
         raise ValueError(f"candidates must hold at least 5 ascending values (got {candidates!r})")
+
+    # every launch of the search, sized before the first (the largest decides)
+    for what, members, spo in (("relaxed_libration (coarse section)", len(x), None),
+                               ("relaxed_libration (libration check)", len(x),
+                                CLASSIFY_SAMPLES_PER_ORBIT),
+                               ("relaxed_libration (zoom)", zoom_candidates, None),
+                               ("relaxed_libration (amplitude)", 1, samples_per_orbit)):
+        resources.check_memory(what, members, orbits, spo,
+                               advice="use fewer orbits, candidates or samples per orbit")
 
     shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
     launches = 0

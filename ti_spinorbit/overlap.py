@@ -35,7 +35,7 @@ from typing import Callable, List, Optional, Union
 
 import numpy as np
 
-from . import accuracy, analytic, catalog
+from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_count, require_range,
                         require_scalar, show)
 from .classify import MEGNO_CHAOTIC
@@ -194,6 +194,13 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     require_range("elongations", q, 1.0, 10.0, low_open=True, high_open=False)
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
+    try:
+        per_elongation = int(center_starts) + int(separatrix_starts)
+    except (TypeError, ValueError):
+        per_elongation = None                  # named by the checks that build the columns
+    if per_elongation is not None and per_elongation > 0:
+        resources.check_memory("overlap_threshold", q.size * per_elongation, orbits,
+                               advice="scan fewer elongations or starts, or fewer orbits")
     systems = [make(float(x)) for x in q]
     e = systems[0].e
     # θ_p = 0 column for the centres; θ_p = 90° column for the connection
@@ -277,6 +284,19 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
     ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
+    # every scan keeps its sections: size all of them together, before the first
+    import inspect
+    default = {k: v.default for k, v in inspect.signature(overlap_threshold).parameters.items()}
+    args = dict(default, **kwargs)
+    try:
+        per_scan = (15 if elongations is None else np.size(elongations)) * \
+            (int(args["center_starts"]) + int(args["separatrix_starts"]))
+        orbits = float(args["orbits"])
+    except (TypeError, ValueError):
+        per_scan = None                        # named by overlap_threshold's own checks
+    if per_scan and np.isfinite(orbits) and orbits > 0:
+        resources.check_memory("overlap_vs_eccentricity", ecc.size * per_scan, orbits,
+                               advice="use fewer eccentricities, elongations, starts or orbits")
     scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
              for e in ecc]
     first = np.array([np.nan if s.first_overlap is None else s.first_overlap for s in scans])

@@ -45,8 +45,10 @@ if _is_command_line():
 
 _STATE = {"arch": None}
 ARCH_ENV = "TI_SPINORBIT_ARCH"
-#: Offline-cache folder under ~/.cache/taichi (bump when kernel settings change).
+#: Offline-cache folder under the user cache folder's taichi/ (bump when kernel settings
+#: change); see :func:`cache_folder`.
 CACHE_SUBDIR = "ti_spinorbit-1"
+CACHE_ENV = "TI_OFFLINE_CACHE_FILE_PATH"
 _KNOWN_ARCHS = ("cpu", "x64", "arm64", "cuda", "vulkan", "metal", "opengl", "gpu")
 
 
@@ -60,8 +62,11 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         the default. Asking for a GPU arch that is not available raises RuntimeError instead
         of silently falling back to the CPU.
     offline_cache : bool
-        Keep compiled kernels on disk (``~/.cache/taichi/ti_spinorbit-1`` unless
-        ``TI_OFFLINE_CACHE_FILE_PATH`` is set), so a fresh process starts in seconds.
+        Keep compiled kernels on disk (:func:`cache_folder`: the user cache folder's
+        ``taichi/ti_spinorbit-1``, ``~/.cache/taichi/ti_spinorbit-1`` on Linux, unless
+        ``TI_OFFLINE_CACHE_FILE_PATH`` is set), so a fresh process starts in seconds. When
+        that folder cannot be created or written (a read-only HOME), kernels are compiled
+        in memory instead, with a one-line notice on stderr.
     cpu_max_num_threads : int, optional
         Threads for the CPU backend (default: all cores).
 
@@ -91,21 +96,94 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         # per-member scheduling costs nothing.
         kwargs.update(make_cpu_multithreading_loop=False, cpu_block_dim_adaptive=False,
                       default_cpu_block_dim=1)
-    if offline_cache and not os.environ.get("TI_OFFLINE_CACHE_FILE_PATH"):
-        # Taichi's cache key ignores the loop settings above, so kernels compiled with other
-        # settings (another program, an older version of this package) must not be reused.
-        kwargs["offline_cache_file_path"] = os.path.join(
-            os.path.expanduser("~"), ".cache", "taichi", CACHE_SUBDIR)
+    # Taichi's cache key ignores the loop settings above, so kernels compiled with other
+    # settings (another program, an older version of this package) must not be reused: our
+    # own folder unless TI_OFFLINE_CACHE_FILE_PATH names one (Taichi reads it). Checked even
+    # with offline_cache=False: Taichi touches its cache path at exit either way.
+    folder = cache_folder()
+    problem = _unwritable(folder)
+    if problem is None:
+        if offline_cache and not os.environ.get(CACHE_ENV):
+            kwargs["offline_cache_file_path"] = folder
+    else:
+        # Taichi crashes at exit (SIGSEGV, status 139) when its cache folder cannot be
+        # written, even with offline_cache=False: compile in memory, with a temporary
+        # folder (removed at exit) as the path Taichi touches
+        kwargs["offline_cache"] = False
+        kwargs["offline_cache_file_path"] = _temporary_cache()
+        print(f"ti_spinorbit: kernel cache folder {folder} is not writable ({problem}); "
+              f"compiling without a disk cache (set {CACHE_ENV} to a writable folder)",
+              file=sys.stderr)
     if _STATE["arch"] is not None:
         ti.reset()
+    saved = None
+    if kwargs.get("offline_cache_file_path") and \
+            kwargs["offline_cache_file_path"] == _STATE.get("temporary_cache"):
+        saved = os.environ.pop(CACHE_ENV, None)   # unwritable; Taichi would warn about it
     try:
         ti.init(**kwargs)
     except Exception as exc:  # Taichi raises a bare RuntimeError with little context
         _STATE["arch"] = None
         raise RuntimeError(f"Taichi could not start on arch {name!r}: {exc}") from exc
+    finally:
+        if saved is not None:
+            os.environ[CACHE_ENV] = saved
     _STATE["arch"] = name
     _STATE["generation"] = _STATE.get("generation", 0) + 1
     return name
+
+
+def cache_folder():
+    """Folder of the offline kernel cache: ``TI_OFFLINE_CACHE_FILE_PATH`` when set, else
+    ``<user cache dir>/taichi/ti_spinorbit-1`` (``platformdirs.user_cache_dir``:
+    ``~/.cache/taichi/ti_spinorbit-1`` on Linux, honouring ``XDG_CACHE_HOME``)."""
+    path = os.environ.get(CACHE_ENV)
+    if path:
+        return path
+    import platformdirs
+
+    return os.path.join(platformdirs.user_cache_dir("taichi", appauthor=False), CACHE_SUBDIR)
+
+
+def _unwritable(folder):
+    """None when ``folder`` exists or can be created and a file can be written in it, else
+    the reason (a real write probe: permission bits say nothing to root or on read-only
+    mounts)."""
+    import tempfile
+
+    try:
+        os.makedirs(folder, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder) as f:
+            f.write(b"probe")
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
+    return None
+
+
+def _temporary_cache():
+    """A private temporary folder for Taichi's cache path, created once per process and
+    removed at exit after Taichi has shut down (``ti.reset`` first: Taichi's own exit hook
+    would otherwise recreate it)."""
+    if _STATE.get("temporary_cache") is None:
+        import atexit
+        import shutil
+        import tempfile
+
+        try:
+            folder = tempfile.mkdtemp(prefix="ti_spinorbit-cache-")
+        except OSError:
+            return None
+
+        def cleanup():
+            if _STATE["arch"] is not None:
+                import taichi as ti
+                ti.reset()
+                _STATE["arch"] = None
+            shutil.rmtree(folder, ignore_errors=True)
+
+        atexit.register(cleanup)
+        _STATE["temporary_cache"] = folder
+    return _STATE["temporary_cache"]
 
 
 def ensure_init():

@@ -47,6 +47,21 @@ def _check_run_inputs(rtol, atol, order, progress, window_orbits):
     require_callable("progress", progress)
 
 
+def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit=None,
+               model="auto"):
+    """Refuse a run whose estimated peak memory (``resources.estimate_bytes``) exceeds what
+    is available, from the input sizes alone: before any member is built. Inputs that do
+    not broadcast are left to :func:`build_members`, which names them."""
+    from . import resources
+
+    systems = () if isinstance(system_or_systems, BinarySystem) else \
+        (len(system_or_systems),) if hasattr(system_or_systems, "__len__") else None
+    n = None if systems is None else resources.member_count(systems, theta_p, thetadot_p)
+    if n is not None:
+        resources.check_memory(what, n, orbits, samples_per_orbit,
+                               width=resources.record_width(system_or_systems, model))
+
+
 def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
                   escape_distance=ESCAPE_DISTANCE):
     """Broadcast systems and initial conditions into a member table.
@@ -210,6 +225,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
+    check_size("surface_of_section", system_or_systems, theta_p, thetadot_p, orbits, model=model)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
@@ -328,6 +344,8 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
+    check_size("time_series", system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit,
+               model)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
