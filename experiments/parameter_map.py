@@ -3,7 +3,8 @@
 At every (a/b, e) the default starts of ti_spinorbit.chaosmap.parameter_map (θ_p ∈ {0°, 90°}
 × 12 rates θ̇_p/n from 0.6 to 2.0, the band of the 1:1 and 3:2 resonances) run with MEGNO, all
 grid points in one launch. Overlaid: the analytic overlap line a/b at ω0 = ω0^RO(e) =
-1/(2 + sqrt(14e)) and contours of the chaotic-layer half-width ΔE/E0 (14π form; physics.md §8).
+1/(2 + sqrt(14e)) and contours of the chaotic-layer half-width ΔE/E0 (14π form;
+docs/physics.md §8.6).
 Full: a/b 1.0-1.59 (13; b ≥ c caps it at 1.596) × e 0-0.3 (7) × 24 starts × 300 orbits; ``--quick``: 3 × 2 × 8 starts
 × 40 orbits.
 

@@ -3,7 +3,8 @@
 f: true anomaly (primary-to-secondary direction measured from the line of apsides);
 θ: the secondary's long axis measured from the line of apsides; α: the long axis measured
 from the line of centres. ti_spinorbit uses α = θ − f, so that at pericentre (f = 0) α equals
-the section angle θ_p; physics.md §7 writes θ + α = f, the same angle with the opposite sign.
+the section angle θ_p; Naidu & Margot's angle diagram (docs/physics.md §6.2) writes
+θ + α = f, the same angle with the opposite sign.
 Amplitudes (max |α|) do not depend on the sign.
 """
 

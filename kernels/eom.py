@@ -1,5 +1,5 @@
 """Equations of motion of the full two-body problem, Maciejewski (1995) form, in the primary's
-body frame (physics.md §3; physics-derivations.md §2.6), and the member parameter layout.
+body frame (docs/physics.md §4; docs/physics.md §4.1–4.2), and the member parameter layout.
 
 Internal state (30 numbers, scaled units: length = initial osculating semimajor axis a,
 time = 1/n, mass = m1 + m2, so G = 1):
@@ -10,7 +10,7 @@ with V = P/m the relative velocity (P the relative momentum, m the reduced mass)
 w1 = Γ1/C1 and w2 = Γ2/C2 the spin angular momenta divided by each body's largest
 principal moment. These constant rescalings make every component O(1), so one relative
 tolerance controls the secondary's spin (Γ2 ~ 1e-5 in plain scaled units) as tightly as
-the orbit. The equations are the physics.md ones divided by m, C1, C2:
+the orbit. The equations are the docs/physics.md §4.1 ones divided by m, C1, C2:
 
     dR/dt  = R × Ω1 + V            dV/dt  = V × Ω1 − (∂U/∂R)/m
     dw1/dt = w1 × Ω1 + μ1/C1       dw2/dt = w2 × Ω1 + μ2/C2

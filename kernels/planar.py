@@ -27,8 +27,7 @@ Why this form (the "cheapest formulation" of issue 5, measured in experiments/RE
 * λ enters no derivative (only the inertial attitude of the 3-D output), so its growth with
   time costs nothing.
 
-Potential (the 3-D model's 4th-order truncation restricted to the plane, derivations
-§2.3-2.4), with V = −U (G = 1):
+Potential (the 3-D model's 4th-order truncation restricted to the plane, docs/physics.md §3.2–3.5, §4.4), with V = −U (G = 1):
 
     V = mA mB / r + [P2(ψ_A) + Q2(ψ_B)] / r³ + [P3 + Q3] / r⁴ + [P4 + Q4 + X(ψ_A, ψ_B)] / r⁵
 

@@ -1,7 +1,7 @@
 """Fourth-order mutual potential, force and torques between two rigid bodies (Taichi).
 
 Explicit truncation of the inertia-integral expansion (Ashenberg 2007; Hou, Scheeres & Xin
-2017; physics-derivations.md §2.3-2.4), evaluated the cheap way:
+2017; docs/physics.md §3.2–3.5), evaluated the cheap way:
 
 * each body's single-body terms L2, L3, L4 and their gradients are evaluated in that body's
   own frame (rotate the unit vector e, never a rank-3 or rank-4 tensor);
@@ -106,7 +106,7 @@ def _monomials(p: ti.template(), i, off: ti.template(), table: ti.template(), px
 def single_body_terms(p: ti.template(), i, off: ti.template(), u, order: ti.template(),
                       odd: ti.template()):
     """L2, L3, L4 of one body for the unit vector ``u`` in that body's frame, and their free
-    gradients (derivations §2.3). Returns (L2, g2, L3, g3, L4, g4)."""
+    gradients (docs/physics.md §3.2). Returns (L2, g2, L3, g3, L4, g4)."""
     t200 = p[i, off + T2]
     t020 = p[i, off + T2 + 1]
     t002 = p[i, off + T2 + 2]
@@ -182,7 +182,7 @@ def mutual(p: ti.template(), i, offA: ti.template(), offB: ti.template(), G, R, 
             grad += ((g3 - g3.dot(e) * e) - 4.0 * U3 * e) * inv_r4 * inv_r
             torqueB_e -= mA * gB3 * inv_r4
         if ti.static(order >= 4):
-            # quadrupole-quadrupole cross term X (derivations §2.3)
+            # quadrupole-quadrupole cross term X (docs/physics.md §3.2)
             JA = ti.Vector([p[i, offA + T2], p[i, offA + T2 + 1], p[i, offA + T2 + 2]])
             jB = ti.Vector([p[i, offB + T2], p[i, offB + T2 + 1], p[i, offB + T2 + 2]])
             JBp = S @ ti.Matrix([[jB[0], 0.0, 0.0], [0.0, jB[1], 0.0], [0.0, 0.0, jB[2]]]) @ S.transpose()

@@ -1,16 +1,16 @@
 """Exact (or exact-to-roundoff) references for testing the mutual potential.
 
 Test-only code; scipy is allowed here. Conventions are those of ti_spinorbit.reference
-(physics-derivations.md §2.1): A frame, R from A's centre of mass to B's, C takes B-frame vectors
+(docs/physics.md §1.3–1.4): A frame, R from A's centre of mass to B's, C takes B-frame vectors
 to the A frame, force_on_b = −∂U/∂R, torques defined by δU = −μ·δθ for a rotation of one body.
 
 * Homogeneous ellipsoid exterior potential and attraction in closed form with Carlson's R_F and
-  R_D (MacMillan 1930; Chandrasekhar 1969 ch. 3; physics-derivations.md §3.1).
-* Sphere–ellipsoid mutual potential, force and torques, exact (physics-derivations.md §3.2): a
+  R_D (MacMillan 1930; Chandrasekhar 1969 ch. 3; docs/physics.md §11.1).
+* Sphere–ellipsoid mutual potential, force and torques, exact (docs/physics.md §11.2): a
   uniform sphere acts, and is acted on, exactly as a point mass at its centre.
 * Ellipsoid–ellipsoid by Gauss quadrature of the exact potential of one body over the volume
-  of the other (physics-derivations.md §3.3); spectrally convergent while the bodies are apart.
-* Point-cloud pairwise sum of the truncated Legendre series (physics-derivations.md §3.4,
+  of the other (docs/physics.md §11.3); spectrally convergent while the bodies are apart.
+* Point-cloud pairwise sum of the truncated Legendre series (docs/physics.md §11.4,
   Hou et al. 2017 eq. 8): algebraically identical to the truncated inertia-integral potential
   of the same cloud, so it tests an implementation to roundoff, odd moments included.
 """
@@ -197,14 +197,14 @@ def pairwise_truncated(G, points_a, masses_a, points_b_rotated, masses_b, R, ord
     return U, -dU_dR, torque_a, torque_b
 
 
-# ---- reference numbers of physics-derivations.md §3.6 (independent check script, G = 1) ----
+# ---- reference numbers of docs/physics.md §11.6 (independent check script, G = 1) ----
 # Primary (M, a, b, c) = (1, 1, 0.8, 0.6); secondary (0.1, 0.45, 0.35, 0.3); R and C below.
-SECTION_3_6_R = np.array([2.0, 0.7, 0.4])
-SECTION_3_6_C = np.array([[0.471809584044725, -0.777130365628833, 0.416490229442588],
+REFERENCE_R = np.array([2.0, 0.7, 0.4])
+REFERENCE_S = np.array([[0.471809584044725, -0.777130365628833, 0.416490229442588],
                           [0.849984216105423, 0.526449971902167, 0.019423168018049],
                           [-0.234355603251114, 0.3448460843649, 0.908932686904263]])
 # order: (U, dU/dR, torque_b, torque_a)
-SECTION_3_6 = {
+REFERENCE_NUMBERS = {
     0: (-4.637388957601683e-02, [0.019945758957427, 0.006981015635099, 0.003989151791485],
         None, None),
     2: (-4.722125681191042e-02, [0.020901821846979, 0.007531655778155, 0.004600471362575],
@@ -214,7 +214,7 @@ SECTION_3_6 = {
         [0.000129307596712, -0.000205694371706, -0.000235296116478],
         [0.00012151260676, -0.000778432631888, 0.000703417355409]),
 }
-SECTION_3_6_EXACT = (
+REFERENCE_EXACT = (
     -4.724895694704011e-02, [0.02094142513142, 0.007564587576963, 0.004691238197687],
     [0.000133002791455, -0.000208557107378, -0.00023608740019],
     [0.000125028916141, -0.000797349235428, 0.000706264962124])

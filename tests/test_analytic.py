@@ -6,7 +6,7 @@ independent routes.
 * Cayley's H(p, e): the quadrature against the series (the gap shrinks as the first omitted
   power of e), against the tabulated values, at e = 0, and as Fourier coefficients that rebuild
   (a/r)³ exp(2if) at arbitrary M.
-* Resonance half-widths, overlap thresholds (table of physics-derivations.md §4.6), the
+* Resonance half-widths, overlap thresholds (table of docs/physics.md §8.5), the
   chaotic-layer formula, ω0 ↔ a/b, the coupled-problem ω0.
 * Energy budgets: E0 against 3n²(B − A)/4, k2 models at 1 km, tidal energy ∝ n⁴ R_s⁵ and
   YORP ∝ R_s³/d² by rescaling inputs.
@@ -62,7 +62,7 @@ def test_effective_omega0_of_1991VH_carries_primary_mass_fraction():
     m1, m2 = system.primary.mass, system.secondary.mass
     ratio = an.omega0_effective(system) / system.omega0
     assert ratio == pytest.approx(math.sqrt(m1 / (m1 + m2)), rel=1e-14)
-    # mass ratio ≈ 12 (physics.md §9): ω0 shifts by ~4 %, i.e. sqrt(12/13) ≈ 0.961
+    # mass ratio ≈ 12 (docs/physics.md §7): ω0 shifts by ~4 %, i.e. sqrt(12/13) ≈ 0.961
     assert 0.95 < ratio < 0.97
 
 
@@ -81,7 +81,7 @@ def test_psi_A_hand_value():
 
 def test_psi_A_against_integration_of_decoupled_equation():
     """RK4 on θ'' = −(ω0²/2)(a/r)³ sin 2(θ − f), started on the forced solution at pericentre;
-    the sin M component of θ − f over 20 orbits is ψ_A (derivations §4.2 table cases)."""
+    the sin M component of θ − f over 20 orbits is ψ_A (docs/physics.md §8.2 table cases)."""
     e = np.array([0.01, 0.005, 0.02])
     w = np.array([0.5, 1.5, 0.3])
     orbits, steps = 20, 200
@@ -164,7 +164,7 @@ def test_cayley_H_vectorised_and_converged():
 
 # ---- resonance widths, overlap, chaotic layer ------------------------------------------------
 def test_resonance_half_widths():
-    # p = 1, e = 0.001: ω0 sqrt(1 − 5e²/2) ≈ 0.2; bisection in derivations §4.4: 0.19985/0.20006
+    # p = 1, e = 0.001: ω0 sqrt(1 − 5e²/2) ≈ 0.2; bisection in docs/physics.md §8.4: 0.19985/0.20006
     width = an.resonance_half_width(1.0, 0.2, 0.001)
     assert width == pytest.approx(0.2 * math.sqrt(1 - 2.5e-6), rel=1e-9)
     assert abs(width - 0.19985) < 3e-4 and abs(width - 0.20006) < 3e-4
@@ -200,7 +200,7 @@ def test_chaotic_layer_hand_value():
     assert expected == pytest.approx(1.520518, rel=1e-6)
     melnikov = an.chaotic_layer_half_width(0.5, 0.1, an.CHAOTIC_LAYER_COEFFICIENT_MELNIKOV)
     assert melnikov == pytest.approx(2 * expected)
-    # derivations §4.5 table rows (e, ω0) -> 14π and 28π forms
+    # docs/physics.md §8.6 table rows (e, ω0) -> 14π and 28π forms
     for e, w, quoted, mel in [(0.01, 0.25, 0.053, 0.105), (0.01, 0.30, 0.087, 0.173),
                               (0.003, 0.30, 0.026, 0.052), (0.02, 0.25, 0.105, 0.210)]:
         assert an.chaotic_layer_half_width(w, e) == pytest.approx(quoted, abs=6e-4)

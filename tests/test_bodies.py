@@ -1,4 +1,4 @@
-"""Bodies and their inertia integrals (physics.md §1) against independent routes.
+"""Bodies and their inertia integrals (docs/physics.md §2) against independent routes.
 
 * Ellipsoid integrals of orders 2–4 (every monomial, odd ones included) against direct
   quadrature over the ellipsoid volume: Gauss–Legendre in r and θ, trapezoid in φ, which is
@@ -88,7 +88,7 @@ def test_ellipsoid_integrals_match_volume_quadrature(order):
             assert got == pytest.approx(expected, rel=1e-12, abs=0.0), key
 
 
-def test_ellipsoid_closed_forms_of_physics_md():
+def test_ellipsoid_closed_forms():
     a, b, c = AXES
     body = Ellipsoid(a, b, c, mass=5.0)
     assert body.integral(2, 0, 0) == pytest.approx(5.0 * a**2 / 5.0, rel=1e-15)

@@ -1,4 +1,4 @@
-"""The catalogue reproduces Table 1 of Naidu & Margot 2015 (physics.md §9) through the paper's
+"""The catalogue reproduces Table 1 of Naidu & Margot 2015 (docs/physics.md §7) through the paper's
 secondary prescription, and refuses bad requests with the allowed values."""
 
 import math
@@ -9,7 +9,7 @@ import pytest
 import ti_spinorbit as tso
 from ti_spinorbit import catalog
 
-TABLE = {  # name: (R_p, rho_p, c, ab, a/b, rho_s, a, e) from physics.md §9
+TABLE = {  # name: (R_p, rho_p, c, ab, a/b, rho_s, a, e) from docs/physics.md §7
     "1991 VH": (600, 1581, 190, 57600, 1.50, 2618, 3300, 0.05),
     "2003 YT1": (550, 2712, 88, 11025, 1.30, 3248, 3930, 0.18),
     "2004 DC": (180, 1461, 26, 900, 1.30, 2000, 750, 0.30),

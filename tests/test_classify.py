@@ -1,4 +1,4 @@
-"""Classification of section traces (physics.md §6-8): synthetic curves, islands and
+"""Classification of section traces (docs/physics.md §6, §8, §10): synthetic curves, islands and
 area-filling sets; standard-map orbits; the MEGNO override; the decoupled island centres
 against an independent solver; and the paper's 1991 VH starts (Naidu & Margot 2015, Fig. 6)."""
 
@@ -154,7 +154,7 @@ def test_bad_thresholds_are_rejected():
 
 def decoupled_center(omega0, e, p, theta0):
     """Pericentre spin rate of the symmetric p:1 periodic orbit of θ̈ = −(ω0²/2)(a/r)³ sin 2(θ−f)
-    (physics-derivations.md §4.1), with DOP853 and Brent: θ(π) − θ0 = pπ at apocentre."""
+    (docs/physics.md §8.1), with DOP853 and Brent: θ(π) − θ0 = pπ at apocentre."""
     def rhs(t, y):
         theta, thetadot, f = y
         one_plus = 1.0 + e * math.cos(f)

@@ -90,7 +90,7 @@ def _energy_test_run(rtol, days=5.0):
 
 
 def test_energy_case_conserves_energy_and_angular_momentum():
-    """physics.md §9 energy-test case (ellipsoidal, fast-spinning primary), 5 days at rtol
+    """docs/physics.md §7 energy-test case (ellipsoidal, fast-spinning primary), 5 days at rtol
     1e-13: total energy and angular momentum to ≤ 1e-10 while the parts exchange much more."""
     out, dE, dL = _energy_test_run(1e-13)
     assert out.status[0] == DONE

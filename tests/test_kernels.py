@@ -1,6 +1,6 @@
 """The Taichi mutual potential and right-hand side against independent routes: the NumPy
 tensor reference (to round-off), finite differences, exact ellipsoid potentials
-(truncation slope), quadrature, and the derivations' reference numbers."""
+(truncation slope), quadrature, and the reference numbers of docs/physics.md §11.6."""
 
 import numpy as np
 import pytest
@@ -12,7 +12,7 @@ from ti_spinorbit.kernels import ensemble as K
 from conftest import lumpy_body, random_rotation
 import oracles
 
-C36, R36, ROWS36 = oracles.SECTION_3_6_C, oracles.SECTION_3_6_R, oracles.SECTION_3_6
+C36, R36, ROWS36 = oracles.REFERENCE_S, oracles.REFERENCE_R, oracles.REFERENCE_NUMBERS
 
 
 def _bodies36():
@@ -20,7 +20,7 @@ def _bodies36():
 
 
 @pytest.mark.parametrize("order", [2, 4])
-def test_reference_numbers_of_the_derivations(order):
+def test_reference_numbers(order):
     A, B = _bodies36()
     V, F, muA, muB = tso.mutual_potential(A, B, R36, C36, order=order)
     U, dUdR, tB, tA = ROWS36[order]
@@ -139,7 +139,7 @@ def test_sphere_ellipsoid_truncation_error_falls_like_r6(sphere_is):
 
 
 def test_ellipsoid_pair_against_quadrature():
-    """Order 4 against the exact potential by Gauss quadrature (derivations §3.3, §3.5):
+    """Order 4 against the exact potential by Gauss quadrature (docs/physics.md §11.3, §11.5):
     close to contact the truncation errs ~1e-5 in U, ~1e-4 in F, ~1e-2 in torque, and order 4
     beats order 2 in each."""
     A, B = _bodies36()

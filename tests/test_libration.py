@@ -1,4 +1,4 @@
-"""Relaxed-mode libration (physics.md §7): the synchronous island's centre and amplitude in the
+"""Relaxed-mode libration (docs/physics.md §9.1): the synchronous island's centre and amplitude in the
 decoupled limit against first-order theory and against the decoupled equation solved
 exactly, convergence of the search, the V fit, the libration check, and bad input."""
 
@@ -36,7 +36,7 @@ def result(decoupled):
 
 def decoupled_periodic_orbit(omega0, e):
     """Exact synchronous periodic solution of θ̈ = −(ω0²/2)(a/r)³ sin 2(θ − f) on a fixed Kepler
-    orbit (physics-derivations.md §4.1; time in 1/n). Symmetric about pericentre, it starts at
+    orbit (docs/physics.md §8.1; time in 1/n). Symmetric about pericentre, it starts at
     θ = 0 and passes θ = π at apocentre (t = π). Returns its θ̇(0) and max |θ − f| (deg)."""
     def rhs(t, y):
         theta, thetadot, f = y
@@ -57,7 +57,7 @@ def decoupled_periodic_orbit(omega0, e):
 
 
 def test_decoupled_limit_matches_forced_libration_theory(decoupled, result):
-    """Decoupled limit (physics-derivations.md §4.2). To first order in e the forced solution is
+    """Decoupled limit (docs/physics.md §8.2). To first order in e the forced solution is
     ψ = θ − f = ψ_A sin M, ψ_A = 2e/(ω0² − 1), so the relaxed amplitude max |α| is |ψ_A|
     (ω0 = 0.877 < 1: ψ_A < 0, a phase of π). Its spin rate θ̇ = ḟ + ψ_A cos M (units of n) at
     pericentre (M = f = 0), where the start sits, with ḟ = (1 + e cos f)²/(1 − e²)^{3/2}:

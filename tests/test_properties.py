@@ -202,7 +202,7 @@ def test_describe_round_trip(system):
 @given(name=st.sampled_from([n for n in tso.catalog.names() if n != "test"]),
        stretch=st.floats(0.0, 1.0), rho=density)
 def test_catalogue_prescription(name, stretch, rho):
-    """physics.md §9: a = sqrt(ab · q), b = sqrt(ab / q), c fixed, mass ρ (4/3) π ab c."""
+    """docs/physics.md §7: a = sqrt(ab · q), b = sqrt(ab / q), c fixed, mass ρ (4/3) π ab c."""
     entry = tso.catalog.entry(name)
     q = 1.0 + stretch * (entry["ab"] / entry["c"] ** 2 - 1.0)     # up to b = c
     system = tso.catalog.system(name, elongation=q, secondary_density=rho)

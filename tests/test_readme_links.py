@@ -44,3 +44,43 @@ def test_the_gallery_is_linked():
     links = list(_links("README.md"))
     assert "docs/dask.md" in links and "experiments/README.md" in links   # the parser works
     assert len([p for p in links if p.startswith("docs/figures/")]) >= 12
+
+
+def _sources():
+    tracked = _tracked() or []
+    here = os.path.relpath(__file__, ROOT)          # this file names what it looks for
+    return [p for p in tracked if p.endswith((".py", ".md", ".toml"))
+            and not p.startswith("docs/") and p != here]
+
+
+def _headings(doc):
+    text = open(os.path.join(ROOT, doc), encoding="utf-8").read()
+    return set(re.findall(r"^#{2,4} (\d+(?:\.\d+)*)\.?\s", text, flags=re.M))
+
+
+def test_every_docs_reference_points_at_a_section_that_exists():
+    """References such as "docs/physics.md §8.6" or "§3.2–3.5, §4.4" name a file of the
+    repository and numbered headings in it; notes outside the repository are never cited."""
+    sources = _sources()
+    if not sources:
+        pytest.skip("not a git checkout")
+    dead, outside = [], []
+    for path in sources:
+        text = open(os.path.join(ROOT, path), encoding="utf-8").read()
+        for m in re.finditer(r"docs/([\w-]+\.md)((?:[ ,;]*§[\d.]+(?:[–-][\d.]+)?)*)", text):
+            doc = "docs/" + m.group(1)
+            if not os.path.exists(os.path.join(ROOT, doc)):
+                dead.append(f"{path}: {m.group(0)}")
+                continue
+            heads = _headings(doc)
+            for ref in re.findall(r"§([\d.]+)(?:[–-]([\d.]+))?", m.group(2)):
+                for number in filter(None, ref):
+                    if number.rstrip(".") not in heads:
+                        dead.append(f"{path}: {m.group(0)} (no section {number})")
+        for name in ("physics-derivations.md", "architecture.md", "shared/docs"):
+            if name in text:
+                outside.append(f"{path}: {name}")
+        if re.search(r"(?<!docs/)\bphysics\.md", text):
+            outside.append(f"{path}: physics.md without docs/")
+    assert not dead, dead
+    assert not outside, outside

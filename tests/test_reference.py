@@ -1,8 +1,8 @@
 """Physics tests of the NumPy reference (ti_spinorbit.reference) against exact oracles.
 
-Sources of the expected values: physics-derivations.md §3.1–3.7 (exact ellipsoid potential,
+Sources of the expected values: docs/physics.md §11 (exact ellipsoid potential,
 sphere–ellipsoid closed form, quadrature, point-cloud pairwise sums, truncation-error table,
-reference numbers, invariance/swap checks) and physics.md §2–3 (conventions, conservation).
+reference numbers, invariance/swap checks) and docs/physics.md §1, §3–4 (conventions, conservation).
 """
 
 import os
@@ -132,17 +132,17 @@ def test_matches_pairwise_truncated_sum_of_point_clouds(clouds, order):
         assert relative(lower[3], got[3]) > 1e-3
 
 
-SECTION_3_6, SECTION_3_6_EXACT = oracles.SECTION_3_6, oracles.SECTION_3_6_EXACT
+REFERENCE_NUMBERS, REFERENCE_EXACT = oracles.REFERENCE_NUMBERS, oracles.REFERENCE_EXACT
 
 
 def test_rotation_of_reference_case():
-    np.testing.assert_allclose(C_CASE, oracles.SECTION_3_6_C, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(C_CASE, oracles.REFERENCE_S, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize("order", [0, 2, 4])
 def test_reproduces_reference_numbers(ellipsoids, order):
     U, force, torque_a, torque_b = potential(*ellipsoids, R_CASE, C_CASE, order)
-    U_want, dUdR_want, tb_want, ta_want = SECTION_3_6[order]
+    U_want, dUdR_want, tb_want, ta_want = REFERENCE_NUMBERS[order]
     assert U == pytest.approx(U_want, rel=1e-12)
     # the table prints 15 decimals: the torques (~1e-4) carry only ~11 significant digits, so
     # allow half a unit of the last printed decimal on top of 1e-12 relative
@@ -154,10 +154,10 @@ def test_reproduces_reference_numbers(ellipsoids, order):
 
 
 def test_oracles_reproduce_reference_numbers():
-    """The exact oracles themselves against §3.6's exact rows."""
+    """The exact oracles themselves against docs/physics.md §11.6's exact rows."""
     U, force, ta, tb = oracles.ellipsoid_ellipsoid(G, MASS_A, AXES_A, MASS_B, AXES_B,
                                                    R_CASE, C_CASE, nodes=(24, 32, 64))
-    U_want, dUdR_want, tb_want, ta_want = SECTION_3_6_EXACT
+    U_want, dUdR_want, tb_want, ta_want = REFERENCE_EXACT
     assert U == pytest.approx(U_want, rel=1e-12)
     assert relative(-force, dUdR_want) < 1e-11
     assert relative(tb, tb_want) < 1e-10 and relative(ta, ta_want) < 1e-10
@@ -261,7 +261,7 @@ def test_two_spheres_are_point_masses():
 @pytest.mark.parametrize("sphere_is", ["a", "b"])
 def test_sphere_ellipsoid_truncation_error_falls_as_R_minus_6(sphere_is):
     """Against the exact Carlson-integral potential; the first neglected term is order 6, so the
-    relative error in U falls like R^-6 and in the ellipsoid's torque like R^-4 (§3.2)."""
+    relative error in U falls like R^-6 and in the ellipsoid's torque like R^-4 (docs/physics.md §11.2)."""
     if sphere_is == "a":  # sphere primary, ellipsoid secondary: the torque is on B
         sphere_mass, ell_mass, ell_axes = 1.0, MASS_B, AXES_B
         bodies = (Sphere(0.3, mass=sphere_mass), Ellipsoid(*ell_axes, mass=ell_mass))
@@ -287,9 +287,9 @@ def test_sphere_ellipsoid_truncation_error_falls_as_R_minus_6(sphere_is):
     assert err_U[0] < 1e-3 and err_torque[0] < 0.1
 
 
-# physics-derivations.md §3.5 (its direction of R is not stated; along R_CASE the measured errors
+# docs/physics.md §11.5 (its direction of R is not stated; along R_CASE the measured errors
 # come out within a factor ~5 of these): |R| -> (dU, dF, dM_B, dM_A)
-SECTION_3_5 = {
+TRUNCATION_ERRORS = {
     2: {2.2: (2.8e-04, 3.9e-03, 1.1e-01, 1.3e-01), 4.4: (1.9e-05, 2.4e-04, 2.8e-02, 3.2e-02),
         8.8: (1.2e-06, 1.5e-05, 7.2e-03, 8.1e-03)},
     4: {2.2: (2.4e-05, 4.1e-04, 1.0e-02, 1.3e-02), 4.4: (3.1e-07, 6.1e-06, 6.5e-04, 8.4e-04),
@@ -307,7 +307,7 @@ def test_ellipsoid_pair_truncation_error_matches_table(ellipsoids):
             got = potential(*ellipsoids, R, C_CASE, order)
             err = np.array([abs(got[0] - U) / abs(U), relative(got[1], force),
                             relative(got[3], tb), relative(got[2], ta)])
-            table = np.array(SECTION_3_5[order][distance])
+            table = np.array(TRUNCATION_ERRORS[order][distance])
             assert np.all(err < 3.0 * table), (order, distance, err, table)
             assert np.all(err > 0.1 * table), (order, distance, err, table)
             errors[order, distance] = err
@@ -335,7 +335,7 @@ def test_invariance_under_global_rotation(clouds):
 
 
 def test_swapping_the_bodies(clouds):
-    """B as the primary: R' = −CᵀR, C' = Cᵀ; U unchanged, vectors rotate by Cᵀ (§3.7)."""
+    """B as the primary: R' = −CᵀR, C' = Cᵀ; U unchanged, vectors rotate by Cᵀ (docs/physics.md §11.7)."""
     (body_a, _, _), (body_b, _, _) = clouds
     R, C = np.array([2.5, -1.0, 0.8]), random_rotation(np.random.default_rng(9))
     for order in (2, 3, 4):

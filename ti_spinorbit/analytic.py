@@ -1,7 +1,7 @@
 """Analytic spin-orbit theory of the decoupled problem, the yardstick for the simulations.
 
 The secondary is a rigid body on a fixed Keplerian orbit about a point mass, spinning about
-its short axis in the orbit plane (physics-derivations.md §4.1):
+its short axis in the orbit plane (docs/physics.md §8.1):
 
     θ̈ + (ω0² n²/2) (a/r)³ sin 2(θ − f) = 0,     ω0² = 3 (B − A) / C,
 
@@ -10,16 +10,16 @@ mean motion. Everything here is pure NumPy and closed form (or a spectrally conv
 quadrature); frequencies and spin rates are in units of n, angles in radians, energies in J.
 
 * ω0 of an ellipsoid and its inverse, and the coupled-problem correction
-  ω0,eff² = ω0² m1/(m1 + m2) (physics.md §8, physics-derivations.md §4.7).
+  ω0,eff² = ω0² m1/(m1 + m2) (docs/physics.md §8.7).
 * Forced libration in synchronous rotation, ψ_A = 2e/(ω0² − 1) (Murray & Dermott 1999 §5;
-  physics-derivations.md §4.2).
+  docs/physics.md §8.2).
 * Cayley's coefficients H(p, e) (Cayley 1859 via Murray & Dermott 1999 §5.4, Table 5.1;
-  physics-derivations.md §4.3), resonance half-widths ω0 √|H(p, e)| (Wisdom, Peale & Mignard
-  1984; Murray & Dermott 1999 §5.4; derivations §4.4).
+  docs/physics.md §8.3), resonance half-widths ω0 √|H(p, e)| (Wisdom, Peale & Mignard
+  1984; Murray & Dermott 1999 §5.4; docs/physics.md §8.4).
 * Resonance overlap ω0_RO = 1/(2 + √(14 e)) and the chaotic separatrix layer
   ΔE/E0 ≈ (14π e/ω0³) exp(−π/(2ω0)) (Wisdom, Peale & Mignard 1984, as used by Naidu &
-  Margot 2015; derivations §4.5–4.6).
-* Energy budgets per orbit that compete with chaotic spin-energy changes (physics.md §8):
+  Margot 2015; docs/physics.md §8.5–8.6).
+* Energy budgets per orbit that compete with chaotic spin-energy changes (docs/physics.md §9.4):
   tides (Murray & Dermott 1999 ch. 4–5; k2 of rubble piles from Goldreich & Sari 2009 or
   Jacobson & Scheeres 2011) and YORP (Naidu & Margot 2015), normalised by the separatrix
   energy E0 = n² ω0² C/4.
@@ -44,12 +44,12 @@ AU = 1.495978707e11
 #: Chaotic-layer coefficient as quoted by Naidu & Margot 2015 from Wisdom, Peale & Mignard 1984.
 CHAOTIC_LAYER_COEFFICIENT_QUOTED = 14.0 * math.pi
 #: Melnikov/Chirikov coefficient for the circulation-side border with E0 = n²ω0²C/4
-#: (physics-derivations.md §4.5).
+#: (docs/physics.md §8.6).
 CHAOTIC_LAYER_COEFFICIENT_MELNIKOV = 28.0 * math.pi
 
-#: Default tidal quality factor (physics.md §8).
+#: Default tidal quality factor (docs/physics.md §9.4).
 DEFAULT_Q = 100.0
-#: Default YORP efficiency f_Y (physics.md §8).
+#: Default YORP efficiency f_Y (docs/physics.md §9.4).
 DEFAULT_F_YORP = 5e-4
 
 #: Rubble-pile Love numbers k2(R_s) with R_s in km.
@@ -58,7 +58,7 @@ K2_MODELS = {
     "jacobson-scheeres": lambda radius_km: 2.5e-5 / radius_km,    # Jacobson & Scheeres 2011
 }
 
-# Cayley series H(p, e) = Σ c_k e^k (physics-derivations.md §4.3, re-derived with sympy),
+# Cayley series H(p, e) = Σ c_k e^k (docs/physics.md §8.3, re-derived with sympy),
 # keyed by 2p so that half-integer p are exact dictionary keys.
 _CAYLEY_SERIES = {
     -1: {3: 1 / 48, 5: 11 / 768},
@@ -122,8 +122,9 @@ def omega0_effective(system):
     """ω0 of the coupled problem: sqrt(3 (B − A)/C · m1/(m1 + m2)), in units of n.
 
     The torque on the secondary scales with G m1 while n² a³ = G (m1 + m2), so written with the
-    true mean motion the decoupled equation carries the primary's mass fraction (physics.md §8,
-    physics-derivations.md §4.7). ``system`` is a :class:`~ti_spinorbit.systems.BinarySystem`;
+    true mean motion the decoupled equation carries the primary's mass fraction
+    (docs/physics.md §8.7,
+    docs/physics.md §8.7). ``system`` is a :class:`~ti_spinorbit.systems.BinarySystem`;
     A, B, C are its secondary's moments about x, y, z, and ω0 is ``system.omega0`` (which
     also covers a secondary whose long axis is y)."""
     fraction = system.primary.mass / system.total_mass
@@ -141,8 +142,9 @@ def elongation_from_omega0(omega0):
 def psi_A(omega0, e):
     """Forced libration amplitude ψ_A = 2e/(ω0² − 1), radians (first order in e).
 
-    ψ = θ − f is the angle of the long axis from the line of centres; physics.md §7 calls it α
-    with the opposite sign (θ + α = f), which leaves the amplitude unchanged. In synchronous
+    ψ = θ − f is the angle of the long axis from the line of centres (α in the package,
+    docs/physics.md §6.2; the paper's angle diagram writes it with the opposite sign, θ + α =
+    f), which leaves the amplitude unchanged. In synchronous
     rotation ψ = ψ_A sin M. For ω0 < 1 the value is negative (the response is in antiphase):
     the amplitude is |ψ_A|, larger than 2e. It diverges at the forced resonance ω0 = 1, which
     is rejected.
@@ -185,8 +187,7 @@ def cayley_H(p, e, n=4096):
         H(p, e) = (1/2π) ∮ (a/r)³ cos(2f − 2pM) dM.
 
     Evaluated by the trapezoid rule in the true anomaly f (dM = (r/a)² df / sqrt(1 − e²)),
-    which converges exponentially for this smooth periodic integrand (physics-derivations.md
-    §4.3). n = 4096 points give ~1e-15 for e <= 0.5; raise n as e approaches 1.
+    which converges exponentially for this smooth periodic integrand (docs/physics.md §8.3). n = 4096 points give ~1e-15 for e <= 0.5; raise n as e approaches 1.
 
     Parameters
     ----------
@@ -215,7 +216,7 @@ def cayley_H(p, e, n=4096):
 
 
 def cayley_H_series(p, e):
-    """Cayley's H(p, e) from its series in e (physics-derivations.md §4.3, Murray & Dermott 1999
+    """Cayley's H(p, e) from its series in e (docs/physics.md §8.3, Murray & Dermott 1999
     Table 5.1), for p in {−1/2, 0, 1/2, 1, 3/2, 2, 5/2, 3} (scalar) and e in [0, 1) (array ok).
 
     The series stop at e⁵ or e⁶ (the next term is O(e⁷) or O(e⁸)); use :func:`cayley_H` for
@@ -234,7 +235,7 @@ def resonance_half_width(p, omega0, e):
 
     From averaging near θ̇ = p n: γ = θ − pM obeys the pendulum γ̈ = −(ω0²/2) H(p, e) sin 2γ,
     whose separatrix reaches |θ̇ − p n| = ω0 sqrt(|H|) (Wisdom, Peale & Mignard 1984; Murray &
-    Dermott 1999 §5.4; physics-derivations.md §4.4). H is the quadrature :func:`cayley_H`.
+    Dermott 1999 §5.4; docs/physics.md §8.4). H is the quadrature :func:`cayley_H`.
     ``p`` (integer or half-integer), ``omega0`` (> 0) and ``e`` (in [0, 1)) broadcast."""
     w = _omega0(omega0)
     return _result(w * np.sqrt(np.abs(cayley_H(p, e))))
@@ -244,7 +245,7 @@ def resonance_half_width(p, omega0, e):
 def omega0_overlap(e):
     """ω0_RO = 1/(2 + sqrt(14 e)): the synchronous (half-width ≈ ω0) and 3:2 (half-width
     ω0 sqrt(7e/2)) islands touch when ω0 (1 + sqrt(7e/2)) = 1/2 (Chirikov criterion as used by
-    Wisdom, Peale & Mignard 1984; physics-derivations.md §4.6). Units of n; e in [0, 1)."""
+    Wisdom, Peale & Mignard 1984; docs/physics.md §8.5). Units of n; e in [0, 1)."""
     e = _eccentricity(e)
     return _result(1.0 / (2.0 + np.sqrt(14.0 * e)))
 
@@ -270,7 +271,7 @@ def chaotic_layer_half_width(omega0, e, coefficient=CHAOTIC_LAYER_COEFFICIENT_QU
     Peale & Mignard 1984; it is what the paper plots, so reproductions should use it, as an
     order-of-magnitude estimate.
 
-    Caveat (physics-derivations.md §4.5): a Melnikov/Chirikov derivation for the dominant
+    Caveat (docs/physics.md §8.6): a Melnikov/Chirikov derivation for the dominant
     p = 3/2 perturbation gives a kick W = 28π e ω0⁻² exp(−π/(2ω0)) per separatrix passage in
     units of E0 = n²ω0²C/4, and a layer border λW = 28π e ω0⁻³ exp(−π/(2ω0)) (λ = 1/ω0) on the
     circulation side, about twice that on the libration side. 14π is λW/2, which is what the
@@ -312,7 +313,7 @@ def separatrix_energy(system, omega0=None):
 
 
 def secondary_radius(system):
-    """R_s = sqrt(a_s b_s), m: the secondary's mean equatorial radius (physics.md §9, ab = R_s²)."""
+    """R_s = sqrt(a_s b_s), m: the secondary's mean equatorial radius (docs/physics.md §7, ab = R_s²)."""
     axes = getattr(system.secondary, "semi_axes", None)
     if axes is None:
         raise ValueError("the secondary has no semi_axes (not an Ellipsoid): R_s = sqrt(a b) "
@@ -333,7 +334,8 @@ def love_number_k2(radius, model="goldreich-sari"):
 
 
 def tidal_energy_per_orbit(system, k2_model="goldreich-sari", Q=DEFAULT_Q, radius=None):
-    """Tidal energy dissipated in the secondary per orbit, J (Murray & Dermott 1999; physics.md §8):
+    """Tidal energy dissipated in the secondary per orbit, J (Murray & Dermott 1999;
+    docs/physics.md §9.4):
 
         δE_tides = π (3/2) (k2/Q) (n⁴/G) R_s⁵.
 
@@ -366,7 +368,7 @@ def tidal_energy_per_orbit(system, k2_model="goldreich-sari", Q=DEFAULT_Q, radiu
 
 def yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e, f_yorp=DEFAULT_F_YORP,
                           radius=None):
-    """YORP energy input per orbit, J (Naidu & Margot 2015; physics.md §8):
+    """YORP energy input per orbit, J (Naidu & Margot 2015; docs/physics.md §9.4):
 
         δE_YORP = 2π R_s³ L_⊙ f_Y / (3 c d² sqrt(1 − e_⊙²)).
 

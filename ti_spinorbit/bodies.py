@@ -1,7 +1,7 @@
 """Rigid bodies described by their mass and inertia integrals of orders 2 to 4.
 
 A body lives in its own principal-axis frame with the origin at its centre of mass
-(physics.md §1). What the mutual potential needs of it is
+(docs/physics.md §2). What the mutual potential needs of it is
 
     T^{lmn} = ∫_B x^l y^m z^n dm      (kg m^{l+m+n}),   l + m + n = 2, 3, 4,
 
@@ -10,7 +10,7 @@ diagonal (principal axes); orders 3 and 4 may be anything, so a lumpy body with 
 integrals plugs into the same kernels as an ellipsoid.
 
 Sources: uniform ellipsoid integrals, Tricarico 2008 eq. 19 / Hou et al. 2017 eq. 26
-(physics-derivations.md §2.5):
+(docs/physics.md §2.2):
     T^{lmn} = 3 M a^l b^m c^n (l-1)!!(m-1)!!(n-1)!! / (l+m+n+3)!!   (all indices even), else 0.
 """
 

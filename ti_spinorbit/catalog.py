@@ -2,7 +2,7 @@
 
 The numbers live in ``data/systems.json`` with their source notes; this module turns an
 entry into a :class:`~ti_spinorbit.systems.BinarySystem` following the paper's secondary
-prescription (physics.md §9): a = sqrt(ab · a/b), b = sqrt(ab / (a/b)), mass
+prescription (docs/physics.md §7): a = sqrt(ab · a/b), b = sqrt(ab / (a/b)), mass
 ρ_s (4/3) π ab c, whatever the elongation.
 """
 

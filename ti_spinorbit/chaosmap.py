@@ -1,4 +1,5 @@
-"""Chaos maps: MEGNO and chaotic fraction over grids of initial conditions (physics.md §8).
+"""Chaos maps: MEGNO and chaotic fraction over grids of initial conditions
+(docs/physics.md §10).
 
 A *chaos map* integrates every start of a (θ_p, θ̇_p/n) grid, with a shadow trajectory per
 member, in ONE ensemble launch (:func:`~ti_spinorbit.section.surface_of_section` with
@@ -15,7 +16,7 @@ The *chaotic fraction* is the share of finished members labelled chaotic. A *par
 does the same over the secondary's elongation a/b and the eccentricity e: a few starts in the
 band of the 1:1 and 3:2 resonances per (a/b, e), again all in one launch (one system per
 member), to compare with the analytic overlap criterion ω0 > ω0^RO = 1/(2 + sqrt(14e)) and the
-chaotic-layer estimate ΔE/E0 (Wisdom, Peale & Mignard 1984; physics.md §8).
+chaotic-layer estimate ΔE/E0 (Wisdom, Peale & Mignard 1984; docs/physics.md §8.6).
 """
 
 import time

@@ -1,6 +1,7 @@
 """Classify the trajectories of a surface of section: resonant, quasi-periodic or chaotic.
 
-Physics (physics.md §6-8; Wisdom, Peale & Mignard 1984; Naidu & Margot 2015 §2.3, Figs. 4-6).
+Physics (docs/physics.md §6, §8, §10; Wisdom, Peale & Mignard 1984; Naidu & Margot 2015 §2.3,
+Figs. 4-6).
 On the pericentre section (θ_p, θ̇_p/n) a regular orbit lies on invariant curves and a chaotic
 one fills an area. A regular orbit whose θ_p stays in a bounded arc *librates*: it is
 **resonant** (islands about θ_p = 0 near θ̇_p/n = 1, 3/2, 2, 5/2, ..., about 90° near 1/2). A
@@ -24,7 +25,7 @@ The rule, per member; it needs only the section points in time order:
      three strides after which the points return closest.
    * The ratio is the smallest found; the search stops once it is below half the threshold.
    A member is **chaotic** when the ratio exceeds ``order_ratio_chaotic`` (default 0.25).
-2. **MEGNO** (optional, physics.md §8). Where a finite ⟨Y⟩ is given, it overrides step 1:
+2. **MEGNO** (optional, docs/physics.md §10). Where a finite ⟨Y⟩ is given, it overrides step 1:
    ⟨Y⟩ >= ``megno_chaotic`` (4) is chaotic, ⟨Y⟩ <= ``megno_regular`` (2.5) is regular
    (⟨Y⟩ → 2 on a torus, → 0 at a stable periodic orbit). In between, step 1 decides.
 3. **Resonant or quasi-periodic: the largest gap.** A regular member is **resonant** when the
@@ -32,7 +33,7 @@ The rule, per member; it needs only the section points in time order:
    (default 30°, i.e. 60° of the doubled angle 2θ_p); otherwise it is **quasi-periodic**. The
    libration centre is the middle of the occupied arc; the half extent is half that arc, in
    deg. For an island this is the horizontal half extent of its trace, the excited-mode
-   amplitude of physics.md §7.
+   amplitude of docs/physics.md §9.1.
 4. **Which resonance.** p is assigned only to a trace centred within ``center_tolerance_deg``
    of θ_p = 0 (candidates p = 1, 3/2, 2, ...: Cayley H(p, e) > 0) or of 90° (p = 1/2:
    H(1/2, e) < 0), and only when its largest gap is at least ``dominant_gap_ratio`` times the
@@ -43,7 +44,7 @@ The rule, per member; it needs only the section points in time order:
      close to 1. For 1991 VH at a/b = 1.5 the 1:1 island sits at θ̇_p/n ≈ 0.45 and the 2:1
      island at ≈ 2.345; rounding to the nearest half-integer would give 1/2 and 5/2.
    * So the candidates' island centres are taken from the decoupled problem: a fixed Kepler
-     orbit with ω0,eff² = ω0² m1/(m1 + m2) (physics-derivations.md §4.1, §4.7), shooting for
+     orbit with ω0,eff² = ω0² m1/(m1 + m2) (docs/physics.md §8.1, §8.7), shooting for
      the symmetric periodic orbit. For 1991 VH (a/b = 1.5) this predicts 0.388 (1:1), 2.355
      (2:1), 2.732 (5:2) and 0.890 (1:2, at 90°); the coupled integration shows 0.45, 2.345,
      2.72 and 0.891. For 2003 YT1 and 2004 DC the p = 5/2 to 5 islands agree within 0.01,

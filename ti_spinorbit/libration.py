@@ -1,6 +1,6 @@
 """Relaxed-mode libration: the centre of the synchronous island and its libration amplitude.
 
-Physics (physics.md §7; Naidu & Margot 2015 §3). Let α be the angle between the secondary's
+Physics (docs/physics.md §9.1; Naidu & Margot 2015 §3). Let α be the angle between the secondary's
 long axis and the line of centres (θ + α = f). A synchronous (1:1) secondary librates in two
 modes: the *relaxed* mode at the orbital frequency, forced by the eccentric orbit, and the
 *excited* mode at the free, shape-dependent frequency. On the pericentre surface of section
@@ -10,9 +10,9 @@ Margot, start at θ_p = 0 and vary θ̇_p(0)/n until the horizontal extent of th
 relaxed-mode amplitude is then max |α| over the whole trajectory, sampled densely (not only at
 pericentre, where the forced libration passes through zero).
 
-For a massless secondary on a fixed Keplerian orbit (physics-derivations.md §4.2) the forced
+For a massless secondary on a fixed Keplerian orbit (docs/physics.md §8.2) the forced
 solution is α = −ψ_A sin M with ψ_A = 2e/(ω0² − 1), ω0² = 3(B − A)/C; spin-orbit coupling
-changes this by an amount that depends on the mass ratio (§4.7 gives the first correction,
+changes this by an amount that depends on the mass ratio (docs/physics.md §8.7 gives the first correction,
 ω0,eff² = ω0² m1/(m1 + m2)). Both values are reported next to the measured amplitude.
 
 Method of :func:`relaxed_libration`. Near the island centre c the trace of a start (0, θ̇0) is a

@@ -1,11 +1,12 @@
-"""Observables derived from recorded scaled states (NumPy; physics.md §6-7).
+"""Observables derived from recorded scaled states (NumPy; docs/physics.md §6, §9.1).
 
 The kernels record the raw 30-element state at events and samples; everything a scientist
 reads is derived here, vectorised over records:
 
 * α: angle from the line of centres to the secondary's long axis, measured about the orbit
   normal (R × V), in (−π, π]: α = θ − f, so at pericentre α is the section angle θ_p.
-  (physics.md §7 writes θ + α = f, i.e. the opposite sign; amplitudes are the same.)
+  (Naidu & Margot's diagram, docs/physics.md §6.2, writes θ + α = f, i.e. the opposite sign;
+  amplitudes are the same.)
 * θ̇: the secondary's inertial spin rate about the orbit normal, units of n.
 * θ: the long axis's angle from the inertial x axis (the initial pericentre direction) in the
   inertial xy plane (the initial orbit plane).

@@ -1,4 +1,4 @@
-"""Numerical overlap of the 1:1 and 3:2 spin-orbit resonances (physics.md §8; Naidu & Margot
+"""Numerical overlap of the 1:1 and 3:2 spin-orbit resonances (docs/physics.md §9.2; Naidu & Margot
 2015 §4, their Fig. 7).
 
 Decoupled theory (Wisdom, Peale & Mignard 1984; Chirikov): the synchronous and 3:2 islands

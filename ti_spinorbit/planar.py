@@ -52,7 +52,7 @@ def _moment_tensors(row):
 
 def legendre_terms(row, psi):
     """L_n(ψ) = ∫ |x|^n P_n(u·x/|x|) dm for n = 2, 3, 4 and u = (cos ψ, sin ψ, 0): the
-    single-body terms of the mutual potential (derivations §2.3), by tensor contraction.
+    single-body terms of the mutual potential (docs/physics.md §3.2), by tensor contraction.
     Returns an array (3, len(psi))."""
     M2, M3, M4 = _moment_tensors(np.asarray(row, dtype=np.float64))
     u = np.stack([np.cos(psi), np.sin(psi), np.zeros_like(psi)], axis=-1)

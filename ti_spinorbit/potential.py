@@ -1,7 +1,7 @@
 """Python access to the kernels' mutual potential (same Taichi code path as the integrator).
 
 ``mutual_potential(primary, secondary, R, S, order=4)`` evaluates, in SI units and in the
-primary's frame, the truncated mutual potential of physics.md §2 (Ashenberg 2007; Hou et al.
+primary's frame, the truncated mutual potential of docs/physics.md §3 (Ashenberg 2007; Hou et al.
 2017) for one configuration or a batch (R of shape (..., 3), S of shape (..., 3, 3)).
 """
 

@@ -3,9 +3,8 @@
 This module is the slow, readable yardstick the Taichi kernels are checked against. It takes
 a deliberately different route from the kernels, so the two cannot share a mistake:
 
-* the kernels evaluate the explicit scalar formulas of physics-derivations.md §2.3/§2.4;
-* this module uses the general Cartesian Taylor (multipole) form of physics-derivations.md
-  §2.2b and physics.md §2,
+* the kernels evaluate the explicit scalar formulas of docs/physics.md §3.2–3.5;
+* this module uses the general Cartesian Taylor (multipole) form of docs/physics.md §3.1 and docs/physics.md §3,
 
       U = −G Σ_{n ≤ N} Σ_{k=0..n} (−1)^{n−k} / (k! (n−k)!) ⟨M′_B^(k) ⊗ M_A^(n−k), ∂^n(1/R)⟩,
       ∂^n_{i1..in}(1/R) = (−1)^n (2n−1)!! STF(e_{i1} … e_{in}) / R^{n+1},   e = R/|R|,
@@ -15,15 +14,15 @@ a deliberately different route from the kernels, so the two cannot share a mista
   Hou, Scheeres & Xin 2017 (CeMDA 127:369) truncated at total order N ≤ 4.
 
 The force is −∂U/∂R from ∂^{n+1}(1/R). The torques come from the derivative of U with respect to
-each body's moment tensors (the general tensor rule of physics-derivations.md §2.3): if U holds
+each body's moment tensors (the general tensor rule of docs/physics.md §3.4): if U holds
 ⟨W, M^(k)⟩ then rotating that body alone by δθ changes U by −μ·δθ with
 
       μ_a = k ε_aij W_{i i2..ik} M^(k)_{j i2..ik}.
 
 The equations of motion are Maciejewski's (1995) form in the primary's body frame
-(physics.md §3; physics-derivations.md §2.6), integrated with scipy's DOP853.
+(docs/physics.md §4; docs/physics.md §4.1–4.2), integrated with scipy's DOP853.
 
-Conventions (physics-derivations.md §2.1): every vector is in the primary (A) body frame;
+Conventions (docs/physics.md §1.3–1.4): every vector is in the primary (A) body frame;
 R points from A's centre of mass to B's; C (Naidu & Margot's S) takes B-frame vectors to the
 A frame; moment tensors are M^(k)_{i..} = ∫ x_i … dm about each body's centre of mass in its
 own frame (so first moments vanish); G is always an argument, so any unit system works.
@@ -265,7 +264,7 @@ class _Pair:
 
 
 def rhs(G, body_a, body_b, y, order=4):
-    """Time derivative of the 30-element state (Maciejewski 1995; physics.md §3).
+    """Time derivative of the 30-element state (Maciejewski 1995; docs/physics.md §4).
 
     y = [R (3), P (3), Γ1 (3), Γ2 (3), S (3×3 row-major), S1 (3×3 row-major)], all vectors in
     the primary frame: R the relative position, P = m·(relative velocity) with reduced mass

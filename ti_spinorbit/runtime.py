@@ -4,7 +4,7 @@ Nothing calls ``ti.init`` at import time. Every entry point that launches a kern
 :func:`ensure_init`, which initialises Taichi once with the package defaults (CPU, f64,
 offline kernel cache). Call :func:`init` yourself first to pick another arch.
 
-Decisions (architecture.md, "Kernel design"):
+Decisions (docs/design.md, "Kernel design"):
 * ``default_fp = f64`` and ``default_ip = i32`` always: tolerances down to 1e-15 must work.
 * ``fast_math=False``: on CUDA fast math degrades f64 sqrt/division.
 * The environment variable ``TI_SPINORBIT_ARCH`` (``cpu``, ``cuda``, ``vulkan``, ...)

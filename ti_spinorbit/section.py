@@ -1,4 +1,4 @@
-"""Surfaces of section and dense time series of ensembles (physics.md §6-7).
+"""Surfaces of section and dense time series of ensembles (docs/physics.md §6, §9.1).
 
 ``surface_of_section`` records, at every pericentre passage of the osculating mutual orbit,
 the angle θ_p from the line of apsides to the secondary's long axis and the secondary's spin

@@ -3,10 +3,10 @@
 This is the first arrow of the data flow: physical description in SI units -> scaled member
 parameters and initial state (numpy), which the kernels consume.
 
-Scaled units (physics.md §3): length = a (initial osculating semimajor axis), time = 1/n with
+Scaled units (docs/physics.md §4): length = a (initial osculating semimajor axis), time = 1/n with
 n = sqrt(G (m1 + m2) / a³), mass = m1 + m2; hence G = 1 and one orbital period is 2π.
 
-Initial conditions (physics.md §5): pericentre of the osculating Kepler orbit (a, e,
+Initial conditions (docs/physics.md §6.4): pericentre of the osculating Kepler orbit (a, e,
 μ = G(m1+m2)) with the line of centres along the primary's x (long) axis, both equators in
 the orbit plane, the secondary's long axis rotated by θ_p from the line of centres, the
 secondary spinning at θ̇_p·n about the orbit normal and the primary at 2π/P about its z axis.
@@ -126,7 +126,7 @@ class BinarySystem:
     @property
     def omega0(self) -> float:
         """Secondary's free libration frequency in units of n: sqrt(3 |B − A| / C)
-        (physics.md §1), A, B, C the moments about the body's x, y, z axes (kg m²).
+        (docs/physics.md §2), A, B, C the moments about the body's x, y, z axes (kg m²).
 
         The secondary spins about its z axis; its long axis in the xy plane (x when A <= B,
         y when B < A) librates about the line of centres with this small-amplitude
@@ -165,7 +165,7 @@ class BinarySystem:
         return p
 
     def initial_state(self, theta_p: float, thetadot_p: float) -> np.ndarray:
-        """Scaled 30-element state at pericentre (physics.md §5).
+        """Scaled 30-element state at pericentre (docs/physics.md §6.4).
 
         theta_p in radians from the line of centres, thetadot_p in units of n."""
         from .kernels import eom
