@@ -110,3 +110,26 @@ def counts(status):
 
     codes, n = np.unique(np.asarray(status).ravel(), return_counts=True)
     return {STATUS_NAMES[int(c)]: int(k) for c, k in zip(codes, n)}
+
+
+class StatusSummary:
+    """Status views shared by every result class with a ``status`` array of codes."""
+
+    @property
+    def status_names(self):
+        """Each member's status as text ("done", "inaccurate", "collision", ...), a list in
+        the order (and, flattened, the shape) of ``status``."""
+        from .kernels.ensemble import STATUS_NAMES
+
+        return [STATUS_NAMES[s] for s in np.asarray(self.status).ravel()]
+
+    @property
+    def status_counts(self) -> dict:
+        """Members per status name, e.g. {"done": 30, "inaccurate": 2}."""
+        return counts(self.status)
+
+    @property
+    def n_inaccurate(self) -> int:
+        """Members that finished with a drift above ``max_drift`` (data kept, status
+        "inaccurate")."""
+        return count(self.status, "inaccurate")

@@ -90,7 +90,7 @@ def _mean_spin(section):
 
 
 @dataclass
-class ChaosMap:
+class ChaosMap(accuracy.StatusSummary):
     """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
     (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
 
@@ -124,10 +124,6 @@ class ChaosMap:
     def shape(self):
         return self.megno.shape
 
-    @property
-    def status_counts(self) -> dict:
-        """Members per status name, e.g. {"done": 1020, "inaccurate": 4}."""
-        return accuracy.counts(self.status)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -280,7 +276,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
 
 
 @dataclass
-class ParameterMap:
+class ParameterMap(accuracy.StatusSummary):
     """Chaotic fraction over elongation a/b × eccentricity e.
 
     ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
@@ -311,13 +307,6 @@ class ParameterMap:
     inaccurate: np.ndarray = None
     include_inaccurate: bool = False
 
-    @property
-    def n_inaccurate(self) -> int:
-        return accuracy.count(self.status, "inaccurate")
-
-    @property
-    def status_counts(self) -> dict:
-        return accuracy.counts(self.status)
 
     @property
     def member_orbits_per_second(self) -> float:

@@ -597,7 +597,7 @@ def _cmd_section(args):
     import numpy as np
 
     from . import catalog, surface_of_section
-    from .plotting import plot_section, save_figure
+    from .plotting import plot_section
 
     system = _system(args)
     starts = args.thetadot or catalog.section_starts(args.system)

@@ -10,7 +10,7 @@ scalars or arrays, are broadcast against each other to N members.
 """
 
 from dataclasses import dataclass, field
-from typing import List, Sequence, Union
+from typing import Sequence, Union
 
 import numpy as np
 
@@ -102,7 +102,7 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
 
 
 @dataclass
-class SectionResult:
+class SectionResult(accuracy.StatusSummary):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
@@ -140,21 +140,6 @@ class SectionResult:
     lyapunov: np.ndarray = None
     max_drift: float = float("nan")
 
-    @property
-    def status_names(self) -> List[str]:
-        from .kernels.ensemble import STATUS_NAMES
-        return [STATUS_NAMES[s] for s in self.status]
-
-    @property
-    def status_counts(self) -> dict:
-        """Members per status name, e.g. {"done": 30, "inaccurate": 2}."""
-        return accuracy.counts(self.status)
-
-    @property
-    def n_inaccurate(self) -> int:
-        """Members that finished with a drift above ``max_drift`` (data kept, status
-        "inaccurate")."""
-        return accuracy.count(self.status, "inaccurate")
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -278,7 +263,7 @@ def _derived_columns(par, records, names, ensemble=None):
 
 
 @dataclass
-class TimeSeriesResult:
+class TimeSeriesResult(accuracy.StatusSummary):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
 
     ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
@@ -313,20 +298,6 @@ class TimeSeriesResult:
     rtol: float = float("nan")
     orbits: float = float("nan")
 
-    @property
-    def status_names(self) -> List[str]:
-        from .kernels.ensemble import STATUS_NAMES
-        return [STATUS_NAMES[s] for s in self.status]
-
-    @property
-    def status_counts(self) -> dict:
-        """Members per status name, e.g. {"done": 3, "inaccurate": 1}."""
-        return accuracy.counts(self.status)
-
-    @property
-    def n_inaccurate(self) -> int:
-        """Members that finished with a drift above ``max_drift`` (kept, "inaccurate")."""
-        return accuracy.count(self.status, "inaccurate")
 
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
