@@ -281,7 +281,7 @@ def _read(path, what, names, digest=None):
     """The arrays ``names`` of one checkpoint file (those present; no other entry is ever
     decompressed), sizes checked before reading (io.ArchiveError rules), its SHA-256
     compared with ``digest`` first when given."""
-    from .io import _DAMAGE, _Entries
+    from .npzfile import _DAMAGE, _Entries
 
     folder = os.path.dirname(path)
     try:

@@ -36,13 +36,12 @@ import dataclasses
 import datetime
 import json
 import os
-import struct
 import zipfile
-import zlib
 
 import numpy as np
 
 from . import runtime
+from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 
 #: Layout version written into every archive's metadata; bump it when the layout changes.
 FORMAT_VERSION = 1
@@ -350,118 +349,6 @@ def save_result(result, path, kind=None, extra=None):
 
 
 # ---- reading ----------------------------------------------------------------------------
-class ArchiveError(ValueError):
-    """A file that :func:`load` (or :func:`read_metadata`) cannot read as a ti_spinorbit
-    archive: not an ``.npz``, damaged (truncated, flipped bytes, renamed or missing entries,
-    bad ``.npy`` headers), malformed metadata (wrong types, absurd nesting), an unknown kind
-    or an unreadable ``format_version``. The message is one line naming the file and what is
-    wrong. A subclass of ValueError, so ``except ValueError`` still catches it."""
-
-
-#: Largest ratio of uncompressed to compressed size that deflate can reach (≈ 1032:1), with
-#: margin: an entry whose zip directory claims more is damaged, and is refused before reading.
-_MAX_DEFLATE_RATIO = 1100
-#: Largest metadata entry read (bytes uncompressed): real metadata is kilobytes to megabytes.
-_MAX_METADATA_BYTES = 256 * 2**20
-#: Errors that reading or decoding a damaged or hostile file can raise (never a bug of ours
-#: with a valid file): each becomes an ArchiveError naming the file.
-_DAMAGE = (KeyError, IndexError, TypeError, AttributeError, ValueError, RecursionError,
-           OverflowError, MemoryError, EOFError, OSError, UnicodeError, zipfile.BadZipFile,
-           zlib.error, struct.error, NotImplementedError)
-
-
-def _one_line(exc):
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text if len(text) <= 300 else text[:297] + "..."
-
-
-class _Entries:
-    """The arrays of an ``.npz``, read one by one on first use with every size checked
-    against the zip directory before anything is allocated; entries never asked for are
-    never decompressed (a small file cannot make :func:`load` allocate gigabytes)."""
-
-    def __init__(self, path, zf):
-        self.path, self.zf, self._cache = path, zf, {}
-        self._names = {}
-        for info in zf.infolist():
-            key = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
-            self._names[key] = info
-
-    @property
-    def files(self):
-        return list(self._names)
-
-    def __contains__(self, key):
-        return key in self._cache or key in self._names
-
-    def __iter__(self):
-        return iter(dict.fromkeys([*self._names, *self._cache]))
-
-    def __setitem__(self, key, value):
-        self._cache[key] = value
-
-    def __getitem__(self, key):
-        if key in self._cache:
-            return self._cache[key]
-        if not isinstance(key, str) or key not in self._names:
-            raise ArchiveError(f"{self.path!r} is damaged: its metadata names the array "
-                               f"{key!r}, which is not in the file")
-        self._cache[key] = value = self._read(key, self._names[key])
-        return value
-
-    def _read(self, key, info, limit=None):
-        where = f"{self.path!r} is damaged: entry {info.filename!r}"
-        if info.compress_type == zipfile.ZIP_STORED:
-            ok = info.file_size == info.compress_size
-        elif info.compress_type == zipfile.ZIP_DEFLATED:
-            ok = info.file_size <= _MAX_DEFLATE_RATIO * info.compress_size + 1024
-        else:
-            raise ArchiveError(f"{where} uses zip compression method {info.compress_type}; "
-                               "NumPy archives use stored or deflated entries")
-        if not ok:
-            raise ArchiveError(f"{where} claims {info.file_size} bytes from "
-                               f"{info.compress_size} compressed bytes (impossible)")
-        if limit is not None and info.file_size > limit:
-            raise ArchiveError(f"{where} holds {info.file_size} bytes, more than the "
-                               f"{limit} bytes allowed for it")
-        fmt = np.lib.format
-        with self.zf.open(info) as fh:
-            try:
-                version = fmt.read_magic(fh)
-                if version == (1, 0):
-                    shape, fortran, dtype = fmt.read_array_header_1_0(fh)
-                elif version == (2, 0):
-                    shape, fortran, dtype = fmt.read_array_header_2_0(fh)
-                else:
-                    reader = getattr(fmt, "_read_array_header", None)
-                    if reader is None:
-                        raise ArchiveError(f"{where} has .npy format version {version}")
-                    shape, fortran, dtype = reader(fh, version)
-            except (ValueError, SyntaxError, TypeError) as exc:
-                if isinstance(exc, ArchiveError):
-                    raise
-                raise ArchiveError(f"{where} has a bad .npy header "
-                                   f"({type(exc).__name__})") from None
-            header = fh.tell()
-            if dtype.hasobject:
-                raise ArchiveError(f"{where} holds Python objects (pickles are never loaded)")
-            count = 1
-            for n in shape:
-                count *= int(n)
-            if count * dtype.itemsize != info.file_size - header:
-                raise ArchiveError(f"{where} has a header for shape {tuple(shape)} of {dtype} "
-                                   f"({count * dtype.itemsize} bytes) but holds "
-                                   f"{info.file_size - header} bytes of data")
-        with self.zf.open(info) as fh:   # sizes agree: reading allocates what the file holds
-            return fmt.read_array(fh, allow_pickle=False)
-
-    def metadata(self):
-        info = self._names.get("metadata")
-        if info is None:
-            return None
-        return self._read("metadata", info, limit=_MAX_METADATA_BYTES)
-
-
 def _open(path):
     """The entries of an archive and its metadata dict, with clear errors; returns
     (zipfile.ZipFile, _Entries, metadata). The caller closes the ZipFile."""
