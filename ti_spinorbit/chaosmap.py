@@ -29,6 +29,7 @@ from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_positive, require_real,
                         require_spin)
 from .classify import MIN_POINTS, classify_section
+from .coordinates import THETADOT_LABEL, check_coordinates
 from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
@@ -99,7 +100,9 @@ class ChaosMap(accuracy.StatusSummary):
     ("resonant", "quasi-periodic", "chaotic", "undetermined"); ``mean_spin`` mean θ̇_p/n over
     the section points; ``status`` integrator status codes (``SectionResult.status_names``); ``chaotic_fraction``
     share of finished members labelled chaotic; ``section`` the underlying SectionResult (flat
-    members in the same C order); ``seconds`` wall time of the launch."""
+    members in the same C order); ``seconds`` wall time of the launch; ``coordinates`` the
+    spin coordinate of ``thetadot_p`` and ``mean_spin`` ("inertial" or "apsidal",
+    docs/physics.md §6.7)."""
 
     theta_p: np.ndarray
     thetadot_p: np.ndarray
@@ -119,6 +122,7 @@ class ChaosMap(accuracy.StatusSummary):
     max_drift: float = float("nan")
     n_inaccurate: int = 0
     include_inaccurate: bool = False
+    coordinates: str = "inertial"
 
     @property
     def shape(self):
@@ -174,7 +178,7 @@ class ChaosMap(accuracy.StatusSummary):
         ax.set_ylim(y[0], y[-1])
         ax.set_xticks(range(0, 181, 30))
         ax.set_xlabel(r"$\theta_p$ (deg)")
-        ax.set_ylabel(r"$\dot\theta_p / n$")
+        ax.set_ylabel(THETADOT_LABEL[self.coordinates])
         if title is None and self.section is not None:
             s = self.section.systems[0]
             title = (f"{s.name}, {self.orbits:g} orbits, rtol {self.rtol:.0e}, chaotic "
@@ -203,7 +207,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
               progress: Optional[Callable[[float], None]] = None, client=None,
               chunk_size=None, model="auto", checkpoint=None, resume=False,
               overwrite_checkpoint=False, max_drift=None,
-              include_inaccurate=False) -> ChaosMap:
+              include_inaccurate=False, coordinates="inertial") -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -238,11 +242,15 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         :mod:`ti_spinorbit.accuracy`).
     include_inaccurate : bool
         Count "inaccurate" members in ``chaotic_fraction`` too (default: excluded).
+    coordinates : {"inertial", "apsidal"}
+        Spin coordinate of the θ̇_p/n axis, of the starts and of the section points
+        (docs/physics.md §6.7; see :func:`~ti_spinorbit.section.surface_of_section`).
 
     Returns
     -------
     ChaosMap
     """
+    check_coordinates(coordinates)
     if not isinstance(system, BinarySystem):
         raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
     theta_p = _axis("theta_p", theta_p)
@@ -259,7 +267,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
                        indicators=True, progress=progress, model=model, checkpoint=checkpoint,
                        resume=resume, overwrite_checkpoint=overwrite_checkpoint,
-                       max_drift=max_drift)
+                       max_drift=max_drift, coordinates=coordinates)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = tp.shape
@@ -272,7 +280,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         megno_chaotic=float(megno_chaotic), section=section,
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
-        n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate))
+        n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
+        coordinates=coordinates)
 
 
 @dataclass
@@ -286,7 +295,8 @@ class ParameterMap(accuracy.StatusSummary):
     ellipsoid; ``seconds`` wall time of the one launch; ``energy_drift``, ``angmom_drift``
     per start and ``max_drift`` the accuracy limit (``ti_spinorbit.accuracy``);
     ``inaccurate`` the count of "inaccurate" starts per (a/b, e), excluded from
-    ``chaotic_fraction`` unless ``include_inaccurate``."""
+    ``chaotic_fraction`` unless ``include_inaccurate``; ``coordinates`` the spin coordinate
+    of ``thetadot_p`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
     elongations: np.ndarray
     eccentricities: np.ndarray
@@ -306,7 +316,7 @@ class ParameterMap(accuracy.StatusSummary):
     max_drift: float = float("nan")
     inaccurate: np.ndarray = None
     include_inaccurate: bool = False
-
+    coordinates: str = "inertial"
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -357,7 +367,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
                   resume=False, overwrite_checkpoint=False, max_drift=None,
-                  include_inaccurate=False) -> ParameterMap:
+                  include_inaccurate=False, coordinates="inertial") -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -377,13 +387,14 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
     progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint,
-    max_drift, include_inaccurate
-        As for :func:`chaos_map`.
+    max_drift, include_inaccurate, coordinates
+        As for :func:`chaos_map` ("apsidal" needs every e ≥ 1e-3, docs/physics.md §6.7).
 
     Returns
     -------
     ParameterMap
     """
+    check_coordinates(coordinates)
     elongations = _axis("elongations", elongations)
     eccentricities = _axis("eccentricities", eccentricities)
     theta_p = _axis("theta_p", theta_p)
@@ -415,7 +426,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
                        chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
                        model=model, checkpoint=checkpoint, resume=resume,
-                       overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift)
+                       overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
+                       coordinates=coordinates)
     seconds = time.perf_counter() - started
     labels = _labels(section, megno_chaotic, orbits)
     shape = (elongations.size, eccentricities.size, starts)
@@ -430,4 +442,4 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         inaccurate=np.sum(status == INACCURATE, axis=-1),
-        include_inaccurate=bool(include_inaccurate))
+        include_inaccurate=bool(include_inaccurate), coordinates=coordinates)

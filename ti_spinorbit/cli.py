@@ -185,6 +185,13 @@ def _parser():
                            help="without --resume, replace a checkpoint already in the "
                                 "--checkpoint directory (refused by default)")
 
+    def coordinates_flag(s):
+        s.add_argument("--coordinates", choices=("inertial", "apsidal"), default="inertial",
+                       help="spin coordinate θ̇_p/n of the starts and results: inertial (the "
+                            "inertial spin rate, default) or apsidal (the paper's: spin rate "
+                            "minus the apsidal precession rate; needs e >= 0.001); "
+                            "docs/physics.md §6.7")
+
     def system_flags(s, default="1991 VH", shape=True):
         s.add_argument("--system", default=default,
                        help=f"catalogued system name (default: {default}; see 'ti-spinorbit systems')")
@@ -212,6 +219,7 @@ def _parser():
                    help="initial θ̇_p/n values (default: the paper's starts for this system)")
     common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12, resume=True)
     accuracy_flags(s)
+    coordinates_flag(s)
 
     s = command("map", "chaos map over (θ_p, θ̇_p/n): MEGNO, Lyapunov, classes (PNG + .npz)")
     system_flags(s)
@@ -221,6 +229,7 @@ def _parser():
                    metavar=("LO", "HI"), help="θ̇_p/n range, LO < HI (default 0.2 3.0)")
     common(s, "PNG path (default map_<system>.png)", resume=True)
     accuracy_flags(s)
+    coordinates_flag(s)
 
     s = command("overlap", "resonance-overlap scan over a/b, 1:1 and 3:2 (PNG + .npz)")
     system_flags(s, shape=False)
@@ -230,6 +239,7 @@ def _parser():
                         "(default 1.01 1.15 0.01)")
     common(s, "PNG path (default overlap_<system>.png)")
     accuracy_flags(s)
+    coordinates_flag(s)
 
     s = command("libration", "relaxed libration amplitude at the synchronous island centre "
                 "(PNG + .npz)")
@@ -243,6 +253,7 @@ def _parser():
     common(s, "PNG path of the centre search, extent vs θ̇_p/n (default libration_<system>.png)",
            orbits=100.0, rtol=1e-12, model=False)
     accuracy_flags(s)
+    coordinates_flag(s)
 
     s = command("energy", "energy and angular-momentum conservation check (PNG + .npz; "
                 "exit status 1 when the drift exceeds --max-drift)")
@@ -434,6 +445,12 @@ def _check_system_flags(args):
             culprit = next((flags[k] for k, v in given.items() if v is not None), flag)
             message = f"{culprit}: {message}"
         raise ValueError(message) from None
+    from .coordinates import APSIDAL_MIN_ECCENTRICITY
+
+    if getattr(args, "coordinates", None) == "apsidal" and system.e < APSIDAL_MIN_ECCENTRICITY:
+        raise ValueError(f"--coordinates apsidal needs an eccentricity >= "
+                         f"{APSIDAL_MIN_ECCENTRICITY:g} ({system.name} has e = {system.e:g}): "
+                         "use --coordinates inertial or a larger --eccentricity")
     if args.command == "libration" and not system.omega0 > 0:
         raise ValueError(f"--elongation must be > 1 for libration: a round secondary has no "
                          f"synchronous island (got {args.elongation:g})")
@@ -606,10 +623,11 @@ def _cmd_section(args):
     with _progress(args) as bar:
         result = surface_of_section(system, args.theta_p, np.array(starts), orbits=args.orbits,
                                     rtol=args.rtol, progress=bar, max_drift=args.max_drift,
-                                    **_run_flags(args, data))
+                                    coordinates=args.coordinates, **_run_flags(args, data))
     out, data = _write(result, data, {"command": args.command_line},
                        lambda: plot_section(result), out)
     _print(args, f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
+                 f"{args.coordinates} coordinates, "
                  f"{len(starts)} trajectories x {args.orbits:g} orbits in {result.seconds:.2f} s "
                  f"({result.member_orbits_per_second:.0f} member-orbits/s), drift limit "
                  f"{result.max_drift:.1e}")
@@ -635,7 +653,8 @@ def _cmd_map(args):
     with _progress(args) as bar:
         cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
                          rtol=args.rtol, progress=bar, max_drift=args.max_drift,
-                         include_inaccurate=args.allow_inaccurate, **_run_flags(args, data))
+                         include_inaccurate=args.allow_inaccurate, coordinates=args.coordinates,
+                         **_run_flags(args, data))
     out, data = _write(cmap, data, {"command": args.command_line}, cmap.plot, out)
     counted = "all finished members" if args.allow_inaccurate else \
         f"{cmap.n_inaccurate} inaccurate left out"
@@ -661,7 +680,8 @@ def _cmd_overlap(args):
         scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
                                  orbits=args.orbits, rtol=args.rtol, progress=bar,
                                  model=args.model, max_drift=args.max_drift,
-                                 include_inaccurate=args.allow_inaccurate)
+                                 include_inaccurate=args.allow_inaccurate,
+                                 coordinates=args.coordinates)
     out, data = _write(scan, data, {"command": args.command_line}, scan.plot, out)
     _print(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
                  f"(analytic {scan.elongation_ro:.4f}) in {scan.seconds:.1f} s; wrote {out} and {data}")
@@ -687,7 +707,7 @@ def _plot_libration(result):
         left.plot(x, extent, label="coarse" if k == 0 else ("zooms" if k == 1 else None),
                   **style)
     left.axvline(result.center_thetadot_p, color="k", lw=0.6, ls="--", label="centre")
-    left.set_xlabel(r"$\dot\theta_p(0)/n$")
+    left.set_xlabel(rf"$\dot\theta_p(0)/n$ ({result.coordinates})")
     left.set_ylabel("section extent max |θ_p| (deg)")
     left.legend(fontsize=7)
     x, extent = result.candidates[-1], result.extents[-1]
@@ -715,7 +735,8 @@ def _cmd_libration(args):
 
     system = _system(args)
     out, data = _paths(args, "libration", system.name)
-    kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol, max_drift=args.max_drift)
+    kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol, max_drift=args.max_drift,
+                  coordinates=args.coordinates)
     if args.candidates:
         lo, hi, n = args.candidates
         kwargs["candidates"] = np.linspace(lo, hi, int(n))

@@ -98,7 +98,7 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         ``progress(fraction)`` on the client after every finished chunk.
     **kwargs
         Passed to ``surface_of_section`` (``rtol``, ``atol``, ``order``, ``window_orbits``,
-        ``escape_distance``, ``indicators``).
+        ``escape_distance``, ``indicators``, ``coordinates``).
 
     Returns
     -------
@@ -121,7 +121,9 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
                          "would share one file); failed chunks are retried instead")
     members, par, y0, tp, td = section.build_members(system_or_systems, theta_p, thetadot_p,
-                                                     call.arguments["escape_distance"])
+                                                     call.arguments["escape_distance"],
+                                                     call.arguments["coordinates"],
+                                                     call.arguments["order"])
     if call.arguments.get("model") == "auto":
         # decided over the whole ensemble, as one launch would, not chunk by chunk
         from .ensemble import _choose_model

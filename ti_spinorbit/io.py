@@ -56,7 +56,12 @@ _COMMON_UNITS = {"status_names": "name", "system_index": "index into metadata sy
                  # accuracy verdict (ti_spinorbit.accuracy)
                  "energy_drift": "1 (relative)", "angmom_drift": "1 (relative)",
                  "max_drift": "1 (relative)", "n_inaccurate": "members",
-                 "include_inaccurate": "bool"}
+                 "include_inaccurate": "bool",
+                 # section coordinates (docs/physics.md §6.7): which spin rate θ̇_p/n means
+                 "coordinates": "name: 'inertial' (θ̇ = inertial spin rate) or 'apsidal' "
+                                "(θ̇ = spin rate − apsidal rate ϖ̇, θ from the osculating "
+                                "line of apsides)",
+                 "apsidal_rate": SPIN}
 #: Units of every array and scalar field, per kind ("1": dimensionless).
 UNITS = {
     "section": {

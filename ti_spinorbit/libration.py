@@ -92,7 +92,8 @@ def _amplitudes(ts, include_inaccurate=False):
 
 
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
-                        rtol=1e-12, max_drift=None, include_inaccurate=False):
+                        rtol=1e-12, max_drift=None, include_inaccurate=False,
+                        coordinates="inertial"):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -113,6 +114,9 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
     max_drift, include_inaccurate
         Accuracy limit (default ``min(1e-4, 1000 · rtol · orbits)``,
         :mod:`ti_spinorbit.accuracy`), and whether members above it still get an amplitude.
+    coordinates : {"inertial", "apsidal"}
+        Spin coordinate of ``thetadot_p`` (docs/physics.md §6.7); α, and so the amplitude,
+        is the same in both.
 
     Returns
     -------
@@ -122,7 +126,7 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         failed the accuracy check (unless ``include_inaccurate``).
     """
     ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
-                     rtol=rtol, max_drift=max_drift)
+                     rtol=rtol, max_drift=max_drift, coordinates=coordinates)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
@@ -148,7 +152,8 @@ class RelaxedLibration:
     centre is below ``max_extent`` and the final trajectory passed the accuracy check;
     ``status`` that trajectory's status ("done", "inaccurate", ...), ``energy_drift`` and
     ``angmom_drift`` its relative drifts and ``max_drift`` their limit
-    (``ti_spinorbit.accuracy``); ``seconds`` wall time."""
+    (``ti_spinorbit.accuracy``); ``seconds`` wall time; ``coordinates`` the spin coordinate of
+    ``center_thetadot_p`` and ``candidates`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
     center_thetadot_p: float
     amplitude: float
@@ -171,6 +176,7 @@ class RelaxedLibration:
     energy_drift: float = float("nan")
     angmom_drift: float = float("nan")
     max_drift: float = float("nan")
+    coordinates: str = "inertial"
 
 
 def _fit_v(x, extent, best):
@@ -205,7 +211,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
                       samples_per_orbit=256, coarse_arm_points=3,
                       max_extent=MAX_CENTER_EXTENT_DEG, progress=None,
-                      max_drift=None) -> RelaxedLibration:
+                      max_drift=None, coordinates="inertial") -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
     Parameters
@@ -243,6 +249,10 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         Accuracy limit of every trajectory (default ``min(1e-4, 1000 · rtol · orbits)``,
         :mod:`ti_spinorbit.accuracy`): "inaccurate" candidates take no part in the search,
         and an inaccurate final trajectory makes the result not converged.
+    coordinates : {"inertial", "apsidal"}
+        Spin coordinate of the candidates and of the centre found (docs/physics.md §6.7):
+        the centre in apsidal coordinates is the inertial one minus ϖ̇(0)/n. The amplitude
+        max |α| does not depend on it.
 
     Returns
     -------
@@ -257,6 +267,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     """
     if not isinstance(system, BinarySystem):
         raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
+    from .coordinates import check_coordinates
+    check_coordinates(coordinates)
     if not system.omega0 > 0:
         raise ValueError("the secondary must be elongated (B > A, omega0 > 0) to have a "
                          "synchronous island")
@@ -311,7 +323,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     start = time.perf_counter()
     # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
     half_width = float(np.max(np.diff(x)))
-    coarse = surface_of_section(system, 0.0, x, orbits, rtol=rtol, max_drift=limit)
+    coarse = surface_of_section(system, 0.0, x, orbits, rtol=rtol, max_drift=limit,
+                                coordinates=coordinates)
     if coarse.n_inaccurate == len(x):
         raise RuntimeError(f"every candidate's conservation drift exceeds max_drift {limit:.3g} "
                            f"(largest energy drift {np.nanmax(coarse.energy_drift):.3g}); "
@@ -319,7 +332,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     extent = section_extent(coarse)
     launched(1 + zooms_left(half_width, 0) + 2)
     librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol, max_drift=limit,
-                                               samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT))
+                                               samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT,
+                                               coordinates=coordinates))
     launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
     tried, extents = [x], [extent]
@@ -337,7 +351,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     while half_width > xtol and iterations < max_iterations:
         x = center + np.linspace(-half_width, half_width, zoom_candidates)
         extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol,
-                                                   max_drift=limit))
+                                                   max_drift=limit, coordinates=coordinates))
         extent[extent >= LIBRATION_LIMIT_DEG] = np.nan
         tried.append(x)
         extents.append(extent)
@@ -354,7 +368,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         launched(zooms_left(half_width, iterations) + 2)
     # 4. the centre itself
     final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
-                                                           rtol=rtol, max_drift=limit),
+                                                           rtol=rtol, max_drift=limit,
+                                                           coordinates=coordinates),
                                         include_inaccurate=True)[0])
     launched(1)
     # a narrow window is not enough: at a true centre the trace shrinks to a point (a chaotic
@@ -366,7 +381,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                       f"{max_extent:g} deg) after {iterations} launches", RuntimeWarning,
                       stacklevel=2)
     ts = time_series(system, 0.0, center, orbits, samples_per_orbit=samples_per_orbit, rtol=rtol,
-                     max_drift=limit)
+                     max_drift=limit, coordinates=coordinates)
     amplitude = float(_amplitudes(ts, include_inaccurate=True)[0])   # kept, flagged below
     launched(0)
     if not np.isfinite(amplitude):
@@ -386,4 +401,4 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
         seconds=time.perf_counter() - start, system=system, status=status,
         energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
-        max_drift=limit)
+        max_drift=limit, coordinates=coordinates)

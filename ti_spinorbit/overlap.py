@@ -80,7 +80,8 @@ class OverlapScan:
     ``elongations``, ``overlaps``: the scan; ``decisions``: per-elongation evidence;
     ``max_drift`` the accuracy limit every trajectory was held against and ``n_inaccurate``
     the trajectories above it (``ti_spinorbit.accuracy``), left out of the decisions unless
-    ``include_inaccurate``."""
+    ``include_inaccurate``; ``coordinates`` the spin coordinate of the starts, centres and
+    ranges ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
     name: str
     eccentricity: float
@@ -96,6 +97,7 @@ class OverlapScan:
     max_drift: float = float("nan")
     n_inaccurate: int = 0
     include_inaccurate: bool = False
+    coordinates: str = "inertial"
 
     def plot(self, ax=None, title=None):
         """Decision per elongation (overlap blue, separate green) with the numerical and the
@@ -137,7 +139,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
                       indicators=True, progress=None, client=None,
                       chunk_size=None, model="auto", max_drift=None,
-                      include_inaccurate=False) -> OverlapScan:
+                      include_inaccurate=False, coordinates="inertial") -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -169,13 +171,19 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         :mod:`ti_spinorbit.accuracy`).
     include_inaccurate : bool
         Let "inaccurate" trajectories take part in the decisions (default: left out).
+    coordinates : {"inertial", "apsidal"}
+        Spin coordinate of the starts and of the centres and ranges in the decisions
+        (docs/physics.md §6.7; "apsidal" is the paper's).
     """
     import time
+
+    from .coordinates import check_coordinates
 
     from .ensemble import check_tolerances
     from .section import check_orbits
 
     # every scalar before any system is built or integrated
+    check_coordinates(coordinates)
     check_orbits(orbits)
     check_tolerances(rtol, None)
     center_starts = require_count("center_starts", center_starts, 2, 100000)
@@ -214,7 +222,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     t0 = time.perf_counter()
     sec = sections(client, members, np.array(theta0), np.array(rates), orbits=orbits,
                    chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
-                   model=model, max_drift=max_drift)
+                   model=model, max_drift=max_drift, coordinates=coordinates)
     per = len(centre_rates) + len(sep_rates)
     decisions = []
     for k, s in enumerate(systems):
@@ -229,7 +237,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                        elongation_ro=float(analytic.elongation_from_omega0(w_ro)), orbits=orbits,
                        seconds=time.perf_counter() - t0, sections=sec,
                        max_drift=sec.max_drift, n_inaccurate=sec.n_inaccurate,
-                       include_inaccurate=bool(include_inaccurate))
+                       include_inaccurate=bool(include_inaccurate), coordinates=coordinates)
 
 
 def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
@@ -280,7 +288,7 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
 
 def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     """Overlap scans of a catalogued system at several eccentricities (same kwargs as
-    :func:`overlap_threshold`, ``client`` included). Returns (eccentricities, numerical
+    :func:`overlap_threshold`, ``client`` and ``coordinates`` included). Returns (eccentricities, numerical
     first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
     ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)

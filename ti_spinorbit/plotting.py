@@ -5,6 +5,7 @@ trajectory unless a classification gives the paper's colours (resonant red, chao
 quasi-periodic green)."""
 
 from .classify import COLORS as CLASS_COLORS  # the paper's red / blue / green
+from .coordinates import THETADOT_LABEL       # "θ̇_p/n (inertial)" or "(apsidal)"
 
 
 def _pyplot():
@@ -44,7 +45,7 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
     ax.set_xlim(0, 180)
     ax.set_xticks(range(0, 181, 30))
     ax.set_xlabel(r"$\theta_p$ (deg)")
-    ax.set_ylabel(r"$\dot\theta_p / n$")
+    ax.set_ylabel(THETADOT_LABEL[getattr(result, "coordinates", "inertial")])
     if title is None:
         s = result.systems[0]
         axes = getattr(s.secondary, "semi_axes", None)

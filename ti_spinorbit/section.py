@@ -4,6 +4,9 @@
 the angle θ_p from the line of apsides to the secondary's long axis and the secondary's spin
 rate θ̇_p/n (Naidu & Margot 2015 §2.3, Figs. 4-6). ``time_series`` samples one or more members
 densely (spin rate, α, r, energy) for libration and spin-rate studies (their Figs. 2, 8, 9).
+Both take ``coordinates``: "inertial" (default; θ̇ the inertial spin rate) or "apsidal" (the
+paper's: θ and θ̇ from the osculating line of apsides, θ̇ = spin rate − ϖ̇; docs/physics.md
+§6.7, ``ti_spinorbit.coordinates``).
 
 Inputs broadcast: a system (or a list giving one member per system), θ_p (deg) and θ̇_p/n,
 scalars or arrays, are broadcast against each other to N members.
@@ -15,6 +18,7 @@ from typing import Sequence, Union
 import numpy as np
 
 from . import accuracy
+from . import coordinates as _coords
 from ._validate import (_as_floats, require_callable, require_count, require_finite,
                         require_order, require_real, require_spin, show)
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
@@ -63,11 +67,14 @@ def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per
 
 
 def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
-                  escape_distance=ESCAPE_DISTANCE):
+                  escape_distance=ESCAPE_DISTANCE, coordinates="inertial", order=4):
     """Broadcast systems and initial conditions into a member table.
 
     Returns (systems list of length N, par (N, NPAR), y0 (N, 30), theta_p_deg (N,),
-    thetadot_p (N,)). ``escape_distance`` is in units of a and must exceed 1."""
+    thetadot_p (N,)). ``escape_distance`` is in units of a and must exceed 1. With
+    ``coordinates="apsidal"`` thetadot_p is the apsidal spin rate θ̇ − ϖ̇ at the start and y0
+    carries the inertial spin θ̇_p + ϖ̇(0) (docs/physics.md §6.7; ϖ̇ of the ``order`` model)."""
+    _coords.check_coordinates(coordinates)
     distance = _as_floats("escape_distance", escape_distance)
     if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
         raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
@@ -98,6 +105,8 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
     par = np.stack([rows.setdefault(id(s), s.parameter_row(escape_distance)) for s in members])
     y0 = np.stack([s.initial_state(np.radians(tp), td)
                    for s, tp, td in zip(members, theta_p, thetadot_p)])
+    if coordinates == "apsidal":
+        y0, _ = _coords.apsidal_initial_states(members, par, y0, theta_p, thetadot_p, order)
     return members, par, y0, theta_p.copy(), thetadot_p.copy()
 
 
@@ -113,7 +122,11 @@ class SectionResult(accuracy.StatusSummary):
     ``status_names`` ("done", "inaccurate" when a drift exceeds ``max_drift``, "non-finite",
     "collision", ...) and ``status_counts``; ``accepted``, ``rejected``, ``rhs_calls``;
     with ``indicators=True``: ``megno`` (MEGNO ⟨Y⟩ at the end: → 2 quasi-periodic, ≫ 2
-    chaotic) and ``lyapunov`` (finite-time maximal Lyapunov exponent, 1/orbit), else NaN."""
+    chaotic) and ``lyapunov`` (finite-time maximal Lyapunov exponent, 1/orbit), else NaN;
+    ``coordinates`` "inertial" (``thetadot_p`` and ``initial_thetadot_p`` are the inertial
+    spin rate) or "apsidal" (spin rate minus the apsidal rate ϖ̇, the paper's; ``apsidal_rate``
+    then holds ϖ̇/n at every crossing, NaN where e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``);
+    θ_p is the same in both (docs/physics.md §6.7)."""
 
     theta_p: np.ndarray
     thetadot_p: np.ndarray
@@ -139,7 +152,8 @@ class SectionResult(accuracy.StatusSummary):
     megno: np.ndarray = None
     lyapunov: np.ndarray = None
     max_drift: float = float("nan")
-
+    coordinates: str = "inertial"
+    apsidal_rate: np.ndarray = None
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -156,7 +170,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
                        progress=None, model="auto", checkpoint=None,
                        resume=False, overwrite_checkpoint=False,
-                       max_drift=None) -> SectionResult:
+                       max_drift=None, coordinates="inertial") -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -202,41 +216,58 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
         Largest relative energy or angular-momentum drift of a member reported "done"; a
         member above it is "inaccurate" (kept, counted apart). Default:
         ``min(1e-4, 1000 · rtol · orbits)`` (``ti_spinorbit.accuracy``); a number in (0, 1].
+    coordinates : {"inertial", "apsidal"}
+        Spin coordinate of the starts and of the recorded points (docs/physics.md §6.7).
+        "inertial" (default): the secondary's inertial spin rate about the orbit normal.
+        "apsidal" (Naidu & Margot 2015): the rate of θ measured from the osculating line of
+        apsides, spin rate − ϖ̇; a start θ̇_p = 1.08 is then the paper's 1.08 (the integration
+        starts at the inertial rate 1.08 + ϖ̇(0)). Needs e ≥ 1e-3
+        (``coordinates.APSIDAL_MIN_ECCENTRICITY``); θ_p is the same in both.
 
     Returns
     -------
     SectionResult
     """
+    _coords.check_coordinates(coordinates)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     check_size("surface_of_section", system_or_systems, theta_p, thetadot_p, orbits, model=model)
-    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
+    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance,
+                                             coordinates, order)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
                   progress=progress, checkpoint=checkpoint, resume=resume,
                   overwrite_checkpoint=overwrite_checkpoint)
-    cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"))
+    cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"),
+                            apsidal=coordinates == "apsidal", order=order)
+    thetadot, rate = cols["thetadot"], None
+    if coordinates == "apsidal":
+        rate, = _coords.mask_small_eccentricity(cols["e"], cols["apsidal_rate"],
+                                                what="pericentre passages")
+        thetadot = thetadot - rate
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
     energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
     return SectionResult(
-        theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=cols["thetadot"],
+        theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=thetadot,
         t=cols["t"] / n[:, None], r=cols["r"] * a[:, None], a=cols["a"] * a[:, None], e=cols["e"],
         count=np.array([len(ev) for ev in out.events]), energy_drift=energy_drift,
         angmom_drift=angmom_drift, status=status, accepted=out.counters[:, 0],
         rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
-        max_drift=limit)
+        max_drift=limit, coordinates=coordinates, apsidal_rate=rate)
 
 
-def _derived_columns(par, records, names, ensemble=None):
+def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
     """Observables of per-member record lists, padded with NaN to (N, max count): "t" and
     ``names`` (observables.derive); with an ``ensemble`` also the energy and angular-momentum
-    split (scaled). All records are derived together: one NumPy pass, one kernel launch."""
+    split (scaled); with ``apsidal`` also "apsidal_rate" (ϖ̇/n, model of ``order``) and
+    "true_anomaly" (rad) of the osculating orbit (docs/physics.md §6.7). All records are
+    derived together: one NumPy pass, one kernel launch."""
     from .kernels.ensemble import RECORD_WIDTH
     from .observables import derive
 
@@ -253,6 +284,13 @@ def _derived_columns(par, records, names, ensemble=None):
 
     d = derive(par[member], flat[:, 1:])
     cols = {"t": padded(flat[:, 0]), **{k: padded(d[k]) for k in names}}
+    if apsidal:
+        from .kernels import eom
+
+        states = flat[:, 1:]
+        cols["apsidal_rate"] = padded(_coords.states_rate(par[member], states, order))
+        cols["true_anomaly"] = padded(_coords.true_anomaly(states[:, eom.Y_R:eom.Y_R + 3],
+                                                           states[:, eom.Y_V:eom.Y_V + 3]))
     if ensemble is not None:
         diag = ensemble.diagnostics(flat[:, 1:], member)
         for c, k in enumerate(("energy_orbit", "energy_primary", "energy_secondary")):
@@ -274,7 +312,10 @@ class TimeSeriesResult(accuracy.StatusSummary):
     (N, samples, 3), kg m² s⁻¹; ``energy_drift``, ``angmom_drift`` the largest relative drift
     of the total energy and angular-momentum vector over every sample and the end of the run,
     held against ``max_drift`` for the ``status`` verdict (``ti_spinorbit.accuracy``);
-    ``rtol``, ``orbits`` the run's tolerance and length (orbital periods)."""
+    ``rtol``, ``orbits`` the run's tolerance and length (orbital periods); ``coordinates``
+    "inertial" (as above) or "apsidal": then ``theta`` is the long axis from the osculating
+    line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
+    e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7."""
 
     t: np.ndarray
     alpha: np.ndarray
@@ -297,33 +338,42 @@ class TimeSeriesResult(accuracy.StatusSummary):
     max_drift: float = float("nan")
     rtol: float = float("nan")
     orbits: float = float("nan")
-
+    coordinates: str = "inertial"
 
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
                 rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                 escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
                 resume=False, overwrite_checkpoint=False,
-                max_drift=None) -> TimeSeriesResult:
+                max_drift=None, coordinates="inertial") -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
     initial orbital period), so samples carry the integrator's accuracy. orbits must lie in
     (0, 1e7] (``MAX_ORBITS``), as for surface_of_section. The drifts are the largest over
-    every sample (and the end); ``max_drift`` as for surface_of_section."""
+    every sample (and the end); ``max_drift`` and ``coordinates`` as for surface_of_section
+    (apsidal: θ from the osculating line of apsides and θ̇ its rate, the starts' θ̇_p too)."""
+    _coords.check_coordinates(coordinates)
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     check_size("time_series", system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit,
                model)
-    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance)
+    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance,
+                                             coordinates, order)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
                   sample_dt=2.0 * np.pi / samples_per_orbit, progress=progress,
                   checkpoint=checkpoint, resume=resume,
                   overwrite_checkpoint=overwrite_checkpoint)
-    cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r"), ensemble=ens)
+    apsidal = coordinates == "apsidal"
+    cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r", "e"),
+                            ensemble=ens, apsidal=apsidal, order=order)
+    if apsidal:   # θ from the osculating apsidal line: α + f, wrapped to (−π, π]
+        theta = np.angle(np.exp(1j * (cols["alpha"] + cols["true_anomaly"])))
+        cols["theta"], cols["thetadot"] = _coords.mask_small_eccentricity(
+            cols["e"], theta, cols["thetadot"] - cols["apsidal_rate"], what="samples")
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
     e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])[:, None]
@@ -338,7 +388,7 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
         **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
-        orbits=orbits)
+        orbits=orbits, coordinates=coordinates)
 
 
 def _sampled_drifts(cols, out: RunOutput):

@@ -82,6 +82,8 @@ def _section(r, units):
     data = {k: (("member", "crossing"), getattr(r, k)) for k in ("theta_p", "thetadot_p", "t", "r", "a", "e")}
     data.update({k: ("member", getattr(r, k)) for k in member_vars if getattr(r, k) is not None})
     data["status_name"] = ("member", io.status_names(r.status))
+    if getattr(r, "apsidal_rate", None) is not None:     # coordinates="apsidal" only
+        data["apsidal_rate"] = (("member", "crossing"), r.apsidal_rate)
     coords = {"member": np.arange(n), "crossing": np.arange(width),
               "initial_theta_p": ("member", r.initial_theta_p),
               "initial_thetadot_p": ("member", r.initial_thetadot_p),
