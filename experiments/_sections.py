@@ -4,13 +4,15 @@ convention (resonant red, chaotic blue, quasi-periodic green)."""
 import numpy as np
 
 
-def section_panel(ax, system, starts, orbits, rtol=1e-12, title=None):
-    """Integrate the starts (θ_p = 0), classify, draw; returns (result, classification)."""
+def section_panel(ax, system, starts, orbits, rtol=1e-12, title=None, coordinates="apsidal"):
+    """Integrate the starts (θ_p = 0), classify, draw; returns (result, classification).
+    ``coordinates`` defaults to the paper's apsidal ones (docs/physics.md §6.7): the starts
+    θ̇_p/n are the paper's numbers."""
     import ti_spinorbit as tso
     from ti_spinorbit.classify import classify_section
 
     result = tso.surface_of_section(system, 0.0, np.array(starts, dtype=float), orbits=orbits,
-                                    rtol=rtol)
+                                    rtol=rtol, coordinates=coordinates)
     cls = classify_section(result)
     result.plot(ax=ax, colors=list(cls.label), markersize=1.0, legend=False, title=title)
     for k, w in enumerate(starts):   # label each trace by its start, at its first point

@@ -9,6 +9,9 @@ crosses 1 inside the scanned range, where that estimate diverges: the curve is c
 
 Prints: per density factor, m1/m2, the island centre θ̇_p(0)/n, the measured amplitude (deg),
 |ψ_A| and |ψ_A,eff| (deg), and the section extent left at the centre.
+
+Coordinates: apsidal, the paper's (docs/physics.md §6.7): the centre θ̇_p(0)/n is the paper's
+(the inertial one minus ϖ̇(0)); the amplitude max |α| is the same in both.
 """
 
 import numpy as np
@@ -43,7 +46,7 @@ def main():
           f"{'|psi_A,eff|':>11} {'omega0_eff':>10} {'extent':>8}  (deg; centre in n)")
     for f in factors:
         system = tso.catalog.system(SYSTEM, elongation=ELONGATION, secondary_density=f * rho_s)
-        lib = relaxed_libration(system, orbits=orbits, rtol=rtol)
+        lib = relaxed_libration(system, orbits=orbits, rtol=rtol, coordinates="apsidal")
         row = (system.mass_ratio, lib.center_thetadot_p, lib.amplitude, abs(lib.psi_A),
                abs(lib.psi_A_effective), lib.extent, lib.converged)
         for k, v in zip(keys, row):

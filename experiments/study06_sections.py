@@ -5,6 +5,9 @@
 overlap value the 1:1 and 3:2 resonances have merged into a large chaotic sea; the
 synchronous island survives, shifted vertically by relaxed-mode libration.
 
+Coordinates: apsidal, the paper's (θ̇ from the osculating line of apsides, spin rate − ϖ̇;
+docs/physics.md §6.7), so the starts are the paper's.
+
 Prints: the classification of every start.
 """
 
@@ -32,7 +35,8 @@ def main():
         numbers.update(numbers_for(name, starts, cls))
         arrays.update(arrays_for(name.replace(" ", ""), result))
     save(args, "study06_sections", fig, arrays, {"orbits": orbits, "rtol": 1e-12,
-                                                 "systems": list(SYSTEMS)}, numbers, started)
+                                                 "systems": list(SYSTEMS),
+                                                 "coordinates": "apsidal"}, numbers, started)
 
 
 if __name__ == "__main__":

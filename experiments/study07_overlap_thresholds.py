@@ -6,6 +6,9 @@ For each system (1991 VH, 2003 YT1, 2004 DC) the elongation a/b is scanned in st
 connects the synchronous and 3:2 zones (ti_spinorbit.overlap). All elongations of a system
 run in one kernel launch.
 
+Coordinates: apsidal, the paper's (docs/physics.md §6.7): the starts, island centres and
+ranges are in θ̇ from the osculating line of apsides.
+
 Prints: the first overlapping a/b per system, numerical and analytic.
 """
 
@@ -29,7 +32,8 @@ def main():
     fig, axes = plt.subplots(2, len(SYSTEMS), figsize=(14, 8), gridspec_kw={"height_ratios": [1, 2]})
     numbers, arrays = {}, {}
     for col, name in enumerate(SYSTEMS):
-        scan = overlap_threshold(name, elongations=elong, orbits=orbits, **kw)
+        scan = overlap_threshold(name, elongations=elong, orbits=orbits, coordinates="apsidal",
+                                 **kw)
         scan.plot(axes[0, col], title=f"{name} (e = {scan.eccentricity})")
         # the connecting trajectory at the first overlap (or the widest one at the last a/b)
         k = (list(scan.elongations).index(scan.first_overlap) if scan.first_overlap is not None

@@ -20,6 +20,11 @@ region is chaotic); it is recorded as NaN. The orbit's radial eccentricity
 e_r = (r_max − r_min)/(r_max + r_min) along each centre trajectory is reported: where it
 exceeds the nominal (initial osculating) e, the non-Keplerian orbit sets the forcing.
 
+Coordinates: inertial, unlike the other section studies. The table includes 1999 KW4
+(e = 0.0004), below the eccentricity floor of the apsidal coordinates, where the apsidal rate
+is several n (docs/physics.md §6.7); the amplitudes max |α| do not depend on the coordinates,
+and an island centre in the paper's coordinates is the printed one minus ϖ̇(0)/n.
+
 Prints: a system × elongation table of the island centre, amplitude, |ψ_A|, their ratio, the
 section extent left at the centre, T_sec/T, e_r and whether the search converged; the reason
 for every failed case; for strobed cases the second method's centre, amplitude and ratio.

@@ -4,6 +4,9 @@
 (chaotic), 2.38 (resonant), 2.60 (quasi-periodic, circulating). A chaotic spin wanders
 irregularly between resonances; regular ones stay in a band.
 
+Coordinates: apsidal, the paper's (docs/physics.md §6.7): the starts are the paper's and the
+plotted θ̇/n is the rate of θ measured from the osculating line of apsides (spin rate − ϖ̇).
+
 Prints: mean and range of θ̇/n for each trajectory.
 """
 
@@ -22,19 +25,21 @@ def main():
 
     vh = tso.catalog.system("1991 VH")
     orbits = 20 if args.quick else 300
-    ts = tso.time_series(vh, 0.0, STARTS, orbits=orbits, samples_per_orbit=32, rtol=1e-12)
+    ts = tso.time_series(vh, 0.0, STARTS, orbits=orbits, samples_per_orbit=32, rtol=1e-12,
+                         coordinates="apsidal")
     fig, axes = plt.subplots(len(STARTS), 1, figsize=(7, 8), sharex=True)
     numbers = {}
     for k, (ax, w) in enumerate(zip(axes, STARTS)):
         ok = np.isfinite(ts.t[k])
         ax.plot(ts.t[k, ok] / vh.orbital_period, ts.thetadot[k, ok], lw=0.6)
-        ax.set_ylabel(r"$\dot\theta/n$")
+        ax.set_ylabel(r"$\dot\theta/n$ (apsidal)")
         ax.set_title(rf"$\dot\theta_p(0)/n$ = {w}", fontsize=8)
         numbers[f"thetadot range ({w})"] = [float(np.nanmin(ts.thetadot[k])), float(np.nanmax(ts.thetadot[k]))]
     axes[-1].set_xlabel("time (orbits)")
     save(args, "study09_spin_rate", fig,
          {"t_s": ts.t, "thetadot": ts.thetadot, "alpha_deg": ts.alpha, "starts": STARTS},
-         {"system": vh.describe(), "orbits": orbits, "rtol": 1e-12}, numbers, started)
+         {"system": vh.describe(), "orbits": orbits, "rtol": 1e-12, "coordinates": "apsidal"},
+         numbers, started)
 
 
 if __name__ == "__main__":

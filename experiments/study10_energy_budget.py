@@ -13,6 +13,9 @@ orders of magnitude smaller, so they cannot pull a secondary out of chaos quickl
 
 Prints: per system E0, the analytic and measured chaotic ΔE/E0, the tidal and YORP ΔE/E0, and
 the ratios tidal/chaotic and YORP/chaotic (against the measured RMS).
+
+Coordinates: apsidal, the paper's (docs/physics.md §6.7): the chaotic starts are the paper's
+θ̇_p(0)/n; the energies do not depend on the coordinates.
 """
 
 import numpy as np
@@ -43,10 +46,10 @@ def main():
     # chaos check: every start and its shadow in one section launch
     sec = tso.surface_of_section([s for s in systems for _ in (0, 1)], 0.0,
                                  np.repeat(starts, 2) + np.tile([0.0, SHADOW_OFFSET], len(names)),
-                                 orbits, rtol=RTOL)
+                                 orbits, rtol=RTOL, coordinates="apsidal")
     # spin energy at fixed times, one orbital period apart every SAMPLES_PER_ORBIT samples
     ts = tso.time_series(systems, 0.0, starts, orbits, samples_per_orbit=SAMPLES_PER_ORBIT,
-                         rtol=RTOL)
+                         rtol=RTOL, coordinates="apsidal")
 
     budgets, measured, separations, diverged_at, dE_series = [], [], [], [], []
     for k, (name, system) in enumerate(zip(names, systems)):
