@@ -54,7 +54,7 @@ def main():
         ax.axhline(d.center_3_2, color="tab:red", lw=0.6, ls=":")
         ax.set_xlim(0, 180)
         ax.set_xlabel(r"$\theta_p$ (deg)")
-        ax.set_ylabel(r"$\dot\theta_p/n$")
+        ax.set_ylabel(r"$\dot\theta_p/n$ (apsidal)")
         ax.set_title(f"a/b = {d.elongation:.2f}: 1:1 and 3:2 centres (red)", fontsize=8)
         ax.legend(fontsize=6, loc="upper right")
         numbers[f"{name} numerical a/b"] = scan.first_overlap
