@@ -430,3 +430,75 @@ def energy_budget(system, heliocentric_a_au, heliocentric_e, Q=DEFAULT_Q, f_yorp
     out["yorp_dE_over_E0"] = yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e,
                                                    f_yorp) / E0
     return out
+
+
+# ---- capture into resonance under a tidal torque ---------------------------------------------
+def tidal_torque_factors(e):
+    """Eccentricity functions of the orbit-averaged viscous (constant time-lag) tidal torque,
+    ⟨N⟩ = −K [Ω(e) θ̇/n − N(e)] (Murray & Dermott 1999 §5.7; docs/physics.md §8.9):
+
+        Ω(e) = ⟨(a/r)⁶⟩ = (1 + 3e² + 3e⁴/8) / (1 − e²)^{9/2},
+        N(e) = ⟨(a/r)⁶ ḟ/n⟩ = (1 + 15e²/2 + 45e⁴/8 + 5e⁶/16) / (1 − e²)⁶,
+
+    averages over the mean anomaly, dimensionless. N/Ω is the spin rate (units of n) at
+    which the averaged torque vanishes (pseudo-synchronous rotation). ``e`` in [0, 1).
+    Returns (Ω, N)."""
+    e = _eccentricity(e)
+    e2 = e * e
+    omega = (1.0 + 3.0 * e2 + 0.375 * e2**2) / (1.0 - e2) ** 4.5
+    big_n = (1.0 + 7.5 * e2 + 5.625 * e2**2 + 0.3125 * e2**3) / (1.0 - e2) ** 6
+    return _result(omega), _result(big_n)
+
+
+def tidal_offset_V(p, e):
+    """V = p − N(e)/Ω(e), in units of n: the averaged viscous tidal torque near the p n
+    resonance, written with γ = θ − pM, is ⟨N⟩ = −K Ω(e) (V + γ̇/n) (Murray & Dermott 1999
+    §5.7; docs/physics.md §8.9). V > 0 means the tides spin the body down through the
+    resonance; V <= 0 means they stop it (at N/Ω) before it gets there. ``p`` an integer or
+    half-integer (> 0), ``e`` in [0, 1); they broadcast. Dimensionless."""
+    two_p = _two_p(p)
+    if np.any(two_p <= 0):
+        raise ValueError(f"p must be a positive integer or half-integer (got {p!r})")
+    omega, big_n = tidal_torque_factors(e)
+    return _result(two_p / 2.0 - np.asarray(big_n) / np.asarray(omega))
+
+
+def capture_probability(p, omega0, e, V=None):
+    """Probability of capture into the p n spin-orbit resonance of a body despun through it
+    by tides, dimensionless in [0, 1] (Goldreich & Peale 1966; Murray & Dermott 1999 §5.7,
+    eq. 5.110; Naidu & Margot 2015 §7.1 for the 2:1 resonance; docs/physics.md §8.9):
+
+        P_c = 2 / (1 + π V / (2 ω0 sqrt|H(p, e)|)),      capped at 1,
+
+    with ω0 in units of n (ω0² = 3(B − A)/C), H Cayley's coefficient (:func:`cayley_H`) and
+    V = p − N(e)/Ω(e) (:func:`tidal_offset_V`, viscous tides) unless ``V`` is given. It is the
+    ratio of the energy the tides remove over one full circulation along the separatrix,
+    4 K Ω ω0 sqrt|H| (per unit C), to the energy they remove on the upper half alone,
+    K Ω (π V + 2 ω0 sqrt|H|): a spin that has just crossed the separatrix energy (uniformly
+    distributed in that window) is captured if it cannot climb back out on the lower half.
+
+    Parameters
+    ----------
+    p : float
+        The resonance (spin rate p n), a positive integer or half-integer (2 for 2:1).
+    omega0 : float or array
+        Free libration frequency in units of n, > 0.
+    e : float or array
+        Eccentricity in [0, 1); H(p, e) must not vanish (e > 0 for p != 1).
+    V : float or array, optional
+        Offset V > 0 of the tidal torque (units of n); default from viscous tides. V <= 0
+        (the tides never spin the body down to p n) is rejected.
+    """
+    w = _omega0(omega0)
+    e = _eccentricity(e)
+    if V is None:
+        V = tidal_offset_V(p, e)
+    V = np.asarray(V, dtype=np.float64)
+    if not np.all(np.isfinite(V)) or np.any(V <= 0):
+        raise ValueError(f"V = p - N(e)/Omega(e) must be > 0 (tides spinning the body down "
+                         f"through the resonance; got {V!r}): lower e or raise p")
+    H = np.abs(np.asarray(cayley_H(p, e)))
+    width = w * np.sqrt(H)
+    if np.any(H < 1e-14):               # the quadrature leaves ~1e-17 where H vanishes
+        raise ValueError(f"e must be > 0 for p = {p!r}: H(p, 0) = 0, the resonance has no width")
+    return _result(np.minimum(1.0, 2.0 / (1.0 + np.pi * V / (2.0 * width))))
