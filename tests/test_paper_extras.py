@@ -93,3 +93,41 @@ def test_capture_probability_matches_a_direct_integration():
     expected = analytic.capture_probability(2, w, e)
     assert expected == pytest.approx(0.1833, abs=1e-3)
     assert captured == pytest.approx(expected, abs=0.03)        # 3.5 sigma of 2000 draws
+
+
+# ---- nonlinear relaxed libration of the decoupled problem -----------------------------------
+@pytest.mark.parametrize("w, e", [(1.5, 0.005), (0.5, 0.01), (1.3, 0.01)])   # O(e²) left out
+def test_decoupled_libration_tends_to_psi_A(w, e):
+    center, amp = analytic.decoupled_relaxed_libration(w, e)
+    assert amp == pytest.approx(abs(analytic.psi_A(w, e)), rel=3e-3)
+    linear = (1 + e) ** 2 / (1 - e * e) ** 1.5 + analytic.psi_A(w, e)
+    assert center == pytest.approx(linear, abs=2e-3)
+
+
+@pytest.mark.parametrize("w, e", [(1.0318, 0.05), (0.877, 0.025), (1.0, 0.05)])
+def test_decoupled_libration_is_a_periodic_orbit(w, e):
+    """Independent route: scipy's DOP853 over a whole orbit from the centre found returns to
+    the start (θ(2π) = 2π, same spin rate) and its max |θ − f| is the amplitude."""
+    solve_ivp = pytest.importorskip("scipy.integrate").solve_ivp
+    center, amp = analytic.decoupled_relaxed_libration(w, e)
+
+    def rhs(t, y):
+        theta, thetadot, f = y
+        one_plus = 1 + e * np.cos(f)
+        return [thetadot, -0.5 * w * w * (one_plus / (1 - e * e)) ** 3 * np.sin(2 * (theta - f)),
+                one_plus**2 / (1 - e * e) ** 1.5]
+
+    t = np.linspace(0, 2 * np.pi, 4001)
+    sol = solve_ivp(rhs, (0, 2 * np.pi), [0.0, center, 0.0], method="DOP853", rtol=1e-12,
+                    atol=1e-12, t_eval=t)
+    assert sol.y[0, -1] == pytest.approx(2 * np.pi, abs=1e-6)
+    assert sol.y[1, -1] == pytest.approx(center, abs=1e-6)
+    assert np.max(np.abs(sol.y[0] - sol.y[2])) == pytest.approx(amp, rel=1e-4)
+
+
+def test_decoupled_libration_stays_finite_where_psi_A_diverges():
+    # at the nominal 1991 VH mass ratio ω0,eff = 1.0318: ψ_A says 88.7°, the pendulum 37.7°
+    assert math.degrees(abs(analytic.psi_A(1.0318, 0.05))) == pytest.approx(88.68, abs=0.01)
+    assert math.degrees(analytic.decoupled_relaxed_libration(1.0318, 0.05)[1]) == pytest.approx(37.66, abs=0.02)
+    with pytest.raises(ValueError, match=re.escape("omega0 must lie in (0.0, 1.8]")):
+        analytic.decoupled_relaxed_libration(2.0, 0.01)
