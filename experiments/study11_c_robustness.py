@@ -1,8 +1,8 @@
-"""Paper §7 (Naidu & Margot 2015, text): robustness of the 1991 VH results to the secondary's c.
+"""Paper §7 (Naidu & Margot 2015, text; script study11): robustness of the 1991 VH results to the secondary's c.
 
 The secondary's short semi-axis c is not measured; the paper states that changing it by up
 to 20 % leaves its results unchanged. Here 1991 VH at the radar elongation a/b = 1.5 (the
-Figs. 7–9 system, study 6) is rebuilt with c scaled by 0.8, 0.9, 1.0, 1.1 and 1.2 at fixed
+Fig. 7 system, script study06) is rebuilt with c scaled by 0.8, 0.9, 1.0, 1.1 and 1.2 at fixed
 density ρ_s and fixed a, b (so the secondary's mass scales with c; docs/physics.md §7.1).
 ω0 = sqrt(3(B − A)/C) of an ellipsoid does not depend on c at all; c enters through the mass
 ratio (ω0,eff, §8.7) and the fourth-order terms of the mutual potential (§3). At this

@@ -1,4 +1,4 @@
-"""Paper §7.1–7.3 (Naidu & Margot 2015, text): 2:1 capture, 2003 YT1 libration, no 2004 DC island.
+"""Paper §7.1–7.3 (Naidu & Margot 2015, text; script study12): 2:1 capture, 2003 YT1 libration, no 2004 DC island.
 
 * §7.1: probability of capture into the 2:1 spin-orbit resonance of a secondary despun by
   tides, P_c = 2/(1 + πV/(2 ω0 sqrt|H(2, e)|)) (Murray & Dermott 1999 eq. 5.110;
@@ -6,7 +6,7 @@
   ω0 and with the coupled problem's ω0,eff.
 * §7.2: the relaxed libration amplitude 2003 YT1's secondary would have if it were
   synchronous: the centre of its synchronous island and max |α| there (``relaxed_libration``,
-  paper coordinates' θ_p = 0 start), against ψ_A.
+  starts at θ_p = 0), against ψ_A.
 * §7.3: 2004 DC (e = 0.30) has no synchronous island for a/b ≥ 1.1: the island-centre search
   converges at a/b = 1.02 and 1.05 and fails for 1.1, 1.2 and 1.3 (no librating start, or a
   "centre" whose section still spreads over tens of degrees), and a MEGNO map of the

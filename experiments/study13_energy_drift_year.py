@@ -1,6 +1,6 @@
-"""Paper §3 (Naidu & Margot 2015, text): energy and angular-momentum drift per year, in the paper's terms.
+"""Paper §3 (Naidu & Margot 2015, text; script study13): energy and angular-momentum drift per year, in the paper's terms.
 
-The paper's energy-check system (docs/physics.md §7.3; the Fig. 1 system, 5 days in study 1)
+The paper's energy-check system (docs/physics.md §7.3; the paper's Fig. 1 system, 5 days in study01)
 integrated for one year (207 orbits of 42.3 h) at the paper's fractional tolerance 1e-15.
 The paper states its accuracy as the drift of the totals relative to the orbital energy and
 relative to the energy that orbit and spins exchange; this study prints exactly those:
@@ -52,7 +52,7 @@ def main():
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
     days = 10.0 if args.quick else 365.25
     orbits = days * DAY / system.orbital_period
-    # ~40 samples per primary rotation resolve the exchange (as in study 1)
+    # ~40 samples per primary rotation resolve the exchange (as in study01)
     per_orbit = int(np.ceil(40 * system.orbital_period / system.primary_spin_period))
     ts = tso.time_series(system, 0.0, spin2, orbits=orbits, samples_per_orbit=per_orbit,
                          rtol=RTOL)
