@@ -10,10 +10,12 @@
 * §7.3: 2004 DC (e = 0.30) has no synchronous island for a/b ≥ 1.1: the island-centre search
   converges at a/b = 1.02 and 1.05 and fails for 1.1, 1.2 and 1.3 (no librating start, or a
   "centre" whose section still spreads over tens of degrees), and a MEGNO map of the
-  synchronous region (θ̇_p/n 0.3–1.6) shows the resonant starts disappear.
+  synchronous region (θ̇_p/n 0.3–1.6, every start classified and its resonance p assigned,
+  ``classify_section``) shows the starts librating in the 1:1 resonance disappear (other
+  islands, e.g. the 1:2 chain at θ_p = 90°, are drawn apart and not counted).
 
 Prints: P_c per system; YT1 centre, amplitude, ψ_A; for 2004 DC per a/b whether an island
-centre was found, its extent, and the resonant fraction of the map.
+centre was found, its extent, and the fraction of the map librating in the 1:1 resonance.
 """
 
 import warnings
@@ -33,7 +35,10 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
+    from matplotlib.colors import ListedColormap
+
     from ti_spinorbit import analytic
+    from ti_spinorbit.classify import classify_section
     from ti_spinorbit.libration import relaxed_libration
 
     numbers = {}
@@ -60,13 +65,13 @@ def main():
     ts = tso.time_series(yt1, 0.0, lib.center_thetadot_p, orbits=3, samples_per_orbit=256)
 
     # §7.3 -------------------------------------------------------------------------------
-    grid = (4, 4) if args.quick else (18, 18)
+    grid = (4, 4) if args.quick else (24, 24)
     map_orbits = 40 if args.quick else 300
     theta = np.linspace(0.0, 180.0, grid[0], endpoint=False)
     thetadot = np.linspace(0.3, 1.6, grid[1])
     elongations = [1.05, 1.2] if args.quick else DC_ELONGATIONS
     found, extents, resonant = [], [], []
-    fig = plt.figure(figsize=(16, 8))
+    fig = plt.figure(figsize=(16, 9))
     gs = fig.add_gridspec(2, 30)         # 30 columns: 3 panels above, 2 or 5 maps below
     top = [fig.add_subplot(gs[0, 10 * k:10 * k + 10]) for k in range(3)]
     w = 30 // len(elongations)
@@ -82,25 +87,26 @@ def main():
             except (RuntimeError, ValueError):   # the search found no librating start
                 ok, ext, why = False, float("nan"), "no start in 0.2–1.3 librates"
         cmap = tso.chaos_map(s, theta, thetadot, orbits=map_orbits, rtol=1e-10)
-        lab = cmap.classification
-        frac = float(np.mean(lab == "resonant"))
+        cls = classify_section(cmap.section)         # members in the map's C order
+        lab = np.asarray(cls.label).reshape(cmap.shape)
+        p = np.asarray(cls.resonance_p).reshape(cmap.shape)
+        synchronous = (lab == "resonant") & (p == 1.0)
+        frac = float(np.mean(synchronous))
         found.append(ok), extents.append(ext), resonant.append(frac)
         numbers[f"§7.3 2004 DC a/b = {q}"] = (f"synchronous island {'found' if ok else 'absent'}"
                                             f"{'' if ok else ' (' + why + ')'}, extent "
-                                            f"{ext:.2g} deg, resonant fraction of the map {frac:.3f}")
-        codes = np.select([lab == "resonant", lab == "quasi-periodic", lab == "chaotic"],
-                          [0, 1, 2], 3)
-        from matplotlib.colors import ListedColormap
-        ax.pcolormesh(theta, thetadot, codes.T, cmap=ListedColormap(["red", "green", "blue", "0.7"]),
-                      vmin=-0.5, vmax=3.5, shading="nearest")
-        ax.set_title(f"2004 DC a/b = {q}: island {'found' if ok else 'absent'}, "
-                     f"resonant {frac:.2f}", fontsize=8)
+                                            f"{ext:.2g} deg, 1:1 fraction of the map {frac:.3f}")
+        codes = np.select([synchronous, lab == "resonant", lab == "quasi-periodic",
+                           lab == "chaotic"], [0, 1, 2, 3], 4)
+        ax.pcolormesh(theta, thetadot, codes.T, shading="nearest", vmin=-0.5, vmax=4.5,
+                      cmap=ListedColormap(["red", "orange", "green", "blue", "0.7"]))
+        ax.set_title(f"a/b = {q}: {'island' if ok else 'no island'}, 1:1 {frac:.2f}", fontsize=8)
         ax.set_xlabel(r"$\theta_p(0)$ (deg)")
-        ax.set_ylabel(r"$\dot\theta_p(0)/n$")
+    maps[0].set_ylabel(r"2004 DC $\dot\theta_p(0)/n$" "\n(red 1:1, orange other p)")
     numbers["§7.3 no 2004 DC synchronous island for a/b >= 1.1"] = bool(
         not any(f for f, q in zip(found, elongations) if q >= 1.1))
     arrays.update({"dc_elongation": np.array(elongations), "dc_island_found": np.array(found),
-                   "dc_extent_deg": np.array(extents), "dc_resonant_fraction": np.array(resonant)})
+                   "dc_extent_deg": np.array(extents), "dc_synchronous_fraction": np.array(resonant)})
 
     top[0].bar(range(3), pc, color="C0", label=r"$\omega_0$")
     top[0].plot(range(3), pc_eff, "k_", ms=30, label=r"$\omega_{0,\rm eff}$")
@@ -121,7 +127,7 @@ def main():
     top[2].plot(elongations, resonant, "o-", color="C3")
     top[2].axvline(1.1, color="0.5", ls=":")
     top[2].set_xlabel("2004 DC a/b")
-    top[2].set_ylabel("resonant fraction, θ̇_p/n 0.3–1.6")
+    top[2].set_ylabel("1:1 fraction of the map")
     top[2].set_title("§7.3: the synchronous island of 2004 DC disappears", fontsize=9)
     save(args, "study12_section7", fig, arrays,
          {"paper": "§7.1-7.3", "libration_orbits": lib_orbits, "map_grid": list(grid),
