@@ -14,7 +14,7 @@ def section_panel(ax, system, starts, orbits, rtol=1e-12, title=None, coordinate
     result = tso.surface_of_section(system, 0.0, np.array(starts, dtype=float), orbits=orbits,
                                     rtol=rtol, coordinates=coordinates)
     cls = classify_section(result)
-    result.plot(ax=ax, colors=list(cls.label), markersize=1.0, legend=False, title=title)
+    result.plot(ax=ax, colors=cls.colors, markersize=1.0, legend=False, title=title)  # grey: undetermined
     for k, w in enumerate(starts):   # label each trace by its start, at its first point
         ax.annotate(f"{w}", (result.theta_p[k, 0] + 2, result.thetadot_p[k, 0]), fontsize=6)
     return result, cls

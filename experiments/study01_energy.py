@@ -1,4 +1,4 @@
-"""Study 1 (Naidu & Margot 2015, Fig. 1): energy and angular-momentum exchange over 5 days.
+"""Paper Fig. 1 (Naidu & Margot 2015; script study01): energy and angular-momentum exchange over 5 days.
 
 The paper's energy-check case (docs/physics.md §7): ellipsoidal primary 600 x 500 x 400 m spinning
 with a 2.775 h period, secondary 252 x 229 x 190 m with a 32.59 h period, a = 3300 m,

@@ -1,4 +1,4 @@
-"""Study 3 (Naidu & Margot 2015, Fig. 3): the angle notation, drawn schematically.
+"""Paper Fig. 2 (Naidu & Margot 2015; script study03): the angle notation, drawn schematically.
 
 f: true anomaly (primary-to-secondary direction measured from the line of apsides);
 θ: the secondary's long axis measured from the line of apsides; α: the long axis measured

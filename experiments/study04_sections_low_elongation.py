@@ -1,4 +1,4 @@
-"""Study 4 (Naidu & Margot 2015, Fig. 4): sections of 1991 VH at low elongation.
+"""Paper Figs. 4–5 (Naidu & Margot 2015; script study04): sections of 1991 VH at low elongation.
 
 a/b = 1.01 (starts θ̇_p/n = 1.08 1.15 1.28 1.55 1.57 1.68 1.78) and a/b = 1.06 (1.13 1.63
 1.70 1.78), all with θ_p = 0. At such low elongation (ω0 = 0.17 and 0.41) the resonances are

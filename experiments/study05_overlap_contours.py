@@ -1,11 +1,11 @@
-"""Study 5 (Naidu & Margot 2015, Fig. 5): chaotic-layer width ΔE/E0 over (a/b, e), overlap line.
+"""Paper Fig. 6 (Naidu & Margot 2015; script study05): chaotic-layer width ΔE/E0 over (a/b, e), overlap line.
 
 Decoupled theory (Wisdom, Peale & Mignard 1984): the synchronous separatrix is surrounded by a
 chaotic layer of half-width ΔE/E0 ≈ (14π e/ω0³) exp(−π/(2ω0)), E0 = n²ω0²C/4, with
 ω0² = 3(a² − b²)/(a² + b²) for an ellipsoid; and the 1:1 and 3:2 resonances overlap (large-scale
 chaos) once ω0 > ω0^RO = 1/(2 + √(14e)). Pure analytic, no integration. The asynchronous
 systems of Table 1 sit far beyond the overlap line; the 1991 VH variants a/b = 1.01 and 1.06 of
-the paper's Fig. 4 bracket it.
+the paper's Figs. 4–5 bracket it.
 
 Prints: the overlap elongation at e = 0.05, 0.18, 0.30 (decoupled, and with the coupled
 ω0,eff of the system with that e), and ΔE/E0 at each marked system.
@@ -16,7 +16,7 @@ import numpy as np
 from _common import parse, save
 
 ASYNCHRONOUS = ("1991 VH", "2003 YT1", "2004 DC")
-#: 1991 VH elongations of the paper's Fig. 4 (low and moderate elongation).
+#: 1991 VH elongations of the paper's Figs. 4–5 (low and moderate elongation).
 VH_VARIANTS = (1.01, 1.06)
 #: ΔE/E0 contour levels (log-spaced, one per decade).
 LEVELS = 10.0 ** np.arange(-8, 2)
@@ -86,7 +86,7 @@ def main():
         marks[f"1991 VH a/b={q}"] = (q, vh.e, dE)
         for ax, shift in zip(axes, (0.0, 1.0)):
             ax.plot(q - shift, vh.e, marker="o", ms=7, mfc="none", mec="C1", mew=1.5, ls="none",
-                    label="1991 VH a/b = 1.01, 1.06 (Fig. 4)" if q == VH_VARIANTS[0] else None)
+                    label="1991 VH a/b = 1.01, 1.06 (Figs. 4–5)" if q == VH_VARIANTS[0] else None)
         numbers[f"dE/E0 1991 VH a/b={q}"] = dE
 
     for e_i, name in zip((0.05, 0.18, 0.30), ASYNCHRONOUS):

@@ -1,4 +1,4 @@
-"""Study 6 (Naidu & Margot 2015, Fig. 6): sections of the asynchronous systems.
+"""Paper Figs. 7–9 (Naidu & Margot 2015; script study06): sections of the asynchronous systems.
 
 1991 VH a/b = 1.5 (θ̇_p/n = 0.43 0.83 1.63 2.31 2.53), 2003 YT1 a/b = 1.3 (0.75 1.29 2.85 3.15
 3.5 3.69) and 2004 DC a/b = 1.3 (1.39 4.29 4.49 5.39), θ_p = 0. With ω0 near or above the

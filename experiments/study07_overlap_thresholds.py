@@ -1,4 +1,4 @@
-"""Study 7 (Naidu & Margot 2015, Fig. 7): elongation at which the 1:1 and 3:2 resonances
+"""Paper §6 (Naidu & Margot 2015, text; script study07): elongation at which the 1:1 and 3:2 resonances
 overlap, numerically and from the decoupled theory ω0^RO = 1/(2 + sqrt(14 e)).
 
 For each system (1991 VH, 2003 YT1, 2004 DC) the elongation a/b is scanned in steps of

@@ -1,4 +1,4 @@
-"""Study 9 (Naidu & Margot 2015, Fig. 9): spin rate vs time for four 1991 VH trajectories.
+"""Paper Fig. 11 (Naidu & Margot 2015; script study09): spin rate vs time for four 1991 VH trajectories.
 
 θ_p = 0 and θ̇_p/n = 0.45 (synchronous island, shifted by relaxed-mode libration), 1.70
 (chaotic), 2.38 (resonant), 2.60 (quasi-periodic, circulating). A chaotic spin wanders

@@ -1,4 +1,4 @@
-"""Study 10 (Naidu & Margot 2015, §5): tidal and YORP energy per orbit vs chaotic energy changes.
+"""Paper §8.1 (Naidu & Margot 2015, text; script study10): tidal and YORP energy per orbit vs chaotic energy changes.
 
 For each asynchronous system (1991 VH, 2003 YT1, 2004 DC) energies per mutual orbit are
 normalised by the separatrix energy E0 = n²ω0²C/4: the analytic chaotic-layer half-width
@@ -22,8 +22,8 @@ import numpy as np
 
 from _common import parse, save
 
-#: Chaotic starts θ̇_p(0)/n (θ_p = 0): the paper's Fig. 6 chaotic orbit for 1991 VH; for the
-#: others starts of Fig. 6 that lie in the chaotic sea.
+#: Chaotic starts θ̇_p(0)/n (θ_p = 0): the paper's Fig. 7 chaotic orbit for 1991 VH; for the
+#: others starts of its Figs. 8–9 that lie in the chaotic sea.
 CHAOTIC_STARTS = {"1991 VH": 1.63, "2003 YT1": 1.29, "2004 DC": 1.39}
 #: Shadow offset in θ̇_p/n and the separation that counts as O(1) divergence.
 SHADOW_OFFSET, DIVERGED = 1e-9, 1e-2

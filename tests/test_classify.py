@@ -1,6 +1,6 @@
 """Classification of section traces (docs/physics.md §6, §8, §10): synthetic curves, islands and
 area-filling sets; standard-map orbits; the MEGNO override; the decoupled island centres
-against an independent solver; and the paper's 1991 VH starts (Naidu & Margot 2015, Fig. 6)."""
+against an independent solver; and the paper's 1991 VH starts (Naidu & Margot 2015, Fig. 7)."""
 
 import math
 
@@ -205,7 +205,7 @@ def vh_section():
 
 
 def test_paper_starts_of_1991VH(vh_section):
-    """Naidu & Margot 2015 Fig. 6 (1991 VH, a/b = 1.5): 0.43 and 0.83 librate in the
+    """Naidu & Margot 2015 Fig. 7 (1991 VH, a/b = 1.5): 0.43 and 0.83 librate in the
     synchronous island (small and large amplitude), 1.63 is chaotic, 2.31 librates in the
     2:1 island, 2.53 circulates; and a small 1:2 island survives at θ_p = 90°."""
     r = vh_section

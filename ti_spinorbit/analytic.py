@@ -430,3 +430,160 @@ def energy_budget(system, heliocentric_a_au, heliocentric_e, Q=DEFAULT_Q, f_yorp
     out["yorp_dE_over_E0"] = yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e,
                                                    f_yorp) / E0
     return out
+
+
+# ---- capture into resonance under a tidal torque ---------------------------------------------
+def tidal_torque_factors(e):
+    """Eccentricity functions of the orbit-averaged viscous (constant time-lag) tidal torque,
+    ⟨N⟩ = −K [Ω(e) θ̇/n − N(e)] (Murray & Dermott 1999 §5.7; docs/physics.md §8.9):
+
+        Ω(e) = ⟨(a/r)⁶⟩ = (1 + 3e² + 3e⁴/8) / (1 − e²)^{9/2},
+        N(e) = ⟨(a/r)⁶ ḟ/n⟩ = (1 + 15e²/2 + 45e⁴/8 + 5e⁶/16) / (1 − e²)⁶,
+
+    averages over the mean anomaly, dimensionless. N/Ω is the spin rate (units of n) at
+    which the averaged torque vanishes (pseudo-synchronous rotation). ``e`` in [0, 1).
+    Returns (Ω, N)."""
+    e = _eccentricity(e)
+    e2 = e * e
+    omega = (1.0 + 3.0 * e2 + 0.375 * e2**2) / (1.0 - e2) ** 4.5
+    big_n = (1.0 + 7.5 * e2 + 5.625 * e2**2 + 0.3125 * e2**3) / (1.0 - e2) ** 6
+    return _result(omega), _result(big_n)
+
+
+def tidal_offset_V(p, e):
+    """V = p − N(e)/Ω(e), in units of n: the averaged viscous tidal torque near the p n
+    resonance, written with γ = θ − pM, is ⟨N⟩ = −K Ω(e) (V + γ̇/n) (Murray & Dermott 1999
+    §5.7; docs/physics.md §8.9). V > 0 means the tides spin the body down through the
+    resonance; V <= 0 means they stop it (at N/Ω) before it gets there. ``p`` an integer or
+    half-integer (> 0), ``e`` in [0, 1); they broadcast. Dimensionless."""
+    two_p = _two_p(p)
+    if np.any(two_p <= 0):
+        raise ValueError(f"p must be a positive integer or half-integer (got {p!r})")
+    omega, big_n = tidal_torque_factors(e)
+    return _result(two_p / 2.0 - np.asarray(big_n) / np.asarray(omega))
+
+
+def capture_probability(p, omega0, e, V=None):
+    """Probability of capture into the p n spin-orbit resonance of a body despun through it
+    by tides, dimensionless in [0, 1] (Goldreich & Peale 1966; Murray & Dermott 1999 §5.7,
+    eq. 5.110; Naidu & Margot 2015 §7.1 for the 2:1 resonance; docs/physics.md §8.9):
+
+        P_c = 2 / (1 + π V / (2 ω0 sqrt|H(p, e)|)),      capped at 1,
+
+    with ω0 in units of n (ω0² = 3(B − A)/C), H Cayley's coefficient (:func:`cayley_H`) and
+    V = p − N(e)/Ω(e) (:func:`tidal_offset_V`, viscous tides) unless ``V`` is given. It is the
+    ratio of the energy the tides remove over one full circulation along the separatrix,
+    4 K Ω ω0 sqrt|H| (per unit C), to the energy they remove on the upper half alone,
+    K Ω (π V + 2 ω0 sqrt|H|): a spin that has just crossed the separatrix energy (uniformly
+    distributed in that window) is captured if it cannot climb back out on the lower half.
+
+    Parameters
+    ----------
+    p : float
+        The resonance (spin rate p n), a positive integer or half-integer (2 for 2:1).
+    omega0 : float or array
+        Free libration frequency in units of n, > 0.
+    e : float or array
+        Eccentricity in [0, 1); H(p, e) must not vanish (e > 0 for p != 1).
+    V : float or array, optional
+        Offset V > 0 of the tidal torque (units of n); default from viscous tides. V <= 0
+        (the tides never spin the body down to p n) is rejected.
+    """
+    w = _omega0(omega0)
+    e = _eccentricity(e)
+    if V is None:
+        V = tidal_offset_V(p, e)
+    V = np.asarray(V, dtype=np.float64)
+    if not np.all(np.isfinite(V)) or np.any(V <= 0):
+        raise ValueError(f"V = p - N(e)/Omega(e) must be > 0 (tides spinning the body down "
+                         f"through the resonance; got {V!r}): lower e or raise p")
+    H = np.abs(np.asarray(cayley_H(p, e)))
+    width = w * np.sqrt(H)
+    if np.any(H < 1e-14):               # the quadrature leaves ~1e-17 where H vanishes
+        raise ValueError(f"e must be > 0 for p = {p!r}: H(p, 0) = 0, the resonance has no width")
+    return _result(np.minimum(1.0, 2.0 / (1.0 + np.pi * V / (2.0 * width))))
+
+
+# ---- nonlinear forced libration of the decoupled problem ------------------------------------
+def _decoupled_half_orbit(omega0, e, w, steps):
+    """RK4 over half an orbit (M from 0 to π, time 1/n) of θ̈ = −(ω0²/2)(a/r)³ sin 2(θ − f),
+    f alongside (df/dM = (1 + e cos f)²/(1 − e²)^{3/2}), from θ = 0, θ̇ = w (array) at
+    pericentre; returns θ(π) and max |θ − f| over the half orbit (rad)."""
+    one_minus_e2 = 1.0 - e * e
+    y = np.stack([np.zeros_like(w), w.astype(np.float64), np.zeros_like(w)])
+
+    def rhs(s):
+        theta, thetadot, f = s
+        one_plus = 1.0 + e * np.cos(f)
+        return np.stack([thetadot,
+                         -0.5 * omega0**2 * (one_plus / one_minus_e2) ** 3 * np.sin(2.0 * (theta - f)),
+                         one_plus**2 / one_minus_e2**1.5])
+
+    h = math.pi / steps
+    amp = np.zeros_like(y[0])
+    for _ in range(steps):
+        k1 = rhs(y)
+        k2 = rhs(y + 0.5 * h * k1)
+        k3 = rhs(y + 0.5 * h * k2)
+        k4 = rhs(y + h * k3)
+        y = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        np.maximum(amp, np.abs(y[0] - y[2]), out=amp)
+    return y[0], amp
+
+
+def decoupled_relaxed_libration(omega0, e, guess=None, steps=512):
+    """Centre of the synchronous island and relaxed libration amplitude of the DECOUPLED
+    problem (docs/physics.md §8.1, §8.8), without the small-amplitude approximation of ψ_A.
+
+    The island centre is the 1:1 periodic orbit symmetric about pericentre: θ = 0 at
+    pericentre and θ = π at apocentre. Its pericentre spin rate w is found by shooting (RK4,
+    ``steps`` steps per half orbit: relative error ~1e-9) on a grid of w in [−1, 3] step 0.01,
+    taking the root of θ(π) − π nearest ``guess`` (default: the linear value
+    (1 + e)²/(1 − e²)^{3/2} + ψ_A, or 1 + 2e at ω0 = 1), then zooming on it (64 points a
+    launch, to 1e-10); its amplitude is max |θ − f| over the orbit (the angle α of the long
+    axis from the line of centres). It tends to |ψ_A| = 2e/|ω0² − 1| as e → 0 away from
+    ω0 = 1, and stays finite at ω0 = 1, where the pendulum's nonlinearity detunes the forced
+    resonance.
+
+    Parameters
+    ----------
+    omega0 : float
+        Free libration frequency in units of n, in (0, 1.8] (every ellipsoid has ω0 < √3; at
+        ω0 = 2 the half orbit is a whole free period and the shooting condition degenerates).
+        Use ω0,eff (:func:`omega0_effective`) for the coupled problem's estimate.
+    e : float
+        Eccentricity in [0, 1).
+    guess : float, optional
+        Pericentre spin rate θ̇_p/n near which to take the root (picks the branch where the
+        forced response has several periodic orbits).
+
+    Returns
+    -------
+    (center, amplitude): θ̇_p/n at pericentre (units of n) and the amplitude (rad); NaN, NaN
+    when no symmetric 1:1 orbit exists in θ̇_p/n ∈ [−1, 3].
+    """
+    require_range("omega0", omega0, 0.0, 1.8, low_open=True, high_open=False)
+    w0 = float(omega0)
+    e = float(_eccentricity(e))
+    steps = require_count("steps", steps, minimum=64)
+    if guess is None:
+        base = (1.0 + e) ** 2 / (1.0 - e * e) ** 1.5
+        guess = base + (2.0 * e / (w0 * w0 - 1.0) if w0 != 1.0 else 0.0)
+    grid = np.arange(-1.0, 3.0, 0.01)
+    g = _decoupled_half_orbit(w0, e, grid, steps)[0] - math.pi
+    i = np.flatnonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)
+    if i.size == 0:
+        return math.nan, math.nan
+    roots = grid[i] - g[i] * 0.01 / (g[i + 1] - g[i])
+    k = i[int(np.argmin(np.abs(roots - guess)))]
+    low, high = grid[k], grid[k + 1]
+    while high - low > 1e-10:                       # zoom: 64 points across the bracket
+        x = np.linspace(low, high, 64)
+        gx = _decoupled_half_orbit(w0, e, x, steps)[0] - math.pi
+        j = np.flatnonzero(np.sign(gx[:-1]) * np.sign(gx[1:]) <= 0)
+        if j.size == 0:
+            break
+        low, high = x[j[0]], x[j[0] + 1]
+    center = 0.5 * (low + high)
+    amp = _decoupled_half_orbit(w0, e, np.array([center]), steps)[1][0]
+    return float(center), float(amp)

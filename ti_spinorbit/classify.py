@@ -1,7 +1,7 @@
 """Classify the trajectories of a surface of section: resonant, quasi-periodic or chaotic.
 
 Physics (docs/physics.md §6, §8, §10; Wisdom, Peale & Mignard 1984; Naidu & Margot 2015 §2.3,
-Figs. 4-6).
+Figs. 4–5 and 7–9).
 On the pericentre section (θ_p, θ̇_p/n) a regular orbit lies on invariant curves and a chaotic
 one fills an area. A regular orbit whose θ_p stays in a bounded arc *librates*: it is
 **resonant** (islands about θ_p = 0 near θ̇_p/n = 1, 3/2, 2, 5/2, ..., about 90° near 1/2). A
@@ -90,7 +90,7 @@ import numpy as np
 
 from ._validate import require_count, require_positive, require_range
 
-#: Paper colour convention (Naidu & Margot 2015, Figs. 4-6).
+#: Paper colour convention (Naidu & Margot 2015, Figs. 4–5 and 7–9).
 COLORS = {"resonant": "red", "chaotic": "blue", "quasi-periodic": "green"}
 LABELS = ("resonant", "quasi-periodic", "chaotic", "undetermined")
 

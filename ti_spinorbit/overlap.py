@@ -1,5 +1,5 @@
 """Numerical overlap of the 1:1 and 3:2 spin-orbit resonances (docs/physics.md §9.2; Naidu & Margot
-2015 §4, their Fig. 7).
+2015 §4, the overlap thresholds of their §6).
 
 Decoupled theory (Wisdom, Peale & Mignard 1984; Chirikov): the synchronous and 3:2 islands
 touch when ω0 exceeds ω0^RO = 1/(2 + sqrt(14 e)). Numerically, the two resonances overlap

@@ -2,8 +2,8 @@
 
 ``surface_of_section`` records, at every pericentre passage of the osculating mutual orbit,
 the angle θ_p from the line of apsides to the secondary's long axis and the secondary's spin
-rate θ̇_p/n (Naidu & Margot 2015 §2.3, Figs. 4-6). ``time_series`` samples one or more members
-densely (spin rate, α, r, energy) for libration and spin-rate studies (their Figs. 2, 8, 9).
+rate θ̇_p/n (Naidu & Margot 2015 §2.3, Figs. 4–9). ``time_series`` samples one or more members
+densely (spin rate, α, r, energy) for libration and spin-rate studies (their Figs. 3, 10, 11).
 Both take ``coordinates``: "inertial" (default; θ̇ the inertial spin rate) or "apsidal" (the
 paper's: θ and θ̇ from the osculating line of apsides, θ̇ = spin rate − ϖ̇; docs/physics.md
 §6.7, ``ti_spinorbit.coordinates``).
