@@ -27,7 +27,7 @@ import numpy as np
 
 from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_positive, require_real,
-                        require_spin)
+                        require_spin, show)
 from .classify import MIN_POINTS, classify_section
 from .distributed import sections
 from .section import SectionResult, check_orbits
@@ -119,6 +119,13 @@ class ChaosMap(accuracy.StatusSummary):
     max_drift: float = float("nan")
     n_inaccurate: int = 0
     include_inaccurate: bool = False
+    # chaotic fraction against integration length (chaos_map(fraction_orbits=...)): the
+    # lengths (orbits, ascending, the map's own last) and the fraction at each; whether it
+    # never decreases (⟨Y⟩ of a chaotic orbit only grows) and a one-line verdict
+    fraction_lengths: np.ndarray = None
+    fraction_by_length: np.ndarray = None
+    fraction_monotone: bool = True
+    fraction_message: str = ""
 
     @property
     def shape(self):
@@ -203,7 +210,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
               progress: Optional[Callable[[float], None]] = None, client=None,
               chunk_size=None, model="auto", checkpoint=None, resume=False,
               overwrite_checkpoint=False, max_drift=None,
-              include_inaccurate=False) -> ChaosMap:
+              include_inaccurate=False, fraction_orbits=None, **section_kwargs) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -238,6 +245,13 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         :mod:`ti_spinorbit.accuracy`).
     include_inaccurate : bool
         Count "inaccurate" members in ``chaotic_fraction`` too (default: excluded).
+    fraction_orbits : sequence of float, optional
+        Shorter lengths (orbits, each in (0, orbits)) at which the same grid is also
+        integrated, from the start, so that the chaotic fraction is reported against
+        orbits (``fraction_lengths``, ``fraction_by_length``, ``fraction_message``); default
+        (orbits/4, orbits/2), about 75 % more work; ``()`` skips it.
+    **section_kwargs
+        Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
     Returns
     -------
@@ -251,6 +265,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     _check_map_inputs(rtol, megno_chaotic, progress)
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
+    shorter = _fraction_lengths(orbits, fraction_orbits)
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
                            advice="use a coarser grid or fewer orbits",
                            width=resources.record_width(system, model))
@@ -259,9 +274,17 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
                        indicators=True, progress=progress, model=model, checkpoint=checkpoint,
                        resume=resume, overwrite_checkpoint=overwrite_checkpoint,
-                       max_drift=max_drift)
-    seconds = time.perf_counter() - started
+                       max_drift=max_drift, **section_kwargs)
     labels = _labels(section, megno_chaotic, orbits)
+    fractions = []
+    for length in shorter:
+        short = sections(client, system, tp, td, length, chunk_size=chunk_size, rtol=rtol,
+                         indicators=True, model=model, max_drift=max_drift, **section_kwargs)
+        fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length), short.status,
+                                           include_inaccurate))
+    seconds = time.perf_counter() - started
+    full = _chaotic_fraction(labels, section.status, include_inaccurate)
+    evidence = fraction_evidence(shorter + [float(orbits)], fractions + [full])
     shape = tp.shape
     return ChaosMap(
         theta_p=theta_p, thetadot_p=thetadot_p, megno=section.megno.reshape(shape),
@@ -272,7 +295,39 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         megno_chaotic=float(megno_chaotic), section=section,
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
-        n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate))
+        n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
+        **evidence)
+
+
+def _fraction_lengths(orbits, fraction_orbits):
+    """The shorter lengths of chaos_map's fraction-against-orbits evidence, ascending."""
+    if fraction_orbits is None:
+        return [float(orbits) / 4.0, float(orbits) / 2.0]
+    values = _as_floats("fraction_orbits", fraction_orbits).ravel()
+    if np.any(~np.isfinite(values)) or np.any(values <= 0) or np.any(values >= float(orbits)):
+        raise ValueError(f"fraction_orbits must hold lengths in (0, orbits) = (0, "
+                         f"{float(orbits):g}) (got {show(fraction_orbits)})")
+    return sorted(float(v) for v in values)
+
+
+def fraction_evidence(lengths, fractions):
+    """ChaosMap fields for the chaotic fraction against orbits: arrays, whether it never
+    decreases (finite values only), and a message that says so or where it drops."""
+    lengths, fractions = np.asarray(lengths, float), np.asarray(fractions, float)
+    finite = fractions[np.isfinite(fractions)]
+    monotone = bool(np.all(np.diff(finite) >= 0))
+    table = ", ".join(f"{f:.3f} at {L:g}" for L, f in zip(lengths, fractions))
+    if len(lengths) < 2:
+        message = f"chaotic fraction {table} orbits (one length: not checked against orbits)"
+    elif monotone:
+        change = fractions[-1] - fractions[-2]
+        message = (f"chaotic fraction vs orbits: {table}; never decreases; last doubling "
+                   f"adds {change:+.3f}")
+    else:
+        message = (f"chaotic fraction vs orbits: {table}; NOT monotone (a member's label "
+                   "changed back: the fraction is not converged)")
+    return {"fraction_lengths": lengths, "fraction_by_length": fractions,
+            "fraction_monotone": monotone, "fraction_message": message}
 
 
 @dataclass

@@ -74,7 +74,8 @@ UNITS = {
     "chaos_map": {
         "theta_p": "deg", "thetadot_p": SPIN, "megno": "1", "lyapunov": "1/orbit",
         "classification": LABEL, "mean_spin": SPIN, "status": STATUS, "chaotic_fraction": "1",
-        "megno_chaotic": "1"},
+        "megno_chaotic": "1", "fraction_lengths": "orbital periods",
+        "fraction_by_length": "1", "fraction_monotone": "bool", "fraction_message": "text"},
     "parameter_map": {
         "elongations": "1 (a/b)", "eccentricities": "1", "chaotic_fraction": "1",
         "megno": "1", "labels": LABEL, "status": STATUS, "theta_p": "deg",
