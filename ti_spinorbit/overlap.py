@@ -207,7 +207,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         Cap of the doubling (default ``4 · orbits``: lengths orbits, 2·orbits, 4·orbits).
         The scan integrates at orbits, 2·orbits, 4·orbits, ... (each length integrates again,
         from the start, only the elongations still "separate": a connection once seen is
-        final) until two successive lengths give the same decision at every elongation
+        final) until two successive lengths give the same decision at every elongation and
+        no elongation is still "separate" where the MEGNO criterion already connects
         (``converged``, ``converged_orbits``); at the cap without that, ``message`` says
         "not converged by N orbits" and ``first_overlap`` is an upper bound
         (``upper_bound``). ``max_orbits = orbits`` runs one length (never converged).
@@ -320,7 +321,11 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         geo_rows.append([d.overlap for d in decisions])
         megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
                            for d in decisions])
-        if step > 0 and [d.overlap for d in decisions] == previous:
+        # converged: the decisions no longer change with length, and no elongation is still
+        # "separate" where the MEGNO criterion already sees one chaotic layer (a slow
+        # connection the trajectories have not completed yet)
+        pending = [d.megno_overlap and not d.overlap for d in decisions]
+        if step > 0 and [d.overlap for d in decisions] == previous and not any(pending):
             converged_at = float(length)
             break
     overlaps = np.array([d.overlap for d in decisions])
@@ -336,6 +341,10 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     else:
         message = (f"not converged by {ran[-1]:g} orbits: first overlap {where} is an upper "
                    f"bound (longer runs can only move it down)")
+        waiting = [f"{d.elongation:.2f}" for d in decisions if d.megno_overlap and not d.overlap]
+        if waiting:
+            message += (f"; the MEGNO criterion already connects at a/b = "
+                        f"{', '.join(waiting)}")
     n_inaccurate = sum(accuracy.count(sec.status[block], "inaccurate") for sec, block in runs)
     scan = OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
