@@ -23,7 +23,17 @@ Decision rule (geometric, from the pericentre section; documented choices):
    separates them.
 
 Finite integration time can only miss a slow connection, never invent one, so the measured
-threshold is an upper bound that converges as ``orbits`` grows. With ``indicators=True``
+threshold is an upper bound that converges as ``orbits`` grows. The scan therefore doubles the
+length (``orbits``, 2·orbits, ... up to ``max_orbits``), integrating again only the
+elongations still "separate", until two successive lengths agree at every elongation and no
+elongation is "separate" where the MEGNO criterion (3.) already connects; otherwise it says
+"not converged by N orbits" and ``first_overlap`` is an upper bound.
+
+3. *MEGNO criterion* (:func:`megno_connects`, reported beside the geometric decision): the
+   θ̇_p ranges of the separatrix-column trajectories with ⟨Y⟩ > 4, joined where they
+   overlap, span c_1 ... c_3/2 — one chaotic layer connects the islands, though no single
+   trajectory has crossed it yet (docs/physics.md §9.2).
+ With ``indicators=True``
 (default) every trajectory also carries MEGNO ⟨Y⟩ and its Lyapunov exponent: the evidence
 records them for the connecting trajectory, which should be clearly chaotic (⟨Y⟩ ≫ 2).
 
