@@ -217,3 +217,28 @@ def test_cli_overlap_prints_the_verdict(tmp_path):
     meta = io.read_metadata(tmp_path / "o.npz")
     assert meta["converged"] is False and meta["convergence"].startswith("not converged by 200")
     assert json.dumps(meta)          # plain JSON
+
+
+def test_cli_libration_prints_the_evidence(tmp_path):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "libration", "--system", "1991 VH",
+                        "--orbits", "20", "--max-orbits", "40", "--xtol", "1e-4", "--out",
+                        "l.png"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=600)
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.splitlines()
+    assert [line.split()[:2] for line in lines if line.strip().startswith(("20 ", "40 "))] == \
+        [["20", "1e-12"], ["40", "1e-12"], ["40", "1e-13"]]
+    assert "  converged: centre and amplitude agree at 20 and 40 orbits and at rtol 1e-12 " \
+           "and 1e-13" in lines
+    meta = io.read_metadata(tmp_path / "l.npz")
+    assert meta["converged"] is True and meta["convergence"].startswith("converged: centre")
+
+
+@pytest.mark.parametrize("flag, value", [("--max-orbits", "50"), ("--max-orbits", "-1")])
+def test_cli_max_orbits_range_is_named(tmp_path, flag, value):
+    env = dict(os.environ, MPLBACKEND="Agg")
+    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "overlap", "--system", "1991 VH",
+                        "--orbits", "100", flag, value, "--out", "o.png"], cwd=tmp_path,
+                       env=env, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 2 and "--max-orbits" in p.stderr and not (tmp_path / "o.npz").exists()
