@@ -271,17 +271,20 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
                            width=resources.record_width(system, model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
-    section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
-                       indicators=True, progress=progress, model=model, checkpoint=checkpoint,
-                       resume=resume, overwrite_checkpoint=overwrite_checkpoint,
-                       max_drift=max_drift, **section_kwargs)
-    labels = _labels(section, megno_chaotic, orbits)
+    # the shorter lengths first, each dropped after its fraction: the peak memory stays
+    # that of the map itself
     fractions = []
     for length in shorter:
         short = sections(client, system, tp, td, length, chunk_size=chunk_size, rtol=rtol,
                          indicators=True, model=model, max_drift=max_drift, **section_kwargs)
         fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length), short.status,
                                            include_inaccurate))
+        del short
+    section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
+                       indicators=True, progress=progress, model=model, checkpoint=checkpoint,
+                       resume=resume, overwrite_checkpoint=overwrite_checkpoint,
+                       max_drift=max_drift, **section_kwargs)
+    labels = _labels(section, megno_chaotic, orbits)
     seconds = time.perf_counter() - started
     full = _chaotic_fraction(labels, section.status, include_inaccurate)
     evidence = fraction_evidence(shorter + [float(orbits)], fractions + [full])

@@ -289,7 +289,9 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     except (TypeError, ValueError):
         per_elongation = None                  # named by the checks that build the columns
     if per_elongation is not None and per_elongation > 0:
-        resources.check_memory("overlap_threshold", q.size * per_elongation, max_orbits,
+        # the first length, all elongations; every longer one (the elongations still
+        # separate) is sized by surface_of_section before it starts
+        resources.check_memory("overlap_threshold", q.size * per_elongation, orbits,
                                advice="scan fewer elongations or starts, or fewer orbits")
     systems = [make(float(x)) for x in q]
     e = systems[0].e
