@@ -242,3 +242,16 @@ def test_cli_max_orbits_range_is_named(tmp_path, flag, value):
                         "--orbits", "100", flag, value, "--out", "o.png"], cwd=tmp_path,
                        env=env, capture_output=True, text=True, timeout=600)
     assert p.returncode == 2 and "--max-orbits" in p.stderr and not (tmp_path / "o.npz").exists()
+
+
+def test_parameter_map_fraction_against_orbits(tmp_path):
+    pmap = tso.parameter_map("1991 VH", [1.05, 1.3], [0.05], 24, thetadot_p=[0.9, 1.4],
+                             theta_p=[90.0])
+    assert pmap.fraction_lengths.tolist() == [6.0, 12.0, 24.0]
+    assert pmap.fraction_by_length.shape == (3, 2, 1)
+    assert np.array_equal(pmap.fraction_by_length[-1], pmap.chaotic_fraction, equal_nan=True)
+    drops = np.diff(pmap.fraction_by_length, axis=0) < 0
+    assert np.array_equal(pmap.fraction_monotone, ~drops.any(axis=0))
+    assert pmap.fraction_message.startswith("chaotic fraction at 6, 12, 24 orbits: ")
+    back = io.load(io.save(pmap, tmp_path / "p.npz"))
+    assert np.array_equal(back.fraction_by_length, pmap.fraction_by_length, equal_nan=True)

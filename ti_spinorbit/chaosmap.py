@@ -364,6 +364,13 @@ class ParameterMap(accuracy.StatusSummary):
     max_drift: float = float("nan")
     inaccurate: np.ndarray = None
     include_inaccurate: bool = False
+    # chaotic fraction against integration length (parameter_map(fraction_orbits=...)):
+    # fraction_by_length has shape (len(fraction_lengths), len(elongations),
+    # len(eccentricities)); fraction_monotone per grid point; fraction_message one line
+    fraction_lengths: np.ndarray = None
+    fraction_by_length: np.ndarray = None
+    fraction_monotone: np.ndarray = None
+    fraction_message: str = ""
 
 
     @property
@@ -415,7 +422,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
                   resume=False, overwrite_checkpoint=False, max_drift=None,
-                  include_inaccurate=False) -> ParameterMap:
+                  include_inaccurate=False, fraction_orbits=None,
+                  **section_kwargs) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -435,8 +443,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
     progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint,
-    max_drift, include_inaccurate
-        As for :func:`chaos_map`.
+    max_drift, include_inaccurate, fraction_orbits, section_kwargs
+        As for :func:`chaos_map` (the fraction against orbits per grid point).
 
     Returns
     -------
@@ -454,6 +462,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         raise ValueError(f"eccentricities must lie in [0, 1) (got {eccentricities!r})")
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
+    shorter = _fraction_lengths(orbits, fraction_orbits)
     if isinstance(factory_or_name, str):
         name = factory_or_name
         factory = lambda q, e: catalog.system(name, elongation=q, eccentricity=e)  # noqa: E731
@@ -469,17 +478,37 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     if not name:
         name = grid[0].name
     members = [s for s in grid for _ in range(starts)]
+    shape = (elongations.size, eccentricities.size, starts)
+
+    def fractions_of(sec, length):
+        lab, st = _labels(sec, megno_chaotic, length).reshape(shape), sec.status.reshape(shape)
+        return lab, st, np.array([[_chaotic_fraction(lab[i, j], st[i, j], include_inaccurate)
+                                   for j in range(shape[1])] for i in range(shape[0])])
+
     started = time.perf_counter()
+    by_length = []
+    for length in shorter:            # first, each dropped after use (as chaos_map)
+        short = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
+                         length, chunk_size=chunk_size, rtol=rtol, indicators=True,
+                         model=model, max_drift=max_drift, **section_kwargs)
+        by_length.append(fractions_of(short, length)[2])
+        del short
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
                        chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
                        model=model, checkpoint=checkpoint, resume=resume,
-                       overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift)
+                       overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
+                       **section_kwargs)
     seconds = time.perf_counter() - started
-    labels = _labels(section, megno_chaotic, orbits)
-    shape = (elongations.size, eccentricities.size, starts)
-    labels, status = labels.reshape(shape), section.status.reshape(shape)
-    fraction = np.array([[_chaotic_fraction(labels[i, j], status[i, j], include_inaccurate)
-                          for j in range(shape[1])] for i in range(shape[0])])
+    labels, status, fraction = fractions_of(section, orbits)
+    by_length = np.array(by_length + [fraction])
+    with np.errstate(invalid="ignore"):
+        steps = np.diff(by_length, axis=0)
+    monotone = np.all(~(steps < 0), axis=0)          # NaN steps do not count as drops
+    lengths = np.array(shorter + [float(orbits)])
+    message = (f"chaotic fraction at {', '.join(f'{L:g}' for L in lengths)} orbits: "
+               + ("never decreases at any grid point" if monotone.all() else
+                  f"decreases at {int((~monotone).sum())} of {monotone.size} grid points "
+                  "(not converged there)"))
     return ParameterMap(
         elongations=elongations, eccentricities=eccentricities, chaotic_fraction=fraction,
         megno=section.megno.reshape(shape), labels=labels, status=status, theta_p=tp,
@@ -488,4 +517,5 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         inaccurate=np.sum(status == INACCURATE, axis=-1),
-        include_inaccurate=bool(include_inaccurate))
+        include_inaccurate=bool(include_inaccurate), fraction_lengths=lengths,
+        fraction_by_length=by_length, fraction_monotone=monotone, fraction_message=message)

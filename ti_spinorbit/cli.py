@@ -653,6 +653,7 @@ def _cmd_map(args):
                  f"{cmap.chaotic_fraction:.3f} ({counted}; statuses {cmap.status_counts}) in "
                  f"{cmap.seconds:.1f} s; largest energy drift {np.nanmax(cmap.energy_drift):.1e}"
                  f" (limit {cmap.max_drift:.1e}); wrote {out} and {data}")
+    _print(args, f"  {cmap.fraction_message}")
     return _accuracy_status(args, cmap.status, cmap.energy_drift, cmap.max_drift)
 
 

@@ -79,7 +79,9 @@ UNITS = {
     "parameter_map": {
         "elongations": "1 (a/b)", "eccentricities": "1", "chaotic_fraction": "1",
         "megno": "1", "labels": LABEL, "status": STATUS, "theta_p": "deg",
-        "thetadot_p": SPIN, "omega0": SPIN, "inaccurate": "members"},
+        "thetadot_p": SPIN, "omega0": SPIN, "inaccurate": "members",
+        "fraction_lengths": "orbital periods", "fraction_by_length": "1",
+        "fraction_monotone": "bool", "fraction_message": "text"},
     "overlap_scan": {
         "eccentricity": "1", "elongations": "1 (a/b)", "overlaps": "bool",
         "first_overlap": "1 (a/b)", "omega0_ro": SPIN, "elongation_ro": "1 (a/b)",
