@@ -191,7 +191,7 @@ def test_chaotic_fraction_against_orbits(tmp_path):
 
 
 @pytest.mark.parametrize("fractions, monotone, words", [
-    ([0.1, 0.2, 0.25], True, "never decreases; last doubling adds +0.050"),
+    ([0.1, 0.2, 0.25], True, "never decreases; the last step adds +0.050"),
     ([0.1, 0.3, 0.2], False, "NOT monotone"),
 ])
 def test_fraction_evidence(fractions, monotone, words):

@@ -324,7 +324,7 @@ def fraction_evidence(lengths, fractions):
         message = f"chaotic fraction {table} orbits (one length: not checked against orbits)"
     elif monotone:
         change = fractions[-1] - fractions[-2]
-        message = (f"chaotic fraction vs orbits: {table}; never decreases; last doubling "
+        message = (f"chaotic fraction vs orbits: {table}; never decreases; the last step "
                    f"adds {change:+.3f}")
     else:
         message = (f"chaotic fraction vs orbits: {table}; NOT monotone (a member's label "
