@@ -4,7 +4,6 @@ averages, a hand-computed value, limits, a scaling symmetry and a direct integra
 averaged equation with weak tides), and the numbering of the study scripts by the paper's
 figures and sections."""
 
-import glob
 import math
 import os
 import re

@@ -27,7 +27,7 @@ import numpy as np
 
 from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_positive, require_real,
-                        require_spin)
+                        require_spin, show)
 from .classify import MIN_POINTS, classify_section
 from .coordinates import THETADOT_LABEL, check_coordinates
 from .distributed import sections
@@ -123,6 +123,13 @@ class ChaosMap(accuracy.StatusSummary):
     n_inaccurate: int = 0
     include_inaccurate: bool = False
     coordinates: str = "inertial"
+    # chaotic fraction against integration length (chaos_map(fraction_orbits=...)): the
+    # lengths (orbits, ascending, the map's own last) and the fraction at each; whether it
+    # never decreases (⟨Y⟩ of a chaotic orbit only grows) and a one-line verdict
+    fraction_lengths: np.ndarray = None
+    fraction_by_length: np.ndarray = None
+    fraction_monotone: bool = True
+    fraction_message: str = ""
 
     @property
     def shape(self):
@@ -207,7 +214,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
               progress: Optional[Callable[[float], None]] = None, client=None,
               chunk_size=None, model="auto", checkpoint=None, resume=False,
               overwrite_checkpoint=False, max_drift=None,
-              include_inaccurate=False, coordinates="inertial") -> ChaosMap:
+              include_inaccurate=False, coordinates="inertial", fraction_orbits=None,
+              **section_kwargs) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -245,6 +253,13 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     coordinates : {"inertial", "apsidal"}
         Spin coordinate of the θ̇_p/n axis, of the starts and of the section points
         (docs/physics.md §6.7; see :func:`~ti_spinorbit.section.surface_of_section`).
+    fraction_orbits : sequence of float, optional
+        Shorter lengths (orbits, each in (0, orbits)) at which the same grid is also
+        integrated, from the start, so that the chaotic fraction is reported against
+        orbits (``fraction_lengths``, ``fraction_by_length``, ``fraction_message``); default
+        (orbits/4, orbits/2), about 75 % more work; ``()`` skips it.
+    **section_kwargs
+        Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
     Returns
     -------
@@ -259,17 +274,31 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     _check_map_inputs(rtol, megno_chaotic, progress)
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
+    shorter = _fraction_lengths(orbits, fraction_orbits)
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
                            advice="use a coarser grid or fewer orbits",
                            width=resources.record_width(system, model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     started = time.perf_counter()
+    # the shorter lengths first, each dropped after its fraction: the peak memory stays
+    # that of the map itself
+    fractions = []
+    for length in shorter:
+        short = sections(client, system, tp, td, length, chunk_size=chunk_size, rtol=rtol,
+                         indicators=True, model=model, max_drift=max_drift,
+                         coordinates=coordinates, **section_kwargs)
+        fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length), short.status,
+                                           include_inaccurate))
+        del short
     section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
                        indicators=True, progress=progress, model=model, checkpoint=checkpoint,
                        resume=resume, overwrite_checkpoint=overwrite_checkpoint,
-                       max_drift=max_drift, coordinates=coordinates)
-    seconds = time.perf_counter() - started
+                       max_drift=max_drift, coordinates=coordinates,
+                       **section_kwargs)
     labels = _labels(section, megno_chaotic, orbits)
+    seconds = time.perf_counter() - started
+    full = _chaotic_fraction(labels, section.status, include_inaccurate)
+    evidence = fraction_evidence(shorter + [float(orbits)], fractions + [full])
     shape = tp.shape
     return ChaosMap(
         theta_p=theta_p, thetadot_p=thetadot_p, megno=section.megno.reshape(shape),
@@ -281,7 +310,38 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
-        coordinates=coordinates)
+        coordinates=coordinates, **evidence)
+
+
+def _fraction_lengths(orbits, fraction_orbits):
+    """The shorter lengths of chaos_map's fraction-against-orbits evidence, ascending."""
+    if fraction_orbits is None:
+        return [float(orbits) / 4.0, float(orbits) / 2.0]
+    values = _as_floats("fraction_orbits", fraction_orbits).ravel()
+    if np.any(~np.isfinite(values)) or np.any(values <= 0) or np.any(values >= float(orbits)):
+        raise ValueError(f"fraction_orbits must hold lengths in (0, orbits) = (0, "
+                         f"{float(orbits):g}) (got {show(fraction_orbits)})")
+    return sorted(float(v) for v in values)
+
+
+def fraction_evidence(lengths, fractions):
+    """ChaosMap fields for the chaotic fraction against orbits: arrays, whether it never
+    decreases (finite values only), and a message that says so or where it drops."""
+    lengths, fractions = np.asarray(lengths, float), np.asarray(fractions, float)
+    finite = fractions[np.isfinite(fractions)]
+    monotone = bool(np.all(np.diff(finite) >= 0))
+    table = ", ".join(f"{f:.3f} at {L:g}" for L, f in zip(lengths, fractions))
+    if len(lengths) < 2:
+        message = f"chaotic fraction {table} orbits (one length: not checked against orbits)"
+    elif monotone:
+        change = fractions[-1] - fractions[-2]
+        message = (f"chaotic fraction vs orbits: {table}; never decreases; the last step "
+                   f"adds {change:+.3f}")
+    else:
+        message = (f"chaotic fraction vs orbits: {table}; NOT monotone (a member's label "
+                   "changed back: the fraction is not converged)")
+    return {"fraction_lengths": lengths, "fraction_by_length": fractions,
+            "fraction_monotone": monotone, "fraction_message": message}
 
 
 @dataclass
@@ -317,6 +377,14 @@ class ParameterMap(accuracy.StatusSummary):
     inaccurate: np.ndarray = None
     include_inaccurate: bool = False
     coordinates: str = "inertial"
+    # chaotic fraction against integration length (parameter_map(fraction_orbits=...)):
+    # fraction_by_length has shape (len(fraction_lengths), len(elongations),
+    # len(eccentricities)); fraction_monotone per grid point; fraction_message one line
+    fraction_lengths: np.ndarray = None
+    fraction_by_length: np.ndarray = None
+    fraction_monotone: np.ndarray = None
+    fraction_message: str = ""
+
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -367,7 +435,8 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
                   resume=False, overwrite_checkpoint=False, max_drift=None,
-                  include_inaccurate=False, coordinates="inertial") -> ParameterMap:
+                  include_inaccurate=False, coordinates="inertial", fraction_orbits=None,
+                  **section_kwargs) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -387,8 +456,9 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic.
     progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint,
-    max_drift, include_inaccurate, coordinates
-        As for :func:`chaos_map` ("apsidal" needs every e ≥ 1e-3, docs/physics.md §6.7).
+    max_drift, include_inaccurate, coordinates, fraction_orbits, section_kwargs
+        As for :func:`chaos_map` ("apsidal" needs every e ≥ 1e-3, docs/physics.md §6.7; the
+        fraction against orbits per grid point).
 
     Returns
     -------
@@ -407,6 +477,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         raise ValueError(f"eccentricities must lie in [0, 1) (got {eccentricities!r})")
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
+    shorter = _fraction_lengths(orbits, fraction_orbits)
     if isinstance(factory_or_name, str):
         name = factory_or_name
         factory = lambda q, e: catalog.system(name, elongation=q, eccentricity=e)  # noqa: E731
@@ -422,18 +493,38 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     if not name:
         name = grid[0].name
     members = [s for s in grid for _ in range(starts)]
+    shape = (elongations.size, eccentricities.size, starts)
+
+    def fractions_of(sec, length):
+        lab, st = _labels(sec, megno_chaotic, length).reshape(shape), sec.status.reshape(shape)
+        return lab, st, np.array([[_chaotic_fraction(lab[i, j], st[i, j], include_inaccurate)
+                                   for j in range(shape[1])] for i in range(shape[0])])
+
     started = time.perf_counter()
+    by_length = []
+    for length in shorter:            # first, each dropped after use (as chaos_map)
+        short = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
+                         length, chunk_size=chunk_size, rtol=rtol, indicators=True,
+                         model=model, max_drift=max_drift, coordinates=coordinates,
+                         **section_kwargs)
+        by_length.append(fractions_of(short, length)[2])
+        del short
     section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
                        chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
                        model=model, checkpoint=checkpoint, resume=resume,
                        overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
-                       coordinates=coordinates)
+                       coordinates=coordinates, **section_kwargs)
     seconds = time.perf_counter() - started
-    labels = _labels(section, megno_chaotic, orbits)
-    shape = (elongations.size, eccentricities.size, starts)
-    labels, status = labels.reshape(shape), section.status.reshape(shape)
-    fraction = np.array([[_chaotic_fraction(labels[i, j], status[i, j], include_inaccurate)
-                          for j in range(shape[1])] for i in range(shape[0])])
+    labels, status, fraction = fractions_of(section, orbits)
+    by_length = np.array(by_length + [fraction])
+    with np.errstate(invalid="ignore"):
+        steps = np.diff(by_length, axis=0)
+    monotone = np.all(~(steps < 0), axis=0)          # NaN steps do not count as drops
+    lengths = np.array(shorter + [float(orbits)])
+    message = (f"chaotic fraction at {', '.join(f'{L:g}' for L in lengths)} orbits: "
+               + ("never decreases at any grid point" if monotone.all() else
+                  f"decreases at {int((~monotone).sum())} of {monotone.size} grid points "
+                  "(not converged there)"))
     return ParameterMap(
         elongations=elongations, eccentricities=eccentricities, chaotic_fraction=fraction,
         megno=section.megno.reshape(shape), labels=labels, status=status, theta_p=tp,
@@ -442,4 +533,6 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         inaccurate=np.sum(status == INACCURATE, axis=-1),
-        include_inaccurate=bool(include_inaccurate), coordinates=coordinates)
+        include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
+        fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
+        fraction_message=message)

@@ -69,6 +69,7 @@ FLAG_RANGES = {
     "max_drift": ("--max-drift", 0.0, 1.0, True, False),
     "xtol": ("--xtol", 1e-12, 0.1, False, False),
     "only": ("--only", 1, 99, False, False),
+    "max_orbits": ("--max-orbits", 0.0, MAX_ORBITS, True, False),
 }
 #: Figures and data files.
 FIGURE_EXTENSIONS = (".png", ".pdf", ".svg")
@@ -237,6 +238,9 @@ def _parser():
                    metavar=("START", "STOP", "STEP"),
                    help=f"a/b scan, 1 < START <= STOP <= {MAX_ELONGATION:g}, STEP > 0 "
                         "(default 1.01 1.15 0.01)")
+    s.add_argument("--max-orbits", type=float, default=None,
+                   help="cap of the length doubling (--orbits, 2x, 4x, ...) that checks the "
+                        "decisions converge, in [--orbits, 1e7] (default 4 x --orbits)")
     common(s, "PNG path (default overlap_<system>.png)")
     accuracy_flags(s)
     coordinates_flag(s)
@@ -250,6 +254,9 @@ def _parser():
     s.add_argument("--candidates", type=float, nargs=3, metavar=("LO", "HI", "N"),
                    help="coarse bracket of θ̇_p/n: N (5 to 10001) values over LO..HI "
                         "(default 45 over 0.2..1.3)")
+    s.add_argument("--max-orbits", type=float, default=None,
+                   help="cap of the length doubling that checks the centre and amplitude "
+                        "converge, in [--orbits, 1e7] (default 4 x --orbits)")
     common(s, "PNG path of the centre search, extent vs θ̇_p/n (default libration_<system>.png)",
            orbits=100.0, rtol=1e-12, model=False)
     accuracy_flags(s)
@@ -371,6 +378,9 @@ def check_args(args):
         value = getattr(args, dest, None)
         for v in (value if isinstance(value, list) else [] if value is None else [value]):
             _check_range(flag, v, low, high, low_open, high_open)
+    if getattr(args, "max_orbits", None) is not None and args.max_orbits < args.orbits:
+        raise ValueError(f"--max-orbits must lie in [--orbits, {MAX_ORBITS:g}] = "
+                         f"[{args.orbits:g}, {MAX_ORBITS:g}] (got {args.max_orbits:g})")
     if getattr(args, "thetadot_range", None):
         lo, hi = args.thetadot_range
         if not hi > lo:
@@ -662,6 +672,7 @@ def _cmd_map(args):
                  f"{cmap.chaotic_fraction:.3f} ({counted}; statuses {cmap.status_counts}) in "
                  f"{cmap.seconds:.1f} s; largest energy drift {np.nanmax(cmap.energy_drift):.1e}"
                  f" (limit {cmap.max_drift:.1e}); wrote {out} and {data}")
+    _print(args, f"  {cmap.fraction_message}")
     return _accuracy_status(args, cmap.status, cmap.energy_drift, cmap.max_drift)
 
 
@@ -681,10 +692,15 @@ def _cmd_overlap(args):
                                  orbits=args.orbits, rtol=args.rtol, progress=bar,
                                  model=args.model, max_drift=args.max_drift,
                                  include_inaccurate=args.allow_inaccurate,
-                                 coordinates=args.coordinates)
-    out, data = _write(scan, data, {"command": args.command_line}, scan.plot, out)
-    _print(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap} "
-                 f"(analytic {scan.elongation_ro:.4f}) in {scan.seconds:.1f} s; wrote {out} and {data}")
+                                 max_orbits=args.max_orbits, coordinates=args.coordinates)
+    out, data = _write(scan, data, {"command": args.command_line, "converged": scan.converged,
+                                    "convergence": scan.message}, scan.plot, out)
+    bound = "" if scan.converged else " (upper bound: not converged)"
+    _print(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap}"
+                 f"{bound} (analytic {scan.elongation_ro:.4f}; MEGNO criterion "
+                 f"{scan.megno_first_overlap}) in {scan.seconds:.1f} s, "
+                 f"{scan.member_orbits:.3g} member-orbits; wrote {out} and {data}")
+    _print(args, *scan.evidence())
     for d in scan.decisions:
         extra = f", connecting <Y> = {d.connecting_megno:.1f}" if d.overlap else ""
         extra += f", {d.inaccurate} inaccurate trajectories" if d.inaccurate else ""
@@ -736,7 +752,7 @@ def _cmd_libration(args):
     system = _system(args)
     out, data = _paths(args, "libration", system.name)
     kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol, max_drift=args.max_drift,
-                  coordinates=args.coordinates)
+                  max_orbits=args.max_orbits, coordinates=args.coordinates)
     if args.candidates:
         lo, hi, n = args.candidates
         kwargs["candidates"] = np.linspace(lo, hi, int(n))
@@ -748,7 +764,9 @@ def _cmd_libration(args):
         if not args.quiet:
             print(f"ti-spinorbit libration: warning: {w.message}", file=sys.stderr)
     plot = getattr(result, "plot", None)
-    out, data = _write(result, data, {"command": args.command_line},
+    out, data = _write(result, data, {"command": args.command_line,
+                                      "converged": result.converged,
+                                      "convergence": result.message},
                        plot if callable(plot) else lambda: _plot_libration(result), out)
     _print(args,
            f"{system.name}: relaxed libration amplitude {result.amplitude:.4f} deg at the "
@@ -759,6 +777,7 @@ def _cmd_libration(args):
            f"{'converged' if result.converged else 'NOT converged'}, {result.seconds:.1f} s",
            f"  centre trajectory: status {result.status}, energy drift {result.energy_drift:.1e}"
            f" (limit {result.max_drift:.1e})",
+           *("  " + line for line in result.evidence()),
            f"wrote {out} and {data}")
     return _accuracy_status(args, np.array([_status_code(result.status)]),
                             np.array([result.energy_drift]), result.max_drift, "trajectories")

@@ -79,11 +79,14 @@ UNITS = {
     "chaos_map": {
         "theta_p": "deg", "thetadot_p": SPIN, "megno": "1", "lyapunov": "1/orbit",
         "classification": LABEL, "mean_spin": SPIN, "status": STATUS, "chaotic_fraction": "1",
-        "megno_chaotic": "1"},
+        "megno_chaotic": "1", "fraction_lengths": "orbital periods",
+        "fraction_by_length": "1", "fraction_monotone": "bool", "fraction_message": "text"},
     "parameter_map": {
         "elongations": "1 (a/b)", "eccentricities": "1", "chaotic_fraction": "1",
         "megno": "1", "labels": LABEL, "status": STATUS, "theta_p": "deg",
-        "thetadot_p": SPIN, "omega0": SPIN, "inaccurate": "members"},
+        "thetadot_p": SPIN, "omega0": SPIN, "inaccurate": "members",
+        "fraction_lengths": "orbital periods", "fraction_by_length": "1",
+        "fraction_monotone": "bool", "fraction_message": "text"},
     "overlap_scan": {
         "eccentricity": "1", "elongations": "1 (a/b)", "overlaps": "bool",
         "first_overlap": "1 (a/b)", "omega0_ro": SPIN, "elongation_ro": "1 (a/b)",
@@ -94,12 +97,25 @@ UNITS = {
         "decisions/widest_range": SPIN, "decisions/connecting_megno": "1",
         "decisions/connecting_lyapunov": "1/orbit",
         "decisions/separatrix_chaotic_fraction": "1", "decisions/inaccurate": "members",
-        "decisions/max_energy_drift": "1 (relative)"},
+        "decisions/max_energy_drift": "1 (relative)",
+        # convergence in integration length (overlap_threshold's doubling)
+        "decisions/megno_overlap": "bool", "decisions/orbits": "orbital periods",
+        "lengths": "orbital periods", "overlaps_by_length": "bool (lengths x elongations)",
+        "megno_overlaps_by_length": "1 = connects, 0 = not, -1 = no indicators",
+        "converged": "bool", "converged_orbits": "orbital periods",
+        "max_orbits": "orbital periods", "message": "text",
+        "megno_first_overlap": "1 (a/b)", "member_orbits": "member x orbital periods"},
     "relaxed_libration": {
         "center_thetadot_p": SPIN, "amplitude": "deg", "extent": "deg", "psi_A": "deg",
         "psi_A_effective": "deg", "omega0": SPIN, "omega0_effective": SPIN,
         "iterations": "launches", "converged": "bool", "candidates": SPIN, "extents": "deg",
-        "samples_per_orbit": "1/orbit", "xtol": SPIN, "status": "name"},
+        "samples_per_orbit": "1/orbit", "xtol": SPIN, "status": "name",
+        # convergence in orbits and tolerance (relaxed_libration(converge=True))
+        "search_converged": "bool", "lengths": "orbital periods",
+        "centers_by_length": SPIN, "amplitudes_by_length": "deg", "rtol_check": "1",
+        "center_rtol_check": SPIN, "amplitude_rtol_check": "deg", "center_tol": SPIN,
+        "amplitude_tol": "deg", "converged_in_orbits": "bool",
+        "converged_in_tolerance": "bool", "convergence_checked": "bool", "message": "text"},
 }
 
 

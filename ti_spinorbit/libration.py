@@ -177,6 +177,38 @@ class RelaxedLibration:
     angmom_drift: float = float("nan")
     max_drift: float = float("nan")
     coordinates: str = "inertial"
+    # convergence evidence (relaxed_libration(converge=True)): the centre and amplitude
+    # found at each length of the doubling (orbits, 2·orbits, ...) and at rtol/10 at the
+    # last length; the tolerances they were held to; the verdicts and a one-line message
+    search_converged: bool = True
+    lengths: np.ndarray = None
+    centers_by_length: np.ndarray = None
+    amplitudes_by_length: np.ndarray = None
+    rtol_check: float = float("nan")
+    center_rtol_check: float = float("nan")
+    amplitude_rtol_check: float = float("nan")
+    center_tol: float = float("nan")
+    amplitude_tol: float = float("nan")
+    converged_in_orbits: bool = False
+    converged_in_tolerance: bool = False
+    convergence_checked: bool = False
+    message: str = ""
+
+    def evidence(self):
+        """Lines: centre and amplitude against orbits and tolerance, and the verdict."""
+        if not self.convergence_checked:
+            return [f"convergence in orbits and tolerance not checked ({self.message})"
+                    if self.message else "convergence in orbits and tolerance not checked"]
+        rows = [f"{'orbits':>8} {'rtol':>8} {'centre (n)':>14} {'amplitude (deg)':>16}"]
+        for L, c, a in zip(self.lengths, self.centers_by_length, self.amplitudes_by_length):
+            rows.append(f"{L:8g} {self.rtol:8.0e} {c:14.9f} {a:16.6f}")
+        if np.isfinite(self.rtol_check):
+            rows.append(f"{self.lengths[-1]:8g} {self.rtol_check:8.0e} "
+                        f"{self.center_rtol_check:14.9f} {self.amplitude_rtol_check:16.6f}")
+        rows.append(f"(held to |Δcentre| <= {self.center_tol:.3g} n, |Δamplitude| <= "
+                    f"{self.amplitude_tol:.3g} deg)")
+        rows.append(self.message)
+        return rows
 
 
 def _fit_v(x, extent, best):
@@ -211,7 +243,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
                       samples_per_orbit=256, coarse_arm_points=3,
                       max_extent=MAX_CENTER_EXTENT_DEG, progress=None,
-                      max_drift=None, coordinates="inertial") -> RelaxedLibration:
+                      max_drift=None, coordinates="inertial", converge=True, max_orbits=None,
+                      center_tol=None, amplitude_tol=0.01, **section_kwargs) -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
     Parameters
@@ -253,6 +286,23 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         Spin coordinate of the candidates and of the centre found (docs/physics.md §6.7):
         the centre in apsidal coordinates is the inertial one minus ϖ̇(0)/n. The amplitude
         max |α| does not depend on it.
+    converge : bool
+        Check the answer in integration length and tolerance (default True): the search is
+        repeated, bracketed around the centre found, at 2·orbits, 4·orbits, ... until two
+        successive lengths give centres within ``center_tol`` and amplitudes within
+        ``amplitude_tol`` (at most ``max_orbits``, default ``4 · orbits``), then at the last
+        length with rtol/10 (skipped below rtol 1e-15). ``converged`` is then True only when
+        the search converged *and* both checks pass; ``message`` says which failed
+        ("not converged by N orbits", "not converged in tolerance"). The reported centre and
+        amplitude are those at ``orbits`` and ``rtol``; the others are the evidence.
+    max_orbits : float, optional
+        Cap of the doubling, in [orbits, 1e7] (default ``4 · orbits``).
+    center_tol : float, optional
+        Agreement required of the centres, units of n (default ``max(10 · xtol, 1e-5)``).
+    amplitude_tol : float
+        Agreement required of the amplitudes, deg (default 0.01).
+    **section_kwargs
+        Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
     Returns
     -------
@@ -277,7 +327,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     check_orbits(orbits)
     check_tolerances(rtol, None)
     require_real("xtol", xtol)
-    limit = accuracy.drift_limit(rtol, orbits, max_drift)
+    accuracy.drift_limit(rtol, orbits, max_drift)           # max_drift checked before any work
     require_positive("xtol", xtol)
     require_scalar("max_extent", max_extent, 0.0, 90.0, low_open=True, unit="deg")
     require_callable("progress", progress)
@@ -301,6 +351,92 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         resources.check_memory(what, members, orbits, spo,
                                advice="use fewer orbits, candidates or samples per orbit")
 
+    if center_tol is None:
+        center_tol = max(10.0 * float(xtol), 1e-5)
+    require_positive("center_tol", require_real("center_tol", center_tol))
+    require_positive("amplitude_tol", require_real("amplitude_tol", amplitude_tol))
+    cap = 4.0 * float(orbits) if max_orbits is None else require_real("max_orbits", max_orbits)
+    if not float(orbits) <= cap <= 1e7:
+        raise ValueError(f"max_orbits must lie in [orbits, 1e7] = [{float(orbits):g}, 1e7] "
+                         f"(got {cap:g})")
+    section_kwargs = dict(section_kwargs, coordinates=coordinates)   # every launch alike
+    search = dict(zoom_candidates=zoom_candidates, xtol=xtol, max_iterations=max_iterations,
+                  samples_per_orbit=samples_per_orbit, coarse_arm_points=coarse_arm_points,
+                  max_extent=max_extent, max_drift=max_drift, section_kwargs=section_kwargs)
+    base = _search(system, orbits, rtol, candidates, progress=progress, **search)
+    if not converge:
+        return base
+    started = time.perf_counter() - base.seconds
+    # the checks start bracketed around the centre found: the coarse scan is not repeated
+    spacing = float(np.max(np.diff(base.candidates[0])))
+    bracket = base.center_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
+    lengths, centres, amplitudes = [float(orbits)], [base.center_thetadot_p], [base.amplitude]
+    in_orbits = False
+    last = base
+    while lengths[-1] * 2.0 <= cap * (1 + 1e-12):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # summarised in the message
+            last = _search(system, lengths[-1] * 2.0, rtol, bracket, **search)
+        lengths.append(lengths[-1] * 2.0)
+        centres.append(last.center_thetadot_p)
+        amplitudes.append(last.amplitude)
+        if abs(centres[-1] - centres[-2]) <= center_tol and \
+                abs(amplitudes[-1] - amplitudes[-2]) <= amplitude_tol:
+            in_orbits = True
+            break
+    tight = float(rtol) / 10.0
+    in_tol, c_tol, a_tol = False, float("nan"), float("nan")
+    if tight >= 1e-16 and len(lengths) > 1:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            fine = _search(system, lengths[-1], tight, bracket, **search)
+        c_tol, a_tol = fine.center_thetadot_p, fine.amplitude
+        in_tol = abs(c_tol - centres[-1]) <= center_tol and \
+            abs(a_tol - amplitudes[-1]) <= amplitude_tol and fine.converged
+    messages = []
+    if not base.converged:
+        messages.append("search not converged (window or extent at the centre)")
+    if len(lengths) == 1:
+        messages.append(f"not converged by {lengths[-1]:g} orbits: max_orbits leaves no "
+                        "doubling to compare")
+    elif not in_orbits:
+        messages.append(f"not converged by {lengths[-1]:g} orbits: centre/amplitude still "
+                        f"move by {abs(centres[-1] - centres[-2]):.3g} n / "
+                        f"{abs(amplitudes[-1] - amplitudes[-2]):.3g} deg")
+    if not np.isfinite(c_tol):
+        if len(lengths) > 1:
+            messages.append(f"tolerance not checked (rtol/10 = {tight:.0e} is below 1e-16)")
+    elif not in_tol:
+        messages.append(f"not converged in tolerance: rtol {tight:.0e} moves the centre by "
+                        f"{abs(c_tol - centres[-1]):.3g} n, the amplitude by "
+                        f"{abs(a_tol - amplitudes[-1]):.3g} deg")
+    converged = bool(base.converged and in_orbits and in_tol)
+    if converged:
+        messages.append(f"converged: centre and amplitude agree at {lengths[-2]:g} and "
+                        f"{lengths[-1]:g} orbits and at rtol {rtol:.0e} and {tight:.0e}")
+    base.search_converged = base.converged
+    base.converged = converged
+    base.lengths = np.array(lengths)
+    base.centers_by_length = np.array(centres)
+    base.amplitudes_by_length = np.array(amplitudes)
+    base.rtol_check, base.center_rtol_check, base.amplitude_rtol_check = \
+        (tight if np.isfinite(c_tol) else float("nan")), c_tol, a_tol
+    base.center_tol, base.amplitude_tol = float(center_tol), float(amplitude_tol)
+    base.converged_in_orbits, base.converged_in_tolerance = in_orbits, bool(in_tol)
+    base.convergence_checked = True
+    base.message = "; ".join(messages)
+    base.seconds = time.perf_counter() - started
+    return base
+
+
+def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterations,
+            samples_per_orbit, coarse_arm_points, max_extent, max_drift, section_kwargs,
+            progress=None) -> RelaxedLibration:
+    """The search of :func:`relaxed_libration` at one length and tolerance (inputs checked)."""
+    limit = accuracy.drift_limit(rtol, orbits, max_drift)
+    coordinates = section_kwargs.get("coordinates", "inertial")
+    x = DEFAULT_CANDIDATES.copy() if candidates is None else \
+        np.asarray(candidates, dtype=np.float64).ravel()
     shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
     launches = 0
 
@@ -324,7 +460,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
     half_width = float(np.max(np.diff(x)))
     coarse = surface_of_section(system, 0.0, x, orbits, rtol=rtol, max_drift=limit,
-                                coordinates=coordinates)
+                                **section_kwargs)
     if coarse.n_inaccurate == len(x):
         raise RuntimeError(f"every candidate's conservation drift exceeds max_drift {limit:.3g} "
                            f"(largest energy drift {np.nanmax(coarse.energy_drift):.3g}); "
@@ -351,7 +487,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     while half_width > xtol and iterations < max_iterations:
         x = center + np.linspace(-half_width, half_width, zoom_candidates)
         extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol,
-                                                   max_drift=limit, coordinates=coordinates))
+                                                   max_drift=limit, **section_kwargs))
         extent[extent >= LIBRATION_LIMIT_DEG] = np.nan
         tried.append(x)
         extents.append(extent)
@@ -369,7 +505,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     # 4. the centre itself
     final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
                                                            rtol=rtol, max_drift=limit,
-                                                           coordinates=coordinates),
+                                                           **section_kwargs),
                                         include_inaccurate=True)[0])
     launched(1)
     # a narrow window is not enough: at a true centre the trace shrinks to a point (a chaotic

@@ -23,7 +23,17 @@ Decision rule (geometric, from the pericentre section; documented choices):
    separates them.
 
 Finite integration time can only miss a slow connection, never invent one, so the measured
-threshold is an upper bound that converges as ``orbits`` grows. With ``indicators=True``
+threshold is an upper bound that converges as ``orbits`` grows. The scan therefore doubles the
+length (``orbits``, 2·orbits, ... up to ``max_orbits``), integrating again only the
+elongations still "separate", until two successive lengths agree at every elongation and no
+elongation is "separate" where the MEGNO criterion (3.) already connects; otherwise it says
+"not converged by N orbits" and ``first_overlap`` is an upper bound.
+
+3. *MEGNO criterion* (:func:`megno_connects`, reported beside the geometric decision): the
+   θ̇_p ranges of the separatrix-column trajectories with ⟨Y⟩ > 4, joined where they
+   overlap, span c_1 ... c_3/2 — one chaotic layer connects the islands, though no single
+   trajectory has crossed it yet (docs/physics.md §9.2).
+ With ``indicators=True``
 (default) every trajectory also carries MEGNO ⟨Y⟩ and its Lyapunov exponent: the evidence
 records them for the connecting trajectory, which should be clearly chaotic (⟨Y⟩ ≫ 2).
 
@@ -69,6 +79,10 @@ class OverlapDecision:
     separatrix_chaotic_fraction: float = float("nan")
     inaccurate: int = 0
     max_energy_drift: float = float("nan")
+    #: the MEGNO connection criterion (see :func:`megno_connects`): None without indicators
+    megno_overlap: Optional[bool] = None
+    #: orbits of the run this decision comes from
+    orbits: float = float("nan")
 
 
 @dataclass
@@ -98,6 +112,49 @@ class OverlapScan:
     n_inaccurate: int = 0
     include_inaccurate: bool = False
     coordinates: str = "inertial"
+    # convergence in integration length (doubling; see overlap_threshold): the lengths run
+    # (orbits), the geometric and MEGNO decisions at each (rows: lengths, columns:
+    # elongations), the verdict, and the cost in member-orbits
+    lengths: np.ndarray = None
+    overlaps_by_length: np.ndarray = None
+    megno_overlaps_by_length: np.ndarray = None
+    converged: bool = False
+    converged_orbits: float = float("nan")
+    max_orbits: float = float("nan")
+    message: str = ""
+    megno_first_overlap: Optional[float] = None
+    member_orbits: float = float("nan")
+
+    @property
+    def upper_bound(self) -> bool:
+        """True when ``first_overlap`` is only an upper bound (not converged in length)."""
+        return not self.converged
+
+    def section_block(self, k):
+        """(SectionResult, member slice) of elongation k in the run its decision comes from
+        (only on a scan just computed; a loaded scan has ``sections`` = the first run)."""
+        runs = getattr(self, "_runs", None)
+        if runs:
+            return runs[k]
+        per = self.sections.count.size // len(self.elongations)
+        return self.sections, slice(k * per, (k + 1) * per)
+
+    def evidence(self):
+        """Lines: decisions per elongation against integration length, and the verdict."""
+        if self.lengths is None or self.overlaps_by_length is None:
+            return [f"{self.name}: one length ({self.orbits:g} orbits), convergence not checked"]
+        rows = [f"{'orbits':>8}  " + " ".join(f"{q:5.2f}" for q in self.elongations)
+                + "  first overlap (geometric / MEGNO)"]
+        for L, geo, meg in zip(self.lengths, self.overlaps_by_length,
+                               self.megno_overlaps_by_length):
+            first = next((f"{q:.2f}" for q, o in zip(self.elongations, geo) if o), "none")
+            mfirst = next((f"{q:.2f}" for q, o in zip(self.elongations, meg) if o == 1), "none")
+            cells = " ".join(f"{'O' if g else '.'}{'m' if m == 1 else ' '}".rjust(5)
+                             for g, m in zip(geo, meg))
+            rows.append(f"{L:8g}  {cells}  {first} / {mfirst}")
+        rows.append("(O geometric overlap, . separate, m MEGNO criterion connects)")
+        rows.append(self.message)
+        return rows
 
     def plot(self, ax=None, title=None):
         """Decision per elongation (overlap blue, separate green) with the numerical and the
@@ -112,7 +169,11 @@ class OverlapScan:
             ax.axvline(self.first_overlap, color="tab:red", lw=1.0, label="numerical")
         ax.set_yticks([0, 1], ["separate", "overlap"])
         ax.set_xlabel("a/b")
-        ax.set_title(title or f"{self.name}, e = {self.eccentricity}: 1:1 / 3:2 overlap", fontsize=9)
+        verdict = "" if self.lengths is None else \
+            (f", converged at {self.converged_orbits:g} orbits" if self.converged
+             else f", not converged by {self.max_orbits:g} orbits (upper bound)")
+        ax.set_title((title or f"{self.name}, e = {self.eccentricity}: 1:1 / 3:2 overlap")
+                     + verdict, fontsize=9)
         ax.legend(fontsize=7)
         return ax
 
@@ -139,7 +200,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
                       indicators=True, progress=None, client=None,
                       chunk_size=None, model="auto", max_drift=None,
-                      include_inaccurate=False, coordinates="inertial") -> OverlapScan:
+                      include_inaccurate=False, coordinates="inertial", max_orbits=None,
+                      **section_kwargs) -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -152,7 +214,18 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     eccentricity : float, optional
         Override the catalogue eccentricity (names only).
     orbits : float
-        Orbits integrated per trajectory (longer finds slower connections).
+        Orbits of the first (shortest) integration; longer ones find slower connections.
+    max_orbits : float, optional
+        Cap of the doubling (default ``4 · orbits``: lengths orbits, 2·orbits, 4·orbits).
+        The scan integrates at orbits, 2·orbits, 4·orbits, ... (each length integrates again,
+        from the start, only the elongations still "separate": a connection once seen is
+        final) until two successive lengths give the same decision at every elongation and
+        no elongation is still "separate" where the MEGNO criterion already connects
+        (``converged``, ``converged_orbits``); at the cap without that, ``message`` says
+        "not converged by N orbits" and ``first_overlap`` is an upper bound
+        (``upper_bound``). ``max_orbits = orbits`` runs one length (never converged).
+        ``overlaps_by_length`` / ``megno_overlaps_by_length`` hold the evidence (rows
+        ``lengths``); ``member_orbits`` the cost.
     rtol : float
         Integrator tolerance (chaos detection needs no more than ~1e-10).
     center_starts, separatrix_starts : int
@@ -174,6 +247,12 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     coordinates : {"inertial", "apsidal"}
         Spin coordinate of the starts and of the centres and ranges in the decisions
         (docs/physics.md §6.7; "apsidal" is the paper's).
+    **section_kwargs
+        Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
+
+    Each decision also carries the MEGNO criterion (:func:`megno_connects`,
+    ``OverlapDecision.megno_overlap``; ``megno_first_overlap`` its threshold): a chaotic
+    layer spanning both islands shows in ⟨Y⟩ before a single trajectory has crossed it.
     """
     import time
 
@@ -185,6 +264,17 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     # every scalar before any system is built or integrated
     check_coordinates(coordinates)
     check_orbits(orbits)
+    if max_orbits is None:
+        max_orbits = 4.0 * float(orbits)
+    elif isinstance(max_orbits, bool) or not isinstance(max_orbits, (int, float, np.integer,
+                                                                     np.floating)) \
+            or not float(orbits) <= float(max_orbits) <= 1e7:
+        raise ValueError(f"max_orbits must be a number in [orbits, 1e7] = [{float(orbits):g}, "
+                         f"1e7] (got {max_orbits!r})")
+    max_orbits = float(max_orbits)
+    if max_orbits < float(orbits):
+        raise ValueError(f"max_orbits must lie in [orbits, 1e7] = [{float(orbits):g}, 1e7] "
+                         f"(got {max_orbits:g})")
     check_tolerances(rtol, None)
     center_starts = require_count("center_starts", center_starts, 2, 100000)
     separatrix_starts = require_count("separatrix_starts", separatrix_starts, 2, 100000)
@@ -207,6 +297,8 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     except (TypeError, ValueError):
         per_elongation = None                  # named by the checks that build the columns
     if per_elongation is not None and per_elongation > 0:
+        # the first length, all elongations; every longer one (the elongations still
+        # separate) is sized by surface_of_section before it starts
         resources.check_memory("overlap_threshold", q.size * per_elongation, orbits,
                                advice="scan fewer elongations or starts, or fewer orbits")
     systems = [make(float(x)) for x in q]
@@ -214,30 +306,117 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     # θ_p = 0 column for the centres; θ_p = 90° column for the connection
     centre_rates = np.linspace(0.6, 2.0, int(center_starts))
     sep_rates = np.linspace(0.8, 1.8, int(separatrix_starts))
-    members, theta0, rates = [], [], []
-    for s in systems:
-        members += [s] * (len(centre_rates) + len(sep_rates))
-        theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
-        rates += list(centre_rates) + list(sep_rates)
-    t0 = time.perf_counter()
-    sec = sections(client, members, np.array(theta0), np.array(rates), orbits=orbits,
-                   chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
-                   model=model, max_drift=max_drift, coordinates=coordinates)
     per = len(centre_rates) + len(sep_rates)
-    decisions = []
-    for k, s in enumerate(systems):
-        block = slice(k * per, (k + 1) * per)
-        decisions.append(_decide(float(q[k]), s, sec, block, centre_rates, sep_rates,
-                                 libration_limit, include_inaccurate))
+    run = dict(chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
+               model=model, max_drift=max_drift, coordinates=coordinates, **section_kwargs)
+    lengths = _lengths(orbits, max_orbits)
+    t0 = time.perf_counter()
+    decisions = [None] * q.size
+    runs = [None] * q.size
+    geo_rows, megno_rows = [], []
+    first_sec = None
+    member_orbits = 0.0
+    converged_at = None
+    for step, length in enumerate(lengths):
+        # a connection seen at a shorter length is a fact (a trajectory crossed both levels):
+        # only elongations still "separate" are integrated again, longer
+        todo = [k for k in range(q.size) if decisions[k] is None or not decisions[k].overlap]
+        previous = [None if d is None else d.overlap for d in decisions]
+        if todo:
+            members, theta0, rates = [], [], []
+            for k in todo:
+                members += [systems[k]] * per
+                theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
+                rates += list(centre_rates) + list(sep_rates)
+            sec = sections(client, members, np.array(theta0), np.array(rates), orbits=length,
+                           **run)
+            member_orbits += len(members) * float(length)
+            first_sec = sec if first_sec is None else first_sec
+            for j, k in enumerate(todo):
+                block = slice(j * per, (j + 1) * per)
+                decisions[k] = _decide(float(q[k]), systems[k], sec, block, centre_rates,
+                                       sep_rates, libration_limit, include_inaccurate)
+                decisions[k].orbits = float(length)
+                runs[k] = (sec, block)
+        geo_rows.append([d.overlap for d in decisions])
+        megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
+                           for d in decisions])
+        # converged: the decisions no longer change with length, and no elongation is still
+        # "separate" where the MEGNO criterion already sees one chaotic layer (a slow
+        # connection the trajectories have not completed yet)
+        pending = [d.megno_overlap and not d.overlap for d in decisions]
+        if step > 0 and [d.overlap for d in decisions] == previous and not any(pending):
+            converged_at = float(length)
+            break
     overlaps = np.array([d.overlap for d in decisions])
     first = next((float(x) for x, o in zip(q, overlaps) if o), None)
+    megno_first = next((float(x) for x, d in zip(q, decisions) if d.megno_overlap), None)
     w_ro = float(analytic.omega0_overlap(e))
-    return OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
+    ran = np.array(lengths[:len(geo_rows)], dtype=np.float64)
+    converged = converged_at is not None
+    where = "none in the scan" if first is None else f"a/b = {first:.2f}"
+    if converged:
+        message = (f"converged: decisions at {ran[-2]:g} and {ran[-1]:g} orbits agree at every "
+                   f"elongation; first overlap {where}")
+    else:
+        message = (f"not converged by {ran[-1]:g} orbits: first overlap {where} is an upper "
+                   f"bound (longer runs can only move it down)")
+        waiting = [f"{d.elongation:.2f}" for d in decisions if d.megno_overlap and not d.overlap]
+        if waiting:
+            message += (f"; the MEGNO criterion already connects at a/b = "
+                        f"{', '.join(waiting)}")
+    n_inaccurate = sum(accuracy.count(sec.status[block], "inaccurate") for sec, block in runs)
+    scan = OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
-                       elongation_ro=float(analytic.elongation_from_omega0(w_ro)), orbits=orbits,
-                       seconds=time.perf_counter() - t0, sections=sec,
-                       max_drift=sec.max_drift, n_inaccurate=sec.n_inaccurate,
-                       include_inaccurate=bool(include_inaccurate), coordinates=coordinates)
+                       elongation_ro=float(analytic.elongation_from_omega0(w_ro)),
+                       orbits=float(ran[-1]), seconds=time.perf_counter() - t0,
+                       sections=first_sec, max_drift=first_sec.max_drift,
+                       n_inaccurate=int(n_inaccurate),
+                       include_inaccurate=bool(include_inaccurate), lengths=ran,
+                       overlaps_by_length=np.array(geo_rows, dtype=bool),
+                       megno_overlaps_by_length=np.array(megno_rows, dtype=np.int64),
+                       converged=converged,
+                       converged_orbits=converged_at if converged else float("nan"),
+                       max_orbits=float(lengths[-1]), message=message,
+                       megno_first_overlap=megno_first, member_orbits=member_orbits,
+                       coordinates=coordinates)
+    scan._runs = runs
+    return scan
+
+
+def _lengths(orbits, max_orbits):
+    """Integration lengths of the doubling: orbits, 2·orbits, 4·orbits, ... while ≤ max_orbits
+    (max_orbits itself ends the list when it is not a doubling of orbits)."""
+    out = [float(orbits)]
+    while out[-1] * 2.0 <= float(max_orbits) * (1 + 1e-12):
+        out.append(out[-1] * 2.0)
+    if out[-1] < float(max_orbits) * (1 - 1e-12):
+        out.append(float(max_orbits))
+    return out
+
+
+def megno_connects(lo, hi, megno, c1, c32, megno_chaotic=MEGNO_CHAOTIC):
+    """MEGNO connection criterion (faster than the geometric one): True when the θ̇_p ranges
+    [lo, hi] of the *chaotic* separatrix-column members (⟨Y⟩ > ``megno_chaotic``), joined where
+    they overlap, form one interval reaching from ≤ c1 to ≥ c32 — a single chaotic layer
+    spans both islands' levels, though no one trajectory has crossed it yet. None when no
+    member has a finite ⟨Y⟩ (indicators off)."""
+    megno = np.asarray(megno, dtype=np.float64)
+    if not np.isfinite(megno).any():
+        return None
+    chaotic = np.isfinite(lo) & np.isfinite(hi) & (megno > megno_chaotic)
+    if not chaotic.any():
+        return False
+    order = np.argsort(lo[chaotic])
+    start, end = lo[chaotic][order][0], hi[chaotic][order][0]
+    for a, b in zip(lo[chaotic][order][1:], hi[chaotic][order][1:]):
+        if a > end:                  # a gap: close the interval reaching c1, if it did
+            if start <= c1 and end >= c32:
+                break
+            start, end = a, b
+        else:
+            end = max(end, b)
+    return bool(start <= c1 and end >= c32)
 
 
 def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
@@ -283,7 +462,8 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
         separatrix_chaotic_fraction=float(np.mean(megno > MEGNO_CHAOTIC)) if np.isfinite(megno).all()
         else float("nan"),
         inaccurate=accuracy.count(sec.status[idx], "inaccurate"),
-        max_energy_drift=float(np.nanmax(sec.energy_drift[idx], initial=0.0)))
+        max_energy_drift=float(np.nanmax(sec.energy_drift[idx], initial=0.0)),
+        megno_overlap=megno_connects(lo, hi, np.where(usable, megno, np.nan), c1, c32))
 
 
 def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
