@@ -11,8 +11,10 @@ criterion already sees one chaotic layer spanning both islands; otherwise the th
 reported as "not converged by N orbits" (an upper bound). Each length integrates again only
 the elongations still separate.
 
-Coordinates: apsidal, the paper's (docs/physics.md §6.7): the starts, island centres and
-ranges are in θ̇ from the osculating line of apsides.
+Coordinates: apsidal, the paper's (docs/physics.md §6.7), by default: the starts, island
+centres and ranges are in θ̇ from the osculating line of apsides; ``--coordinates inertial``
+runs the same scan in the package's default coordinates (the figure and files then carry the
+suffix ``_inertial``).
 
 Prints: per system the decisions per elongation against length (geometric and MEGNO), the
 first overlapping a/b with its verdict, the MEGNO-criterion threshold and the analytic one.
@@ -31,6 +33,8 @@ def main():
                        help="orbits of the first length (default 300; quick 50)")
         p.add_argument("--max-orbits", type=float, default=None,
                        help="cap of the doubling (default 8 x --orbits; quick 2 x)")
+        p.add_argument("--coordinates", choices=("apsidal", "inertial"), default="apsidal",
+                       help="section coordinates (default apsidal, the paper's)")
 
     args, started = parse(__doc__.splitlines()[0], flags)
     import matplotlib.pyplot as plt
@@ -45,7 +49,7 @@ def main():
     numbers, arrays = {}, {}
     for col, name in enumerate(SYSTEMS):
         scan = overlap_threshold(name, elongations=elong, orbits=orbits, max_orbits=max_orbits,
-                                 coordinates="apsidal", **kw)
+                                 coordinates=args.coordinates, **kw)
         print(f"{name} (e = {scan.eccentricity}, analytic a/b = {scan.elongation_ro:.4f}), "
               f"{scan.seconds:.1f} s, {scan.member_orbits:.3g} member-orbits:")
         print("\n".join("  " + line for line in scan.evidence()))
@@ -70,7 +74,7 @@ def main():
         ax.axhline(d.center_3_2, color="tab:red", lw=0.6, ls=":")
         ax.set_xlim(0, 180)
         ax.set_xlabel(r"$\theta_p$ (deg)")
-        ax.set_ylabel(r"$\dot\theta_p/n$ (apsidal)")
+        ax.set_ylabel(rf"$\dot\theta_p/n$ ({args.coordinates})")
         ax.set_title(f"a/b = {d.elongation:.2f}, {d.orbits:g} orbits: 1:1 and 3:2 centres (red)",
                      fontsize=8)
         ax.legend(fontsize=6, loc="upper right")
@@ -89,9 +93,10 @@ def main():
         arrays[f"{key}_lengths"] = scan.lengths
         arrays[f"{key}_overlaps_by_length"] = scan.overlaps_by_length
         arrays[f"{key}_megno_overlaps_by_length"] = scan.megno_overlaps_by_length
-    save(args, "study07_overlap_thresholds", fig, arrays,
+    suffix = "" if args.coordinates == "apsidal" else "_" + args.coordinates
+    save(args, "study07_overlap_thresholds" + suffix, fig, arrays,
          {"orbits": orbits, "max_orbits": max_orbits, "elongations": elong,
-          "systems": list(SYSTEMS)}, numbers, started)
+          "systems": list(SYSTEMS), "coordinates": args.coordinates}, numbers, started)
 
 
 if __name__ == "__main__":
