@@ -505,12 +505,14 @@ def capture_probability(p, omega0, e, V=None):
 
 
 # ---- nonlinear forced libration of the decoupled problem ------------------------------------
-def _decoupled_half_orbit(omega0, e, w, steps):
+def _decoupled_half_orbit(omega0, e, w, steps, theta0=0.0):
     """RK4 over half an orbit (M from 0 to π, time 1/n) of θ̈ = −(ω0²/2)(a/r)³ sin 2(θ − f),
-    f alongside (df/dM = (1 + e cos f)²/(1 − e²)^{3/2}), from θ = 0, θ̇ = w (array) at
-    pericentre; returns θ(π) and max |θ − f| over the half orbit (rad)."""
+    f alongside (df/dM = (1 + e cos f)²/(1 − e²)^{3/2}), from θ = theta0, θ̇ = w (array) at
+    pericentre; returns θ(π) and max |θ − f| over the half orbit (rad). Serves the relaxed
+    amplitude here and the island centres of ``classify``."""
     one_minus_e2 = 1.0 - e * e
-    y = np.stack([np.zeros_like(w), w.astype(np.float64), np.zeros_like(w)])
+    w = np.asarray(w, dtype=np.float64)
+    y = np.stack([np.full_like(w, theta0), w.copy(), np.zeros_like(w)])
 
     def rhs(s):
         theta, thetadot, f = s

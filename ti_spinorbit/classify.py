@@ -89,6 +89,7 @@ from typing import ClassVar, Dict
 import numpy as np
 
 from ._validate import require_count, require_positive, require_range
+from .analytic import _decoupled_half_orbit
 
 #: Paper colour convention (Naidu & Margot 2015, Figs. 4–5 and 7–9).
 COLORS = {"resonant": "red", "chaotic": "blue", "quasi-periodic": "green"}
@@ -332,25 +333,9 @@ def _decoupled_centers(omega0, e, two_p_max, steps=1024, dw=0.005):
     grid of w (vectorised; f integrated alongside, df/dM = (1 + e cos f)²/(1 − e²)^{3/2}) and
     linear interpolation of the root nearest p. Returns a dict {2p: w} (NaN if none)."""
     w = np.arange(-1.0, 0.5 * two_p_max + 1.5, dw)
-    one_minus_e2 = 1.0 - e * e
     out = {}
     for theta_c, two_ps in ((0.0, range(2, two_p_max + 1)), (0.5 * math.pi, (1,))):
-        y = np.stack([np.full_like(w, theta_c), w.copy(), np.zeros_like(w)])
-
-        def rhs(s):
-            theta, thetadot, f = s
-            one_plus = 1.0 + e * np.cos(f)
-            a_over_r = one_plus / one_minus_e2
-            return np.stack([thetadot, -0.5 * omega0**2 * a_over_r**3 * np.sin(2.0 * (theta - f)),
-                             one_plus**2 / one_minus_e2**1.5])
-
-        h = math.pi / steps
-        for _ in range(steps):
-            k1 = rhs(y)
-            k2 = rhs(y + 0.5 * h * k1)
-            k3 = rhs(y + 0.5 * h * k2)
-            k4 = rhs(y + h * k3)
-            y = y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        y = _decoupled_half_orbit(omega0, e, w, steps, theta0=theta_c)
         for two_p in two_ps:
             g = y[0] - theta_c - 0.5 * two_p * math.pi
             i = np.flatnonzero((g[:-1] < 0) & (g[1:] >= 0))
