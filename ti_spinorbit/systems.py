@@ -14,7 +14,8 @@ The state is fully 3-D even though these starts are planar.
 """
 
 import math
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
@@ -30,6 +31,26 @@ G = 6.67430e-11
 #: Default escape radius in units of a: beyond it a member is stopped with status "escape".
 ESCAPE_DISTANCE = 50.0
 
+#: Below these sizes a body or orbit is implausible for an asteroid (a warning, not an error:
+#: "kilometres typed as metres?"): a body semi-axis or radius, and the semimajor axis, m.
+SMALL_BODY_M, SMALL_ORBIT_M = 1.0, 10.0
+
+
+class ImplausibleInputWarning(UserWarning):
+    """An input that is allowed but probably not meant: bodies or an orbit far smaller than
+    any asteroid (kilometres typed as metres?), or a surface of section at e ≈ 0 where the
+    pericentre is ill-defined."""
+
+
+#: Below this eccentricity a surface of section at pericentre warns (NearCircularWarning).
+NEAR_CIRCULAR_E = 1e-3
+
+
+class NearCircularWarning(ImplausibleInputWarning):
+    """A surface of section at e < 1e-3 (``NEAR_CIRCULAR_E``): the pericentre, where the
+    section samples, is ill-defined on a (nearly) circular orbit, and the section's points
+    scatter with the osculating elements rather than the spin."""
+
 
 @dataclass(frozen=True)
 class BinarySystem:
@@ -38,7 +59,9 @@ class BinarySystem:
     Parameters
     ----------
     primary, secondary : Body
-        e.g. ``Sphere(600, 1581)``, ``Ellipsoid(245, 163, 190, 2618)``.
+        e.g. ``Sphere(600, 1581)`` (radius 600 m, density 1581 kg m^-3),
+        ``Ellipsoid(245, 190, 163, 2618)`` (semi-axes a >= b >= c in m, not diameters, and
+        density). Lengths are metres: a body under 1 m or an orbit under 10 m warns.
         The mass ratio m1/m2 must lie in [1e-12, 1e12] (``MAX_MASS_RATIO``) and each body's
         principal moments must be at least 1e-6 of its largest (``MIN_MOMENT_RATIO``: the
         spin equations divide by them, so a body collapsed onto a line is refused).
@@ -53,6 +76,24 @@ class BinarySystem:
         1e5 n (``MAX_PRIMARY_SPIN``): |P| >= orbital period / 1e5.
     name : str
         Label used in plots and saved files.
+    orbital_period : float, optional
+        Observed orbital period of the mutual orbit, s (positive, finite), e.g. 11.92 h =
+        42912 s for Didymos-Dimorphos. When given, both bodies' masses (hence densities; shapes
+        unchanged) are multiplied by one factor ``density_scale`` = (P_Kepler / P)² so that
+        the Keplerian period 2π sqrt(a³ / (G (m1 + m2))) equals it; the mass ratio and ω0 are
+        unchanged. Not stored: the scaled bodies are, with ``density_scale``.
+
+    Attributes
+    ----------
+    density_scale : float
+        The factor ``orbital_period`` applied to both bodies' masses and densities (1.0 when
+        the bodies were used as given); shown by :meth:`describe`.
+
+    Warns
+    -----
+    ImplausibleInputWarning
+        A body with a semi-axis (or bounding radius) below 1 m or a semimajor axis below 10 m
+        (``SMALL_BODY_M``, ``SMALL_ORBIT_M``): kilometres typed as metres?
     """
 
     primary: Body
@@ -61,6 +102,7 @@ class BinarySystem:
     e: float
     primary_spin_period: Optional[float] = None
     name: str = "binary"
+    density_scale: float = field(default=1.0, init=False)
 
     def __post_init__(self):
         for label, body in (("primary", self.primary), ("secondary", self.secondary)):
@@ -101,6 +143,21 @@ class BinarySystem:
             raise ValueError(
                 f"bodies overlap at pericentre: a(1-e) = {pericentre:.6g} m must exceed the sum "
                 f"of bounding radii {contact:.6g} m (increase a or decrease e)")
+        self._warn_if_implausibly_small()
+
+    def _warn_if_implausibly_small(self):
+        small = []
+        for label, body in (("primary", self.primary), ("secondary", self.secondary)):
+            sizes = getattr(body, "semi_axes", None) or (body.bounding_radius,)
+            if min(sizes) < SMALL_BODY_M:
+                small.append(f"{label} size {min(sizes):.3g} m")
+        if self.a < SMALL_ORBIT_M:
+            small.append(f"a = {self.a:.3g} m")
+        if small:
+            warnings.warn(f"{self.name}: {', '.join(small)} is implausibly small for an asteroid "
+                          f"(below {SMALL_BODY_M:g} m for a body, {SMALL_ORBIT_M:g} m for a): "
+                          "kilometres typed as metres? All lengths are in metres",
+                          ImplausibleInputWarning, stacklevel=5)
 
     # ---- physical quantities (SI) ----------------------------------------------------------
     @property
@@ -221,7 +278,8 @@ class BinarySystem:
         return {"name": self.name, "primary": body(self.primary), "secondary": body(self.secondary),
                 "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
                 "mean_motion_rad_s": self.mean_motion, "mass_ratio": self.mass_ratio,
-                "omega0": self.omega0}
+                "omega0": self.omega0, "orbital_period_h": self.orbital_period / 3600.0,
+                "density_scale": self.density_scale}
 
     @classmethod
     def from_description(cls, d: dict) -> "BinarySystem":
@@ -281,7 +339,55 @@ class BinarySystem:
             return general
 
         period = d.get("primary_spin_period_s")
-        return cls(body("primary", d["primary"]), body("secondary", d["secondary"]),
-                   float(d["a_m"]), float(d["e"]),
-                   primary_spin_period=None if period is None else float(period),
-                   name=d.get("name", "binary"))
+        system = cls(body("primary", d["primary"]), body("secondary", d["secondary"]),
+                     float(d["a_m"]), float(d["e"]),
+                     primary_spin_period=None if period is None else float(period),
+                     name=d.get("name", "binary"))
+        scale = d.get("density_scale", 1.0)
+        require_positive_scalar("density_scale", scale, 0.0, math.inf, "")
+        object.__setattr__(system, "density_scale", float(scale))
+        return system
+
+
+def _scaled_body(body: Body, factor: float) -> Body:
+    """The same shape with every mass element (hence mass, density and every inertia
+    integral) multiplied by ``factor``. A uniform ellipsoid is rebuilt from its semi-axes
+    and new mass, so that its description (semi-axes, mass) rebuilds it bit for bit."""
+    if hasattr(body, "semi_axes"):
+        from .bodies import Ellipsoid
+
+        return Ellipsoid(*body.semi_axes, mass=body.mass * factor, name=body.name)
+    scaled = Body(body.mass * factor, {k: v * factor for k, v in body.integrals.items()},
+                  body.bounding_radius, body.name)
+    return scaled
+
+
+_dataclass_init = BinarySystem.__init__
+
+
+def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, name="binary",
+                      *, orbital_period=None):
+    if orbital_period is None:
+        return _dataclass_init(self, primary, secondary, a, e, primary_spin_period, name)
+    require_real("orbital_period", orbital_period)
+    require_positive_scalar("orbital_period", orbital_period, 0.0, math.inf, "s")
+    for label, body in (("primary", primary), ("secondary", secondary)):
+        if not isinstance(body, Body):
+            raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body), "
+                            f"got {type(body).__name__}")
+    require_positive_scalar("a", a, MIN_LENGTH, MAX_SEMIMAJOR_AXIS, "m")
+    kepler = 2.0 * math.pi * math.sqrt(float(a) ** 3 / (G * (primary.mass + secondary.mass)))
+    factor = (kepler / float(orbital_period)) ** 2
+    try:
+        scaled = [_scaled_body(b, factor) for b in (primary, secondary)]
+    except ValueError as exc:
+        raise ValueError(f"orbital_period {float(orbital_period):.6g} s needs densities x "
+                         f"{factor:.6g} (Keplerian period of the given bodies {kepler:.6g} s), "
+                         f"which makes a body's {' '.join(str(exc).split())}") from None
+    _dataclass_init(self, *scaled, a, e, primary_spin_period, name)
+    object.__setattr__(self, "density_scale", factor)
+
+
+_init_with_period.__doc__ = _dataclass_init.__doc__
+_init_with_period.__qualname__ = "BinarySystem.__init__"
+BinarySystem.__init__ = _init_with_period
