@@ -66,6 +66,21 @@ def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per
                                width=resources.record_width(system_or_systems, model))
 
 
+def _warn_near_circular(members):
+    """NearCircularWarning when a section's system has e < NEAR_CIRCULAR_E (pericentre
+    ill-defined); a warning, since such a run is still a valid integration."""
+    import warnings
+
+    from .systems import NEAR_CIRCULAR_E, NearCircularWarning
+
+    low = sorted({m.e for m in members if m.e < NEAR_CIRCULAR_E})
+    if low:
+        warnings.warn(f"surface_of_section: e = {low[0]:g} < {NEAR_CIRCULAR_E:g}: the pericentre "
+                      "where the section samples is ill-defined on a nearly circular orbit; the "
+                      "points follow the osculating elements more than the spin",
+                      NearCircularWarning, stacklevel=3)
+
+
 def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
                   escape_distance=ESCAPE_DISTANCE, coordinates="inertial", order=4):
     """Broadcast systems and initial conditions into a member table.
@@ -235,6 +250,7 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     check_size("surface_of_section", system_or_systems, theta_p, thetadot_p, orbits, model=model)
     members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance,
                                              coordinates, order)
+    _warn_near_circular(members)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
                   progress=progress, checkpoint=checkpoint, resume=resume,
