@@ -18,6 +18,9 @@ from .systems import BinarySystem
 
 HOUR = 3600.0
 
+#: θ̇_p/n starts of a surface of section where the paper shows none (θ_p = 0).
+DEFAULT_SECTION_STARTS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5)
+
 
 @lru_cache(maxsize=1)
 def _data():
@@ -106,7 +109,7 @@ def section_starts(name):
     """Initial θ̇_p/n of the paper's surfaces of section for this system (θ_p = 0), or a
     default spread over 0.5-2.5 where the paper shows none."""
     values = _data()[_resolve(name)].get("section_thetadot_p")
-    return list(values) if values else [0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 2.25, 2.5]
+    return list(values) if values else list(DEFAULT_SECTION_STARTS)
 
 
 def heliocentric_orbit(name):

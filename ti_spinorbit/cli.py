@@ -195,7 +195,10 @@ def _parser():
 
     def system_flags(s, default="1991 VH", shape=True):
         s.add_argument("--system", default=default,
-                       help=f"catalogued system name (default: {default}; see 'ti-spinorbit systems')")
+                       help=f"catalogued system name (default: {default}; see 'ti-spinorbit "
+                            "systems') or a .json file of your own system, as written by "
+                            "'ti-spinorbit systems --show NAME --out PATH' (then --elongation "
+                            "and --density are refused: edit the file; --eccentricity applies)")
         if shape:
             s.add_argument("--elongation", type=float,
                            help=f"secondary a/b in [1, {MAX_ELONGATION:g}] (default: catalogue value)")
@@ -430,6 +433,10 @@ def _check_system_flags(args):
     if name is None or args.command == "figures":
         return
     flag = "--show" if args.command == "systems" else "--system"
+    if flag == "--system" and _is_system_file(name):
+        system = _file_system(args)
+        _check_derived(args, system)
+        return
     try:
         catalog.entry(name)
     except (TypeError, ValueError) as exc:
@@ -455,6 +462,11 @@ def _check_system_flags(args):
             culprit = next((flags[k] for k, v in given.items() if v is not None), flag)
             message = f"{culprit}: {message}"
         raise ValueError(message) from None
+    _check_derived(args, system)
+
+
+def _check_derived(args, system):
+    """Checks of the built system that the catalogue and a --system file share."""
     from .coordinates import APSIDAL_MIN_ECCENTRICITY
 
     if getattr(args, "coordinates", None) == "apsidal" and system.e < APSIDAL_MIN_ECCENTRICITY:
@@ -481,12 +493,76 @@ def _init(args):
         return init(arch=args.arch)
 
 
+def _is_system_file(value):
+    """--system names a file (rather than a catalogued system) when it ends in .json."""
+    return isinstance(value, str) and value.lower().endswith(".json")
+
+
+def _file_system(args):
+    """The BinarySystem of a --system .json (BinarySystem.describe() output, as written by
+    'ti-spinorbit systems --show NAME --out PATH', or the one-item list 'systems --out'
+    writes), with --eccentricity applied. --elongation and --density are refused: they
+    rebuild a catalogued secondary by the catalogue's prescription (docs/physics.md §7),
+    which a file of your own system does not follow."""
+    import dataclasses
+    import json
+
+    from .systems import BinarySystem
+
+    path = args.system
+    for dest, flag in (("elongation", "--elongation"), ("density", "--density")):
+        if getattr(args, dest, None) is not None:
+            raise ValueError(f"{flag} applies only to a catalogued --system (the catalogue's "
+                             f"secondary prescription); for the file {path!r} edit the "
+                             "secondary's semi_axes_m/mass_kg in it instead")
+    if getattr(args, "elongations", None) is not None:
+        raise ValueError(f"--system: overlap scans the catalogue's elongation prescription, so "
+                         f"it needs a catalogued system name (got the file {path!r})")
+    try:
+        with open(path) as f:
+            d = json.load(f)
+    except FileNotFoundError:
+        raise ValueError(f"--system: no such file {path!r} (a catalogued name, or a .json "
+                         "written by 'ti-spinorbit systems --show NAME --out PATH')") from None
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"--system: cannot read {path!r} as JSON ({_one_line(exc)[:200]})") \
+            from None
+    if isinstance(d, list) and len(d) == 1:
+        d = d[0]
+    try:
+        system = BinarySystem.from_description(d)
+    except (TypeError, ValueError, KeyError, AttributeError) as exc:
+        raise ValueError(f"--system: {path!r} is not a system description "
+                         f"(BinarySystem.describe() output): {_one_line(exc)[:300]}") from None
+    e = getattr(args, "eccentricity", None)
+    if e is not None and e != system.e:
+        contact = system.primary.bounding_radius + system.secondary.bounding_radius
+        if not system.a * (1.0 - e) > contact:
+            raise ValueError(f"--eccentricity must lie in [0, {1.0 - contact / system.a:.4g}) "
+                             f"for {system.name}: at {e:g} the bodies overlap at pericentre")
+        system = dataclasses.replace(system, e=float(e))
+    return system
+
+
+def _catalogue_name(system):
+    """The catalogue key of a system loaded from a file when its name is one, else None
+    (its defaults, e.g. the section starts, then follow the catalogue)."""
+    from . import catalog
+
+    try:
+        return catalog._resolve(system.name)
+    except (TypeError, ValueError):
+        return None
+
+
 def _system(args):
     from . import catalog
 
+    if _is_system_file(args.system):
+        return _file_system(args)
     return catalog.system(args.system, elongation=getattr(args, "elongation", None),
                           secondary_density=getattr(args, "density", None),
-                          eccentricity=args.eccentricity)
+                          eccentricity=getattr(args, "eccentricity", None))
 
 
 def _paths(args, prefix, system_name):
@@ -594,6 +670,17 @@ def _print(args, *lines):
 
 # ---- subcommands ------------------------------------------------------------------------
 
+def _body_size(body):
+    """A body's size for the systems table: "R 600" for a sphere, else its semi-axes a x b x c
+    (m), else its bounding radius."""
+    axes = getattr(body, "semi_axes", None)
+    if axes is None:
+        return f"<= {body.bounding_radius:.0f}"
+    if axes[0] == axes[1] == axes[2]:
+        return f"R {axes[0]:.0f}"
+    return " x ".join(f"{x:.0f}" for x in axes)
+
+
 def _cmd_systems(args):
     import json
 
@@ -612,11 +699,14 @@ def _cmd_systems(args):
     if args.out:
         with open(args.out, "w") as f:
             json.dump([s.describe() for s in systems], f, indent=1)
-    _print(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} {'omega0':>7s}")
+    _print(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} "
+                 f"{'omega0':>7s} {'P_orb (h)':>9s}  {'primary (m)':>17s}  "
+                 f"{'secondary semi-axes (m)':>23s}")
     for s in systems:
         ax = s.secondary.semi_axes
         _print(args, f"{s.name:12s} {s.mass_ratio:10.2f} {s.a:8.0f} {s.e:7.4f} "
-                     f"{ax[0] / ax[1]:5.2f} {s.omega0:7.3f}")
+                     f"{ax[0] / ax[1]:5.2f} {s.omega0:7.3f} {s.orbital_period / 3600:9.2f}  "
+                     f"{_body_size(s.primary):>17s}  {_body_size(s.secondary):>23s}")
     return 0
 
 
@@ -627,7 +717,9 @@ def _cmd_section(args):
     from .plotting import plot_section
 
     system = _system(args)
-    starts = args.thetadot or catalog.section_starts(args.system)
+    known = _catalogue_name(system)
+    starts = args.thetadot or (catalog.section_starts(known) if known else
+                               list(catalog.DEFAULT_SECTION_STARTS))
     out, data = _paths(args, "sos", system.name)
     _init(args)
     with _progress(args) as bar:
@@ -836,7 +928,8 @@ def _cmd_energy(args):
     out, data = _paths(args, "energy", system.name)
     thetadot = args.thetadot
     if thetadot is None:
-        period = catalog.secondary_spin_period(args.system)
+        known = _catalogue_name(system)
+        period = None if known is None else catalog.secondary_spin_period(known)
         thetadot = 1.0 if period is None else 2 * m.pi / period / system.mean_motion
     samples = args.samples_per_orbit
     if samples is None:
@@ -889,7 +982,7 @@ def _cmd_benchmark(args):
     from . import catalog, runtime, surface_of_section
     from .io import provenance
 
-    system = catalog.system(args.system)
+    system = _system(args)
     out = args.out or "benchmark.json"
     thetadot = np.linspace(*BENCH_THETADOT_RANGE, args.members)
     _init(args)
@@ -969,6 +1062,29 @@ def _one_line(exc):
     return " ".join(str(exc).split())
 
 
+def _checked_run(args):
+    """check_args then the handler, with this package's input warnings (ImplausibleInputWarning:
+    tiny bodies, a section at e ~ 0) printed once each as one line on stderr (none with
+    --quiet); other warnings as Python shows them."""
+    import warnings
+
+    from .systems import ImplausibleInputWarning
+
+    shown = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not issubclass(category, ImplausibleInputWarning):
+            return shown(message, category, filename, lineno, file, line)
+        if not getattr(args, "quiet", False):
+            print(f"ti-spinorbit {args.command}: warning: {_one_line(message)}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", ImplausibleInputWarning)   # once per run, per place
+        warnings.showwarning = show
+        check_args(args)
+        return HANDLERS[args.command](args)
+
+
 def main(argv=None):
     """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit status:
     0 success, 1 a check failed (energy), 2 bad input or a failed run (one line on stderr),
@@ -985,11 +1101,9 @@ def main(argv=None):
     # recorded in every data file, quoted so that it can be pasted back into a shell
     args.command_line = shlex.join(["ti-spinorbit", *(sys.argv[1:] if argv is None else argv)])
     if getattr(args, "debug", False):
-        check_args(args)
-        return HANDLERS[args.command](args)
+        return _checked_run(args)
     try:
-        check_args(args)
-        return HANDLERS[args.command](args)
+        return _checked_run(args)
     except (ValueError, TypeError, RuntimeError, OSError) as exc:
         print(f"ti-spinorbit {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return EXIT_ERROR
