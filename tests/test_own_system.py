@@ -55,9 +55,12 @@ def test_json_rebuilds_the_catalogue_system_exactly(vh_json):
 
 
 def test_eccentricity_flag_applies_to_a_json_system(vh_json):
+    d = json.loads(vh_json.read_text())
+    d["density_scale"] = 2.5           # a record only: it survives the changed eccentricity
+    vh_json.write_text(json.dumps([d]))      # the one-item list 'systems --out' writes
     args = cli._parser().parse_args(["section", "--system", str(vh_json), "--eccentricity", "0.2"])
     system = cli._system(args)
-    assert system.e == 0.2
+    assert system.e == 0.2 and system.density_scale == 2.5
     np.testing.assert_array_equal(system.parameter_row(),
                                   catalog.system("1991 VH", eccentricity=0.2).parameter_row())
 

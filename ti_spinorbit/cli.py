@@ -540,7 +540,9 @@ def _file_system(args):
         if not system.a * (1.0 - e) > contact:
             raise ValueError(f"--eccentricity must lie in [0, {1.0 - contact / system.a:.4g}) "
                              f"for {system.name}: at {e:g} the bodies overlap at pericentre")
+        scale = system.density_scale
         system = dataclasses.replace(system, e=float(e))
+        object.__setattr__(system, "density_scale", scale)    # not an __init__ argument
     return system
 
 
