@@ -34,6 +34,7 @@ from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
 from .kernels.ensemble import INACCURATE
+from . import display as _display
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -130,6 +131,13 @@ class ChaosMap(accuracy.StatusSummary):
     fraction_by_length: np.ndarray = None
     fraction_monotone: bool = True
     fraction_message: str = ""
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     @property
     def shape(self):
@@ -385,6 +393,12 @@ class ParameterMap(accuracy.StatusSummary):
     fraction_monotone: np.ndarray = None
     fraction_message: str = ""
 
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     @property
     def member_orbits_per_second(self) -> float:
