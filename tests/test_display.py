@@ -200,3 +200,11 @@ def test_a_result_over_several_systems_names_them_briefly(vh):
     assert_compact(text)
     assert "systems 4 ('1991 VH')," in text
     assert "a/b 1.1–1.4" in text
+
+
+@pytest.mark.parametrize("kind", [k for k in RESULTS if k != "big_section"])
+def test_a_loaded_result_prints_as_the_saved_one(kind, request, tmp_path):
+    result = request.getfixturevalue(kind)
+    loaded = tso.load(tso.save(result, tmp_path / f"{kind}.npz"))
+    assert repr(loaded) == repr(result)
+    assert loaded._repr_html_() == result._repr_html_()
