@@ -33,7 +33,6 @@ from .coordinates import THETADOT_LABEL, check_coordinates
 from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
-from .kernels.ensemble import INACCURATE
 from . import display as _display
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
@@ -352,6 +351,13 @@ def fraction_evidence(lengths, fractions):
             "fraction_monotone": monotone, "fraction_message": message}
 
 
+def _inaccurate_code():
+    """The "inaccurate" status code (imported here: importing the kernels imports Taichi,
+    which ``import ti_spinorbit`` must not)."""
+    from .kernels.ensemble import INACCURATE
+    return INACCURATE
+
+
 @dataclass
 class ParameterMap(accuracy.StatusSummary):
     """Chaotic fraction over elongation a/b × eccentricity e.
@@ -546,7 +552,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         rtol=float(rtol), seconds=seconds, name=name,
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
-        inaccurate=np.sum(status == INACCURATE, axis=-1),
+        inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
         fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
         fraction_message=message)
