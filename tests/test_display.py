@@ -4,6 +4,7 @@ lines — never its arrays, however many members — and a small HTML table in n
 Results come from tiny real runs (a 1024-member one-orbit section is about a second once the
 kernels are cached; the others use 2-8 members and a few orbits)."""
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -66,7 +67,7 @@ RESULTS = {
                                       "status done", "coordinates inertial"]),
     "time_series": ("TimeSeriesResult", ["members 2", "orbits 2", "rtol 1e-09",
                                          "samples per member 16", "'1991 VH'", "status done"]),
-    "chaos_map": ("ChaosMap", ["members 4", "orbits 3", "chaotic fraction",
+    "chaos_map": ("ChaosMap", ["members 4", "orbits 3", "chaotic fraction 0 of 4 counted",
                                "threshold ⟨Y⟩ > 4", "grid θ_p × θ̇_p/n 2 × 2", "status done"]),
     "parameter_map": ("ParameterMap", ["members 8", "orbits 3", "'1991 VH'", "a/b 1.2–1.4",
                                        "e 0.05–0.1", "chaotic fraction", "ω0", "status done"]),
@@ -208,3 +209,16 @@ def test_a_loaded_result_prints_as_the_saved_one(kind, request, tmp_path):
     loaded = tso.load(tso.save(result, tmp_path / f"{kind}.npz"))
     assert repr(loaded) == repr(result)
     assert loaded._repr_html_() == result._repr_html_()
+
+
+def test_chaotic_fraction_says_how_many_members_it_counts(chaos_map):
+    """Inaccurate members are left out of the fraction (unless included): the repr says so."""
+    from ti_spinorbit.kernels.ensemble import INACCURATE
+
+    status = chaos_map.status.copy()
+    status.flat[0] = INACCURATE
+    flagged = dataclasses.replace(chaos_map, status=status)
+    text = repr(flagged)
+    assert "of 3 counted" in text and "done 3, inaccurate 1" in text
+    included = repr(dataclasses.replace(flagged, include_inaccurate=True))
+    assert "of 4 counted" in included and "counts inaccurate yes" in included

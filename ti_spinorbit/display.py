@@ -182,7 +182,10 @@ def _time_series(r):
 
 
 def _fraction(r):
-    row = [("chaotic fraction", number(r.chaotic_fraction, ".3g"))]
+    from .accuracy import usable          # status codes live with the kernels: import late
+
+    counted = int(usable(r.status, getattr(r, "include_inaccurate", False)).sum())
+    row = [("chaotic fraction", f"{number(r.chaotic_fraction, '.3g')} of {counted} counted")]
     if getattr(r, "megno_chaotic", None) is not None:
         row.append(("threshold ⟨Y⟩ >", number(r.megno_chaotic, "g")))
     if getattr(r, "include_inaccurate", False):
