@@ -5,8 +5,8 @@ fourth-order mutual potential built from inertia integrals, integrated for whole
 by Taichi kernels (one adaptive Cash-Karp loop per member). Reference science: Naidu &
 Margot 2015, AJ 149:80.
 
-Importing the package does not initialise Taichi; the first computation does (CPU, f64), or
-call ``ti_spinorbit.init(arch=...)`` first.
+Importing the package does not initialise Taichi, nor even import it (so it prints nothing):
+the first computation does (CPU, f64), or call ``ti_spinorbit.init(arch=...)`` first.
 """
 
 from .bodies import Body, Ellipsoid, Sphere

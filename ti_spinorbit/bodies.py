@@ -23,6 +23,7 @@ import numpy as np
 from ._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LENGTH, MIN_MASS,
                         MIN_MOMENT_RATIO, require_finite,
                         require_positive_scalar, require_real, show, _as_floats)
+from . import display as _display
 
 # Fixed orders of the monomials, shared with the kernels (kernels/potential.py unrolls them).
 EXPONENTS_2 = ((2, 0, 0), (0, 2, 0), (0, 0, 2))
@@ -90,6 +91,13 @@ class Body:
     bounding_radius: float
     name: str = "body"
     _row: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     def __post_init__(self):
         require_positive_scalar("mass", self.mass, MIN_MASS, MAX_MASS, "kg")

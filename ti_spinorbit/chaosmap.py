@@ -33,7 +33,7 @@ from .coordinates import THETADOT_LABEL, check_coordinates
 from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
-from .kernels.ensemble import INACCURATE
+from . import display as _display
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -130,6 +130,13 @@ class ChaosMap(accuracy.StatusSummary):
     fraction_by_length: np.ndarray = None
     fraction_monotone: bool = True
     fraction_message: str = ""
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     @property
     def shape(self):
@@ -344,6 +351,13 @@ def fraction_evidence(lengths, fractions):
             "fraction_monotone": monotone, "fraction_message": message}
 
 
+def _inaccurate_code():
+    """The "inaccurate" status code (imported here: importing the kernels imports Taichi,
+    which ``import ti_spinorbit`` must not)."""
+    from .kernels.ensemble import INACCURATE
+    return INACCURATE
+
+
 @dataclass
 class ParameterMap(accuracy.StatusSummary):
     """Chaotic fraction over elongation a/b × eccentricity e.
@@ -385,6 +399,12 @@ class ParameterMap(accuracy.StatusSummary):
     fraction_monotone: np.ndarray = None
     fraction_message: str = ""
 
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -532,7 +552,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         rtol=float(rtol), seconds=seconds, name=name,
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
-        inaccurate=np.sum(status == INACCURATE, axis=-1),
+        inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
         fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
         fraction_message=message)

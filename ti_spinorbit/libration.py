@@ -51,6 +51,7 @@ from ._validate import (require_callable, require_count, require_positive,
 from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
+from . import display as _display
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
 DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
@@ -193,6 +194,13 @@ class RelaxedLibration:
     converged_in_tolerance: bool = False
     convergence_checked: bool = False
     message: str = ""
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     def evidence(self):
         """Lines: centre and amplitude against orbits and tolerance, and the verdict."""

@@ -52,6 +52,7 @@ from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
 from .distributed import sections
 from .systems import BinarySystem
+from . import display as _display
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
@@ -124,6 +125,13 @@ class OverlapScan:
     message: str = ""
     megno_first_overlap: Optional[float] = None
     member_orbits: float = float("nan")
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     @property
     def upper_bound(self) -> bool:

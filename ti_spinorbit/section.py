@@ -23,6 +23,7 @@ from ._validate import (_as_floats, require_callable, require_count, require_fin
                         require_order, require_real, require_spin, show)
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
+from . import display as _display
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -169,6 +170,13 @@ class SectionResult(accuracy.StatusSummary):
     max_drift: float = float("nan")
     coordinates: str = "inertial"
     apsidal_rate: np.ndarray = None
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -355,6 +363,13 @@ class TimeSeriesResult(accuracy.StatusSummary):
     rtol: float = float("nan")
     orbits: float = float("nan")
     coordinates: str = "inertial"
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,

@@ -24,6 +24,7 @@ from ._validate import (MAX_MASS_RATIO, MAX_PRIMARY_SPIN, MAX_SEMIMAJOR_AXIS, MI
                         MIN_MOMENT_RATIO, require_finite, require_positive_scalar, require_range,
                         require_real, show)
 from .bodies import Body
+from . import display as _display
 
 #: Newtonian constant of gravitation, m^3 kg^-1 s^-2 (CODATA 2018).
 G = 6.67430e-11
@@ -103,6 +104,13 @@ class BinarySystem:
     primary_spin_period: Optional[float] = None
     name: str = "binary"
     density_scale: float = field(default=1.0, init=False)
+
+    def __repr__(self):
+        """A few lines, never the arrays (ti_spinorbit.display)."""
+        return _display.text(self)
+
+    def _repr_html_(self):
+        return _display.html(self)
 
     def __post_init__(self):
         for label, body in (("primary", self.primary), ("secondary", self.secondary)):

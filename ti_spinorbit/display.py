@@ -1,0 +1,280 @@
+"""Short, readable summaries of systems, bodies and results: ``repr`` and notebook HTML.
+
+One place for the formatting every class uses: :func:`text` gives a ``__repr__`` of at most a
+few lines (no arrays, however many members), :func:`html` a small ``<table>`` for Jupyter's
+``_repr_html_``. Both are built from :func:`summary`, a title and lines of (label, value)
+pairs, so the two views always say the same thing.
+"""
+
+import html as _html
+import math
+
+import numpy as np
+
+#: Longest user-supplied name shown (longer ones are cut with "…").
+MAX_NAME = 40
+#: Most distinct systems named in a result's summary.
+MAX_SYSTEMS = 3
+
+
+def number(x, spec=".4g"):
+    """A float in ``spec`` format; "—" for None, "nan"/"inf" spelled out."""
+    if x is None:
+        return "—"
+    x = float(x)
+    if math.isnan(x):
+        return "nan"
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return format(x, spec)
+
+
+def name(text):
+    """A user-supplied name, quoted and cut to ``MAX_NAME`` characters."""
+    text = str(text)
+    return repr(text if len(text) <= MAX_NAME else text[:MAX_NAME - 1] + "…")
+
+
+def length(metres):
+    """A length in m, or km above 10 km."""
+    metres = float(metres)
+    return f"{number(metres / 1e3)} km" if abs(metres) >= 1e4 else f"{number(metres)} m"
+
+
+def counts(mapping):
+    """{"done": 30, "inaccurate": 2} -> "done 30, inaccurate 2" (largest first)."""
+    if not mapping:
+        return "none"
+    items = sorted(mapping.items(), key=lambda kv: -kv[1])
+    return ", ".join(f"{k} {v}" for k, v in items)
+
+
+def span(values, spec=".3g"):
+    """Range of an array as "lo–hi" (ignoring NaN), "lo" when constant, "—" when empty/NaN."""
+    values = np.asarray(values, dtype=np.float64).ravel()
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return "—"
+    lo, hi = values.min(), values.max()
+    return number(lo, spec) if lo == hi else f"{number(lo, spec)}–{number(hi, spec)}"
+
+
+# ---- bodies and systems ------------------------------------------------------------------
+def semi_axes(body):
+    """Semi-axes (m) of a Sphere/Ellipsoid; for a general Body those of the uniform ellipsoid
+    with the same second moments (T^200 = M a²/5, ...)."""
+    axes = getattr(body, "semi_axes", None)
+    if axes is not None:
+        return tuple(axes), True
+    m = float(body.mass)
+    return tuple(math.sqrt(5.0 * body.integral(*k) / m) for k in
+                 ((2, 0, 0), (0, 2, 0), (0, 0, 2))), False
+
+
+def body_size(body):
+    """"sphere R 600 m", "ellipsoid 245 × 163 × 190 m" or "body ≈ 1 × 0.7 × 0.5 m" (the
+    ellipsoid with the same second moments)."""
+    axes, exact = semi_axes(body)
+    if exact and axes[0] == axes[1] == axes[2]:
+        return f"sphere R {length(axes[0])}"
+    metres = max(axes) < 1e4
+    unit, scale = ("m", 1.0) if metres else ("km", 1e-3)
+    dims = " × ".join(number(x * scale) for x in axes)
+    return f"ellipsoid {dims} {unit}" if exact else f"body ≈ {dims} {unit} (equal-moment ellipsoid)"
+
+
+def elongation(body):
+    """a/b of the body (of its equal-moment ellipsoid for a general Body)."""
+    axes, _ = semi_axes(body)
+    return axes[0] / axes[1] if axes[1] > 0 else math.inf
+
+
+def _body(b):
+    axes, _ = semi_axes(b)
+    volume = 4.0 / 3.0 * math.pi * axes[0] * axes[1] * axes[2]
+    exact = getattr(b, "semi_axes", None) is not None
+    lines = [[("shape", body_size(b)), ("mass", f"{number(b.mass)} kg")],
+             ([("density", f"{number(b.mass / volume, '.4g')} kg/m³")] if exact and volume > 0
+              else []) + [("bounding radius", length(b.bounding_radius))]]
+    if b.has_odd_integrals:
+        lines[1].append(("odd integrals", "yes"))
+    return f"Body {name(b.name)}", lines
+
+
+def _system(s):
+    P = s.primary_spin_period
+    lines = [[("a/b", number(elongation(s.secondary), ".4g")), ("e", number(s.e, ".4g")),
+              ("M_p/M_s", number(s.mass_ratio, ".4g")), ("ω0", f"{number(s.omega0, '.4g')} n"),
+              ("P_orb", f"{number(s.orbital_period / 3600.0, '.4g')} h")],
+             [("a", length(s.a)), ("primary", body_size(s.primary)),
+              ("secondary", body_size(s.secondary))]]
+    if P is not None:       # a spherical or non-spinning primary: nothing to say
+        lines.append([("primary spin period", f"{number(P / 3600.0, '.4g')} h")])
+    return f"BinarySystem {name(s.name)}", lines
+
+
+def _systems(systems):
+    """One line naming the distinct systems of a result (by identity, first MAX_SYSTEMS)."""
+    seen = {}
+    for s in systems or ():
+        seen.setdefault(id(s), s)
+    unique = list(seen.values())
+    if not unique:
+        return []
+    if len(unique) == 1:
+        s = unique[0]
+        return [("system", name(s.name)), ("a/b", number(elongation(s.secondary), ".4g")),
+                ("e", number(s.e, ".4g")), ("M_p/M_s", number(s.mass_ratio, ".4g")),
+                ("P_orb", f"{number(s.orbital_period / 3600.0, '.4g')} h")]
+    names = sorted({str(s.name) for s in unique})
+    shown = ", ".join(name(n) for n in names[:MAX_SYSTEMS]) + (" …" if len(names) > MAX_SYSTEMS else "")
+    return [("systems", f"{len(unique)} ({shown})"),
+            ("a/b", span([elongation(s.secondary) for s in unique])),
+            ("e", span([s.e for s in unique]))]
+
+
+# ---- results ------------------------------------------------------------------------------
+def _run(r, members, rtol=None):
+    """members, orbits, rtol, method/order, coordinates, seconds."""
+    rtol = getattr(r, "rtol", rtol)
+    row = [("members", str(members)), ("orbits", number(getattr(r, "orbits", None), "g"))]
+    if rtol is not None:
+        row.append(("rtol", number(rtol, "g")))
+    method = getattr(r, "method", None)
+    if method is not None:
+        row.append(("method", str(method)))
+    elif getattr(r, "order", None) is not None:
+        row.append(("order", str(r.order)))
+    row.append(("coordinates", str(getattr(r, "coordinates", "inertial"))))
+    seconds = getattr(r, "seconds", None)
+    if seconds:
+        row.append(("seconds", number(seconds, ".3g")))
+    return row
+
+
+def _status(r):
+    row = [("status", counts(r.status_counts))]
+    md = getattr(r, "max_drift", None)
+    if md is not None and not math.isnan(float(md)):
+        row.append(("max_drift", number(md, ".2g")))
+    return row
+
+
+def _section(r):
+    n = int(np.size(r.count))
+    points = np.asarray(r.count)
+    lines = [_run(r, n), _systems(r.systems) or [("system", "—")],
+             [("section points", f"{int(points.sum())} (per member {span(points, 'g')})")]
+             + ([("⟨Y⟩", span(r.megno))] if r.megno is not None
+                and np.isfinite(np.asarray(r.megno, dtype=float)).any() else []),
+             _status(r)]
+    return "SectionResult", lines
+
+
+def _time_series(r):
+    t = np.asarray(r.t, dtype=np.float64)
+    n = t.shape[0] if t.ndim else 0
+    samples = t.shape[1] if t.ndim > 1 else 0
+    lines = [_run(r, n), _systems(r.systems) or [("system", "—")],
+             [("samples per member", str(samples)), ("θ̇/n", span(r.thetadot))],
+             _status(r)]
+    return "TimeSeriesResult", lines
+
+
+def _fraction(r):
+    from .accuracy import usable          # status codes live with the kernels: import late
+
+    counted = int(usable(r.status, getattr(r, "include_inaccurate", False)).sum())
+    row = [("chaotic fraction", f"{number(r.chaotic_fraction, '.3g')} of {counted} counted")]
+    if getattr(r, "megno_chaotic", None) is not None:
+        row.append(("threshold ⟨Y⟩ >", number(r.megno_chaotic, "g")))
+    if getattr(r, "include_inaccurate", False):
+        row.append(("counts inaccurate", "yes"))
+    return row
+
+
+def _chaos_map(r):
+    shape = tuple(np.shape(r.megno))
+    lines = [_run(r, int(np.prod(shape))),
+             _systems(getattr(r.section, "systems", None)) if r.section is not None else [],
+             [("grid θ_p × θ̇_p/n", f"{shape[0]} × {shape[1]}" if len(shape) == 2 else str(shape)),
+              ("θ_p", f"{span(r.theta_p)} deg"), ("θ̇_p/n", span(r.thetadot_p))],
+             _fraction(r), _status(r)]
+    return "ChaosMap", [line for line in lines if line]
+
+
+def _parameter_map(r):
+    shape = tuple(np.shape(r.megno))
+    lines = [_run(r, int(np.prod(shape))),
+             ([("system", name(r.name))] if r.name else [])
+             + [("a/b", span(r.elongations)), ("e", span(r.eccentricities)),
+                ("grid", " × ".join(str(k) for k in shape) + " (a/b × e × starts)")],
+             [("chaotic fraction", span(r.chaotic_fraction)),
+              ("ω0", f"{span(r.omega0)} n")],
+             _status(r)]
+    return "ParameterMap", lines
+
+
+def _overlap(r):
+    sections = r.sections
+    members = int(np.size(sections.count)) if sections is not None else 0
+    first = "none in scan" if r.first_overlap is None else number(r.first_overlap, ".4g")
+    if r.first_overlap is not None and not r.converged and r.lengths is not None:
+        first += " (upper bound)"
+    lines = [_run(r, members, getattr(sections, "rtol", None)),
+             [("system", name(r.name)), ("e", number(r.eccentricity, ".4g")),
+              ("a/b scanned", f"{span(r.elongations)} ({len(r.elongations)})")]
+             + ([("lengths", f"{span(r.lengths, 'g')} orbits"),
+                 ("converged", "yes" if r.converged else "no")] if r.lengths is not None else []),
+             [("first overlap a/b", first), ("analytic a/b at ω0^RO", number(r.elongation_ro, ".4g")),
+              ("ω0^RO", f"{number(r.omega0_ro, '.4g')} n")]]
+    if sections is not None:
+        lines.append([("status (first run)", counts(sections.status_counts)),
+                      ("inaccurate", str(r.n_inaccurate))])
+    else:
+        lines.append([("inaccurate", str(r.n_inaccurate))])
+    return "OverlapScan", lines
+
+
+def _libration(r):
+    lines = [_run(r, 1),
+             [("system", name(r.system.name) if r.system is not None else "—"),
+              ("ω0", f"{number(r.omega0, '.4g')} n"),
+              ("centre θ̇_p/n", number(r.center_thetadot_p, ".6g"))],
+             [("amplitude", f"{number(r.amplitude, '.4g')} deg"),
+              # an amplitude: the sign of 2e/(ω0² − 1) is only the phase (below ω0 = 1 the
+              # forced libration is in antiphase), so it is shown as |ψ_A|
+              ("|ψ_A|", f"{number(abs(r.psi_A), '.4g')} deg"),
+              ("extent", f"{number(r.extent, '.3g')} deg")],
+             [("status", str(r.status)), ("converged", "yes" if r.converged else "no")]]
+    return "RelaxedLibration", lines
+
+
+_SUMMARIES = {"Body": _body, "BinarySystem": _system, "SectionResult": _section,
+              "TimeSeriesResult": _time_series, "ChaosMap": _chaos_map,
+              "ParameterMap": _parameter_map, "OverlapScan": _overlap,
+              "RelaxedLibration": _libration}
+
+
+def summary(obj):
+    """(title, lines): each line a list of (label, value) strings."""
+    for cls in type(obj).__mro__:
+        if cls.__name__ in _SUMMARIES:
+            return _SUMMARIES[cls.__name__](obj)
+    raise TypeError(f"no summary for {type(obj).__name__}")
+
+
+def text(obj):
+    """A ``__repr__`` of at most a few short lines."""
+    title, lines = summary(obj)
+    body = ["  " + ", ".join(f"{k} {v}" for k, v in line) for line in lines if line]
+    return "\n".join([f"<{title}>"] + body)
+
+
+def html(obj):
+    """A small HTML table for notebooks (``_repr_html_``)."""
+    title, lines = summary(obj)
+    esc = _html.escape
+    rows = "".join(f"<tr><th style=\"text-align:left\">{esc(k)}</th><td style=\"text-align:left\">"
+                   f"{esc(v)}</td></tr>" for line in lines for k, v in line)
+    return f"<table><caption>{esc(title)}</caption>{rows}</table>"
