@@ -222,3 +222,11 @@ def test_chaotic_fraction_says_how_many_members_it_counts(chaos_map):
     assert "of 3 counted" in text and "done 3, inaccurate 1" in text
     included = repr(dataclasses.replace(flagged, include_inaccurate=True))
     assert "of 4 counted" in included and "counts inaccurate yes" in included
+
+
+def test_system_repr_says_when_densities_were_scaled_to_a_period():
+    d = tso.catalog.system("Didymos")
+    s = tso.BinarySystem(d.primary, d.secondary, a=d.a, e=d.e, orbital_period=11.0 * 3600)
+    text = repr(s)
+    assert "P_orb 11 h" in text and "scaled ×" in text and "to match P_orb" in text
+    assert "scaled" not in repr(d)

@@ -13,7 +13,7 @@ from .bodies import Body, Ellipsoid, Sphere
 from .potential import mutual_potential
 from .runtime import init
 from .section import SectionResult, TimeSeriesResult, surface_of_section, time_series
-from .systems import G, BinarySystem
+from .systems import G, BinarySystem, ImplausibleInputWarning, NearCircularWarning
 from . import analytic, catalog
 from .chaosmap import chaos_map, parameter_map
 from .classify import classify_section
@@ -24,6 +24,7 @@ from .io import load, save, to_xarray
 __version__ = "0.1.0"
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
+           "ImplausibleInputWarning", "NearCircularWarning",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
            "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray",

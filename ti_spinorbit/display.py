@@ -110,6 +110,9 @@ def _system(s):
               ("secondary", body_size(s.secondary))]]
     if P is not None:       # a spherical or non-spinning primary: nothing to say
         lines.append([("primary spin period", f"{number(P / 3600.0, '.4g')} h")])
+    scale = getattr(s, "density_scale", 1.0)
+    if scale != 1.0:        # BinarySystem(orbital_period=...): say what was changed
+        lines.append([("densities", f"scaled × {number(scale, '.6g')} to match P_orb")])
     return f"BinarySystem {name(s.name)}", lines
 
 
