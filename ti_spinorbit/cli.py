@@ -981,7 +981,7 @@ def _cmd_benchmark(args):
 
     import numpy as np
 
-    from . import catalog, runtime, surface_of_section
+    from . import runtime, surface_of_section
     from .io import provenance
 
     system = _system(args)
