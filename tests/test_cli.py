@@ -169,7 +169,8 @@ def test_quiet_hides_the_taichi_banner(tmp_path):
 
 def test_the_banner_is_hidden_in_the_command_only(tmp_path):
     """runtime.py sets ENABLE_TAICHI_HEADER_PRINT=0 for the ti-spinorbit command (console
-    script or python -m); a library import still prints Taichi's banner."""
+    script or python -m); a library import prints nothing (Taichi is not imported), and the
+    library's first computation still shows Taichi's own banner."""
     env = {k: v for k, v in os.environ.items() if k != "ENABLE_TAICHI_HEADER_PRINT"}
     script = os.path.join(os.path.dirname(sys.executable), "ti-spinorbit")
     if os.path.exists(script):
@@ -178,6 +179,9 @@ def test_the_banner_is_hidden_in_the_command_only(tmp_path):
         assert p.returncode == 0 and p.stdout == "", p.stdout + p.stderr
     p = subprocess.run([sys.executable, "-c", "import ti_spinorbit"], cwd=tmp_path, env=env,
                        capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0 and p.stdout == "" and p.stderr == "", p.stdout + p.stderr
+    p = subprocess.run([sys.executable, "-c", "import ti_spinorbit as t; t.init()"],
+                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
     assert p.returncode == 0 and p.stdout.startswith(TAICHI_BANNER), p.stdout + p.stderr
 
 

@@ -489,6 +489,10 @@ def _init(args):
 
     if not args.quiet:
         return init(arch=args.arch)
+    # Taichi decides at import whether stdout is "a graphical shell" (sys.stdout is not
+    # sys.__stdout__) and then logs a line and wraps printing: import it before redirecting
+    import taichi  # noqa: F401  (its banner is off in the command, see runtime.py)
+
     with contextlib.redirect_stdout(io.StringIO()):
         return init(arch=args.arch)
 
