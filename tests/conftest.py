@@ -1,5 +1,8 @@
 """Shared fixtures: one Taichi runtime per test session (arch from TI_SPINORBIT_ARCH, CPU by
-default), and small systems used across the suite."""
+default), small systems used across the suite, and 1991 VH with one cheap result of every
+kind (module scope, like the per-file fixtures they replace)."""
+
+import warnings
 
 import numpy as np
 import pytest
@@ -34,3 +37,39 @@ def lumpy_body(rng, n=40, scale=1.0, mass=1.0):
     m = rng.uniform(0.5, 1.5, n)
     body, _ = tso.Body.from_point_masses(pts, m * mass / m.sum())
     return body
+
+
+# ---- 1991 VH and one cheap result of every kind (tests of io, display, ...) -----------------
+@pytest.fixture(scope="module")
+def vh():
+    return tso.catalog.system("1991 VH")
+
+
+@pytest.fixture(scope="module")
+def time_series(vh):
+    return tso.time_series(vh, 0.0, [0.83, 1.63], orbits=2, samples_per_orbit=8, rtol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def chaos_map(vh):
+    return tso.chaos_map(vh, [30.0, 120.0], [0.8, 1.6], orbits=3)
+
+
+@pytest.fixture(scope="module")
+def parameter_map():
+    return tso.parameter_map("1991 VH", [1.2, 1.4], [0.05, 0.1], orbits=3, theta_p=[0.0],
+                             thetadot_p=[1.0, 1.5])
+
+
+@pytest.fixture(scope="module")
+def overlap_scan():
+    return tso.overlap_threshold("2004 DC", elongations=[1.01, 1.03], orbits=5, center_starts=6,
+                                 separatrix_starts=4)
+
+
+@pytest.fixture(scope="module")
+def relaxed_libration(vh):
+    with warnings.catch_warnings():      # 3 orbits and one zoom: not converged, on purpose
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return tso.relaxed_libration(vh, orbits=3, candidates=np.linspace(0.2, 1.3, 9),
+                                     zoom_candidates=5, max_iterations=1, samples_per_orbit=16)

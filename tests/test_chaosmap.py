@@ -16,11 +16,6 @@ ORBITS = 150
 
 
 @pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
-@pytest.fixture(scope="module")
 def vh_map(vh):
     return chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=1e-10)
 

@@ -42,11 +42,6 @@ def client():
 
 
 @pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
-@pytest.fixture(scope="module")
 def vh_local(vh):
     return chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL)
 

@@ -14,11 +14,6 @@ from ti_spinorbit.section import build_members
 DAY = 86400.0
 
 
-@pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
 def test_two_spheres_follow_kepler():
     """Pericentre times k·P, pericentre distance a(1−e) and osculating a, e to 1e-9."""
     two = tso.BinarySystem(tso.Sphere(500, 2000), tso.Sphere(100, 2000), 3000, 0.3)

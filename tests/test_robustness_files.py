@@ -40,11 +40,6 @@ def windows(ckpt):
     return len(list(ckpt.glob("records-*.npz")))
 
 
-@pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
 def run(vh, ckpt=None, starts=STARTS, **kw):
     return tso.surface_of_section(vh, 0.0, starts, checkpoint=ckpt, **{**ARGS, **kw})
 

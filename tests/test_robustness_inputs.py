@@ -24,11 +24,6 @@ S = tso.Ellipsoid(245, 163, 150, 2000)
 GOOD_SECOND = {(2, 0, 0): 0.3, (0, 2, 0): 0.2, (0, 0, 2): 0.1}
 
 
-@pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
 def line_body():
     """Two point masses on a line: a body with a zero principal moment (integrated to "done"
     with NaN diagnostics before it was refused)."""

@@ -20,11 +20,6 @@ EXPERIMENT = os.path.join(ROOT, "experiments", "memory_estimate.py")
 GIB = 2.0**30
 
 
-@pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
 # ---- 1. the estimate is right --------------------------------------------------------------
 
 @pytest.mark.parametrize("entry, kw", [

@@ -22,11 +22,6 @@ def gap(where):
     return pytest.mark.xfail(strict=True, reason=f"needs check in {where}")
 
 
-@pytest.fixture(scope="module")
-def vh():
-    return tso.catalog.system("1991 VH")
-
-
 P = tso.Sphere(600, 1581)
 S = tso.Ellipsoid(245, 163, 150, 2000)
 

@@ -62,8 +62,8 @@ def _multi_index(exponents):
     return (0,) * l + (1,) * m + (2,) * n
 
 
-@dataclass(frozen=True)
-class Body:
+@dataclass(frozen=True, repr=False)
+class Body(_display.Readable):
     """A rigid body given by its mass and inertia integrals in its principal-axis frame.
 
     Parameters
@@ -91,13 +91,6 @@ class Body:
     bounding_radius: float
     name: str = "body"
     _row: np.ndarray = field(init=False, repr=False, compare=False)
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     def __post_init__(self):
         require_positive_scalar("mass", self.mass, MIN_MASS, MAX_MASS, "kg")

@@ -90,8 +90,8 @@ def _mean_spin(section):
         return np.where(counts > 0, total / np.maximum(counts, 1), np.nan)
 
 
-@dataclass
-class ChaosMap(accuracy.StatusSummary):
+@dataclass(repr=False)
+class ChaosMap(accuracy.StatusSummary, _display.Readable):
     """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
     (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
 
@@ -130,13 +130,6 @@ class ChaosMap(accuracy.StatusSummary):
     fraction_by_length: np.ndarray = None
     fraction_monotone: bool = True
     fraction_message: str = ""
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     @property
     def shape(self):
@@ -358,8 +351,8 @@ def _inaccurate_code():
     return INACCURATE
 
 
-@dataclass
-class ParameterMap(accuracy.StatusSummary):
+@dataclass(repr=False)
+class ParameterMap(accuracy.StatusSummary, _display.Readable):
     """Chaotic fraction over elongation a/b × eccentricity e.
 
     ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
@@ -398,13 +391,6 @@ class ParameterMap(accuracy.StatusSummary):
     fraction_by_length: np.ndarray = None
     fraction_monotone: np.ndarray = None
     fraction_message: str = ""
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     @property
     def member_orbits_per_second(self) -> float:

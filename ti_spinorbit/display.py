@@ -281,3 +281,15 @@ def html(obj):
     rows = "".join(f"<tr><th style=\"text-align:left\">{esc(k)}</th><td style=\"text-align:left\">"
                    f"{esc(v)}</td></tr>" for line in lines for k, v in line)
     return f"<table><caption>{esc(title)}</caption>{rows}</table>"
+
+
+class Readable:
+    """``__repr__`` (a few lines, never the arrays) and ``_repr_html_`` (a small table) for
+    the package's systems, bodies and results. Dataclasses that inherit it are declared with
+    ``@dataclass(repr=False)``, which keeps this ``__repr__`` instead of generating one."""
+
+    def __repr__(self):
+        return text(self)
+
+    def _repr_html_(self):
+        return html(self)

@@ -139,8 +139,8 @@ def _psi_A_deg(omega0, e):
     return math.degrees(analytic.psi_A(omega0, e))
 
 
-@dataclass
-class RelaxedLibration:
+@dataclass(repr=False)
+class RelaxedLibration(_display.Readable):
     """Centre of the synchronous island and the relaxed-mode libration amplitude.
 
     ``center_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
@@ -194,13 +194,6 @@ class RelaxedLibration:
     converged_in_tolerance: bool = False
     convergence_checked: bool = False
     message: str = ""
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     def evidence(self):
         """Lines: centre and amplitude against orbits and tolerance, and the verdict."""

@@ -86,8 +86,8 @@ class OverlapDecision:
     orbits: float = float("nan")
 
 
-@dataclass
-class OverlapScan:
+@dataclass(repr=False)
+class OverlapScan(_display.Readable):
     """Result of :func:`overlap_threshold`.
 
     ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
@@ -125,13 +125,6 @@ class OverlapScan:
     message: str = ""
     megno_first_overlap: Optional[float] = None
     member_orbits: float = float("nan")
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     @property
     def upper_bound(self) -> bool:

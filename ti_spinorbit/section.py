@@ -126,8 +126,8 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
     return members, par, y0, theta_p.copy(), thetadot_p.copy()
 
 
-@dataclass
-class SectionResult(accuracy.StatusSummary):
+@dataclass(repr=False)
+class SectionResult(accuracy.StatusSummary, _display.Readable):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
@@ -170,13 +170,6 @@ class SectionResult(accuracy.StatusSummary):
     max_drift: float = float("nan")
     coordinates: str = "inertial"
     apsidal_rate: np.ndarray = None
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -324,8 +317,8 @@ def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4)
     return cols
 
 
-@dataclass
-class TimeSeriesResult(accuracy.StatusSummary):
+@dataclass(repr=False)
+class TimeSeriesResult(accuracy.StatusSummary, _display.Readable):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
 
     ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
@@ -363,13 +356,6 @@ class TimeSeriesResult(accuracy.StatusSummary):
     rtol: float = float("nan")
     orbits: float = float("nan")
     coordinates: str = "inertial"
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,

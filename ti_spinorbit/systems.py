@@ -53,8 +53,8 @@ class NearCircularWarning(ImplausibleInputWarning):
     scatter with the osculating elements rather than the spin."""
 
 
-@dataclass(frozen=True)
-class BinarySystem:
+@dataclass(frozen=True, repr=False)
+class BinarySystem(_display.Readable):
     """Primary + secondary on an initial osculating orbit.
 
     Parameters
@@ -104,13 +104,6 @@ class BinarySystem:
     primary_spin_period: Optional[float] = None
     name: str = "binary"
     density_scale: float = field(default=1.0, init=False)
-
-    def __repr__(self):
-        """A few lines, never the arrays (ti_spinorbit.display)."""
-        return _display.text(self)
-
-    def _repr_html_(self):
-        return _display.html(self)
 
     def __post_init__(self):
         for label, body in (("primary", self.primary), ("secondary", self.secondary)):
