@@ -2,12 +2,23 @@
 default), small systems used across the suite, and 1991 VH with one cheap result of every
 kind (module scope, like the per-file fixtures they replace)."""
 
+import os
+import subprocess
+import sys
 import warnings
 
 import numpy as np
 import pytest
 
 import ti_spinorbit as tso
+
+
+def run_cli(*args, cwd, env=None, timeout=600):
+    """``python -m ti_spinorbit ARGS`` in a fresh process (Agg backend; ``env`` adds to or
+    overrides the environment); the CompletedProcess with text stdout and stderr."""
+    env = {**os.environ, "MPLBACKEND": "Agg", **(env or {})}
+    return subprocess.run([sys.executable, "-m", "ti_spinorbit", *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=timeout)
 
 
 @pytest.fixture(scope="session", autouse=True)

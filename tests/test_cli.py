@@ -18,14 +18,10 @@ import ti_spinorbit as tso
 from ti_spinorbit import cli
 from ti_spinorbit.io import read_metadata
 
+from conftest import run_cli
+
 PNG = b"\x89PNG\r\n\x1a\n"
 TAICHI_BANNER = "[Taichi] version"      # printed by `import taichi` itself, see test below
-
-
-def run_cli(*args, cwd):
-    env = dict(os.environ, MPLBACKEND="Agg")
-    return subprocess.run([sys.executable, "-m", "ti_spinorbit", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=600)
 
 
 def own_stdout(p):

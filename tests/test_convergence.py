@@ -4,9 +4,6 @@ libration centre and amplitude in orbits and tolerance, and the chaotic fraction
 against orbits; the evidence saved and loaded back, and printed by the CLI."""
 
 import json
-import os
-import subprocess
-import sys
 import warnings
 
 import numpy as np
@@ -17,6 +14,8 @@ from ti_spinorbit import io, libration
 from ti_spinorbit.chaosmap import chaos_map, fraction_evidence
 from ti_spinorbit.libration import relaxed_libration
 from ti_spinorbit.overlap import OverlapScan, _lengths, megno_connects, overlap_threshold
+
+from conftest import run_cli
 
 STARTS = dict(center_starts=24, separatrix_starts=16)
 
@@ -206,11 +205,8 @@ def test_fraction_orbits_out_of_range_is_named():
 
 def test_cli_overlap_prints_the_verdict(tmp_path):
     """Not converged is not an error: exit 0, the message on stdout and in the metadata."""
-    env = dict(os.environ, MPLBACKEND="Agg")
-    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "overlap", "--system", "1991 VH",
-                        "--elongations", "1.04", "1.04", "0.01", "--orbits", "100",
-                        "--max-orbits", "200", "--out", "o.png"], cwd=tmp_path, env=env,
-                       capture_output=True, text=True, timeout=600)
+    p = run_cli("overlap", "--system", "1991 VH", "--elongations", "1.04", "1.04", "0.01",
+                "--orbits", "100", "--max-orbits", "200", "--out", "o.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert "not converged by 200 orbits" in p.stdout and "(upper bound" in p.stdout
     assert "     100     .m" in p.stdout and "     200     .m" in p.stdout
@@ -220,11 +216,8 @@ def test_cli_overlap_prints_the_verdict(tmp_path):
 
 
 def test_cli_libration_prints_the_evidence(tmp_path):
-    env = dict(os.environ, MPLBACKEND="Agg")
-    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "libration", "--system", "1991 VH",
-                        "--orbits", "20", "--max-orbits", "40", "--xtol", "1e-4", "--out",
-                        "l.png"], cwd=tmp_path, env=env, capture_output=True, text=True,
-                       timeout=600)
+    p = run_cli("libration", "--system", "1991 VH", "--orbits", "20", "--max-orbits", "40",
+                "--xtol", "1e-4", "--out", "l.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     lines = p.stdout.splitlines()
     assert [line.split()[:2] for line in lines if line.strip().startswith(("20 ", "40 "))] == \
@@ -237,10 +230,8 @@ def test_cli_libration_prints_the_evidence(tmp_path):
 
 @pytest.mark.parametrize("flag, value", [("--max-orbits", "50"), ("--max-orbits", "-1")])
 def test_cli_max_orbits_range_is_named(tmp_path, flag, value):
-    env = dict(os.environ, MPLBACKEND="Agg")
-    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "overlap", "--system", "1991 VH",
-                        "--orbits", "100", flag, value, "--out", "o.png"], cwd=tmp_path,
-                       env=env, capture_output=True, text=True, timeout=600)
+    p = run_cli("overlap", "--system", "1991 VH", "--orbits", "100", flag, value,
+                "--out", "o.png", cwd=tmp_path)
     assert p.returncode == 2 and "--max-orbits" in p.stderr and not (tmp_path / "o.npz").exists()
 
 

@@ -6,7 +6,6 @@ angle along a dense trajectory, and the same trajectory recorded in both coordin
 
 import json
 import math
-import sys
 import warnings
 
 import numpy as np
@@ -17,6 +16,8 @@ from ti_spinorbit import coordinates as C
 from ti_spinorbit import reference
 from ti_spinorbit.classify import classify_section
 from ti_spinorbit.section import build_members
+
+from conftest import run_cli
 
 
 def kepler_state(e, f, a=1.0, mu=1.0, varpi=0.0):
@@ -286,19 +287,12 @@ def test_relaxed_libration_centre_shifts_by_the_initial_apsidal_rate():
 
 
 def test_cli_coordinates_flag(tmp_path):
-    import subprocess
-
-    import os
-    env = dict(os.environ, MPLBACKEND="Agg")
-    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "section", "--system", "1991 VH",
-                        "--elongation", "1.01", "--thetadot", "1.08", "--orbits", "2",
-                        "--coordinates", "apsidal", "--out", "s.png"], cwd=tmp_path, env=env,
-                       capture_output=True, text=True, timeout=600)
+    p = run_cli("section", "--system", "1991 VH", "--elongation", "1.01", "--thetadot", "1.08",
+                "--orbits", "2", "--coordinates", "apsidal", "--out", "s.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert tso.load(tmp_path / "s.npz").coordinates == "apsidal"
-    p = subprocess.run([sys.executable, "-m", "ti_spinorbit", "map", "--system", "1999 KW4",
-                        "--coordinates", "apsidal", "--out", "m.png"], cwd=tmp_path, env=env,
-                       capture_output=True, text=True, timeout=600)
+    p = run_cli("map", "--system", "1999 KW4", "--coordinates", "apsidal", "--out", "m.png",
+                cwd=tmp_path)
     assert p.returncode == 2
     assert p.stderr.strip().splitlines()[-1] == (
         "ti-spinorbit map: error: --coordinates apsidal needs an eccentricity >= 0.001 "

@@ -7,8 +7,6 @@ few orbits is already far above the default limit, so loose tolerances give memb
 must be flagged "inaccurate" while their data are kept."""
 
 import os
-import subprocess
-import sys
 import time
 
 import numpy as np
@@ -19,14 +17,10 @@ from ti_spinorbit import accuracy, cli
 from ti_spinorbit.kernels.ensemble import (COLLISION, DONE, ESCAPE, INACCURATE, NONFINITE,
                                            STATUS_NAMES, STEP_UNDERFLOW)
 
+from conftest import run_cli
+
 VH = tso.catalog.system("1991 VH")
 STARTS = [0.83, 1.63]
-
-
-def run_cli(*args, cwd, env=None):
-    env = {**os.environ, "MPLBACKEND": "Agg", **(env or {})}
-    return subprocess.run([sys.executable, "-m", "ti_spinorbit", *args], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=600)
 
 
 # ---- the limit and the verdict ------------------------------------------------------------

@@ -29,6 +29,8 @@ from ti_spinorbit import checkpoint as C
 from ti_spinorbit import io
 from ti_spinorbit.io import ArchiveError
 
+from conftest import run_cli
+
 STARTS = [0.83, 1.63]
 ARGS = dict(orbits=20, rtol=1e-10, window_orbits=4)
 #: Windows are adaptive (1, 2, 4, 4, ... orbits, shortened when slow): count the files.
@@ -79,11 +81,6 @@ def snapshot(path):
 
 def env():
     return dict(os.environ, MPLBACKEND="Agg")
-
-
-def run_cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "ti_spinorbit", *args], cwd=cwd, env=env(),
-                          capture_output=True, text=True, timeout=600)
 
 
 CLI_SECTION = ["section", "--system", "1991 VH", "--orbits", "20", "--thetadot", "0.83",

@@ -19,6 +19,8 @@ import ti_spinorbit as tso
 from ti_spinorbit import _validate
 from ti_spinorbit.overlap import overlap_vs_eccentricity
 
+from conftest import run_cli
+
 P = tso.Sphere(600, 1581)
 S = tso.Ellipsoid(245, 163, 150, 2000)
 GOOD_SECOND = {(2, 0, 0): 0.3, (0, 2, 0): 0.2, (0, 0, 2): 0.1}
@@ -387,8 +389,7 @@ API_NAMES = r"(?<![-\w])(elongations?|secondary_density|thetadot_p|theta_p|eccen
 
 @pytest.mark.parametrize("argv, message", CLI, ids=[" ".join(a) for a, _ in CLI])
 def test_cli_names_the_flag(argv, message, tmp_path):
-    run = subprocess.run([sys.executable, "-m", "ti_spinorbit", *argv], cwd=tmp_path, env=_env(),
-                         capture_output=True, text=True, timeout=120)
+    run = run_cli(*argv, cwd=tmp_path, env=_env(), timeout=120)
     lines = run.stderr.strip().splitlines()
     assert run.returncode == 2, run.stderr
     assert len(lines) == 1 and "Traceback" not in run.stderr, run.stderr
