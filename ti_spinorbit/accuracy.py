@@ -56,14 +56,18 @@ def drift_limit(rtol, orbits, max_drift=None):
     return float(min(DRIFT_CAP, DRIFT_PER_ORBIT * float(rtol) * max(float(orbits), 1.0)))
 
 
+def totals(diag):
+    """Total energy (N,) and total angular-momentum vector (N, 3) from DIAG_FIELDS rows
+    (``kernels.ensemble``: three energies, then the orbit's, the primary's and the
+    secondary's angular-momentum vectors, ...), scaled units."""
+    return diag[:, :3].sum(1), diag[:, 3:6] + diag[:, 6:9] + diag[:, 9:12]
+
+
 def drifts(diag_start, diag_end):
-    """Relative energy and angular-momentum drift per member from DIAG_FIELDS rows
-    (``kernels.ensemble``: three energies, three angular-momentum vectors, ...) at the start
-    and at the end: |E1 − E0| / |E0| and |L1 − L0| / |L0|. NaN where a diagnostic is."""
-    e0 = diag_start[:, :3].sum(1)
-    e1 = diag_end[:, :3].sum(1)
-    l0 = diag_start[:, 3:6] + diag_start[:, 6:9] + diag_start[:, 9:12]
-    l1 = diag_end[:, 3:6] + diag_end[:, 6:9] + diag_end[:, 9:12]
+    """Relative energy and angular-momentum drift per member from DIAG_FIELDS rows at the
+    start and at the end: |E1 − E0| / |E0| and |L1 − L0| / |L0|. NaN where a diagnostic is."""
+    e0, l0 = totals(diag_start)
+    e1, l1 = totals(diag_end)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         energy = np.abs(e1 - e0) / np.abs(e0)
         angmom = np.linalg.norm(l1 - l0, axis=1) / np.linalg.norm(l0, axis=1)

@@ -579,8 +579,11 @@ def _paths(args, prefix, system_name):
     data = args.data or os.path.splitext(out)[0] + ".npz"
     _check_output("--out" if args.out else "the figure (default --out)", out, FIGURE_EXTENSIONS)
     _check_output("--data" if args.data else "the data file (default --data)", data, (".npz",))
-    if hasattr(args, "checkpoint"):       # a checkpoint that would be refused: before any work
-        _run_flags(args, data)
+    checkpoint = _checkpoint_path(args, data)
+    if checkpoint is not None:   # a checkpoint that would be refused: before any work
+        from .checkpoint import check_target
+
+        check_target(checkpoint, args.resume, args.overwrite_checkpoint, cli=True)
     return out, data
 
 
@@ -597,20 +600,21 @@ def _with_progress(func, bar):
     return {"progress": bar} if "progress" in inspect.signature(func).parameters else {}
 
 
+def _checkpoint_path(args, data):
+    """The checkpoint directory of a run (--checkpoint; with --resume alone the data path with
+    .ckpt), or None for commands and runs without one."""
+    if getattr(args, "checkpoint", None) is not None:
+        return args.checkpoint
+    if getattr(args, "resume", False):
+        return os.path.splitext(data)[0] + ".ckpt"
+    return None
+
+
 def _run_flags(args, data):
-    """model, checkpoint and resume keywords from the flags (the checkpoint defaults to the
-    data path with .ckpt when --resume is given alone)."""
-    import os
-
-    from .checkpoint import check_target
-
-    checkpoint = args.checkpoint
-    if checkpoint is None and args.resume:
-        checkpoint = os.path.splitext(data)[0] + ".ckpt"
-    if checkpoint is not None:   # refused before any work, naming the flags
-        check_target(checkpoint, args.resume, args.overwrite_checkpoint, cli=True)
-    return {"model": args.model, "checkpoint": checkpoint, "resume": args.resume,
-            "overwrite_checkpoint": args.overwrite_checkpoint}
+    """model, checkpoint and resume keywords from the flags (the directory was checked by
+    :func:`_paths` before any work)."""
+    return {"model": args.model, "checkpoint": _checkpoint_path(args, data),
+            "resume": args.resume, "overwrite_checkpoint": args.overwrite_checkpoint}
 
 
 def _save(result, path, extra):

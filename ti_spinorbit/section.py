@@ -413,8 +413,8 @@ def _sampled_drifts(cols, out: RunOutput):
     end of the run (scaled units, ``_derived_columns`` with an ensemble). A non-finite
     diagnostic in any recorded sample makes the member's drift NaN, so it can never pass."""
     end_energy, end_angmom = accuracy.drifts(out.diag_start, out.diag_end)
-    e0 = out.diag_start[:, :3].sum(1)[:, None]
-    l0 = (out.diag_start[:, 3:6] + out.diag_start[:, 6:9] + out.diag_start[:, 9:12])[:, None]
+    e0, l0 = accuracy.totals(out.diag_start)
+    e0, l0 = e0[:, None], l0[:, None]
     recorded = np.isfinite(cols["t"])
     energy = cols["energy_orbit"] + cols["energy_primary"] + cols["energy_secondary"]
     angmom = cols["angmom_orbit"] + cols["angmom_primary"] + cols["angmom_secondary"]
