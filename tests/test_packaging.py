@@ -41,3 +41,18 @@ def test_init_is_idempotent_and_arch_env_override():
                          env=dict(os.environ, TI_SPINORBIT_ARCH="cpu"))
     lines = [x for x in out.stdout.strip().splitlines() if not x.startswith("[Taichi]")]
     assert lines == ["None", "cpu"]                 # nothing initialised at import time
+
+
+def test_source_checkout_finds_its_own_kernels_without_an_editable_install(tmp_path):
+    # After a plain `pip install .`, `python -m pytest` in a checkout imports the checkout's
+    # ti_spinorbit/ (the current directory comes first on sys.path), which has no kernels/
+    # subfolder: the package must find the checkout's top-level kernels/ itself, not fail
+    # (or, under an editable install, silently use another tree's).
+    import shutil
+    for d in ("ti_spinorbit", "kernels"):
+        shutil.copytree(ROOT / d, tmp_path / d, ignore=shutil.ignore_patterns("__pycache__"))
+    code = "import ti_spinorbit.kernels.tableau as k; print(k.__file__)"
+    p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                       text=True, timeout=120, env=dict(os.environ, PYTHONPATH=""))
+    assert p.returncode == 0, p.stderr
+    assert Path(p.stdout.strip().splitlines()[-1]).resolve() == (tmp_path / "kernels" / "tableau.py").resolve()

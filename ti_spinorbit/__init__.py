@@ -9,6 +9,17 @@ Importing the package does not initialise Taichi, nor even import it (so it prin
 the first computation does (CPU, f64), or call ``ti_spinorbit.init(arch=...)`` first.
 """
 
+from pathlib import Path as _Path
+
+# kernels/ lives at the top of the source tree and is installed as ti_spinorbit.kernels
+# (pyproject package-dir). When this package is imported straight from a checkout (e.g.
+# ``python -m pytest`` puts the checkout first on sys.path, ahead of an installed copy),
+# look for the subpackage there as well; an installed package has its own kernels/ and
+# never takes this branch.
+_checkout = _Path(__file__).resolve().parent.parent
+if not (_Path(__file__).parent / "kernels").is_dir() and (_checkout / "kernels" / "__init__.py").is_file():
+    __path__.append(str(_checkout))        # noqa: F821 (the package's own module __path__)
+
 from .bodies import Body, Ellipsoid, Sphere
 from .potential import mutual_potential
 from .runtime import init
