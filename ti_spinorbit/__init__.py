@@ -31,11 +31,12 @@ from .classify import classify_section
 from .libration import libration_amplitude, relaxed_libration
 from .overlap import overlap_threshold
 from .io import load, save, to_xarray
+from .initial import InitialState
 
 __version__ = "0.1.0"
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
-           "ImplausibleInputWarning", "NearCircularWarning",
+           "ImplausibleInputWarning", "NearCircularWarning", "InitialState",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
            "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray",

@@ -247,6 +247,14 @@ class BinarySystem(_display.Readable):
         y[eom.Y_S1:eom.Y_S1 + 9] = np.eye(3).ravel()
         return y
 
+    def tilted_start(self, theta_p: float, thetadot_p: float, **tilts):
+        """The paper's start (θ_p in degrees, θ̇_p in units of n) tilted out of the plane:
+        an :class:`ti_spinorbit.InitialState` (keywords roll, pitch, yaw, spin_x, spin_y,
+        inclination, primary_tilt: :func:`ti_spinorbit.initial.tilted_start`,
+        docs/physics.md §6.8)."""
+        from .initial import tilted_start
+        return tilted_start(self, theta_p, thetadot_p, **tilts)
+
     def to_physical(self, y: np.ndarray) -> np.ndarray:
         """Scaled internal state -> SI physical state [R, P, Γ1, Γ2, S, S1] (reference layout)."""
         from .kernels import eom
