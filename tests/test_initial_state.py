@@ -188,3 +188,21 @@ def test_description_round_trip(vh):
     for name in ("R", "V", "primary_attitude", "secondary_attitude", "secondary_omega"):
         np.testing.assert_array_equal(getattr(back, name), getattr(s, name))
     assert "secondary z axis 5.83° from the orbit normal" in repr(s)
+
+
+def test_kick_changes_only_the_velocity_along_the_orbit_frame(vh):
+    s = I.tilted_start(vh, 10.0, 1.0, inclination=20.0)
+    k = s.kicked([0.0, -2.7e-3, 1e-3])
+    frame = I.orbit_frame(s.R, s.V)
+    np.testing.assert_allclose(frame.T @ (k.V - s.V), [0.0, -2.7e-3, 1e-3], atol=1e-18)
+    for name in ("R", "primary_attitude", "secondary_attitude", "secondary_omega"):
+        np.testing.assert_array_equal(getattr(k, name), getattr(s, name))
+    # a circular orbit's Keplerian period changes by 3 Δv/v to first order (exact: vis-viva)
+    circ = tso.BinarySystem(vh.primary, vh.secondary, a=vh.a, e=0.0)
+    c = circ.tilted_start(0.0, 1.0)
+    v = np.linalg.norm(c.V)
+    dv = -1e-3 * v
+    kv = c.kicked([0.0, dv, 0.0])
+    mu = tso.G * circ.total_mass
+    a_new = 1.0 / (2.0 / np.linalg.norm(kv.R) - kv.V @ kv.V / mu)
+    assert (a_new / circ.a) ** 1.5 - 1.0 == pytest.approx(3 * dv / v, rel=3e-3)

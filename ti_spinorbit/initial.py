@@ -197,6 +197,18 @@ class InitialState:
                    secondary_attitude=_nearest_rotation(A1 @ S),
                    secondary_omega=(S.T @ x[9:12]) / system.secondary.moments)
 
+    def kicked(self, dv):
+        """This state after an impulsive velocity change of the secondary, e.g. an impact:
+        ``dv`` = (radial, along-track, normal) in m/s, in the orbit frame of this state
+        (:func:`orbit_frame`); a DART-like deflection is mostly along-track and negative. The
+        bodies' attitudes and spins are unchanged (a kick at a later time: integrate to it,
+        take ``InitialState.from_scaled(system, y)`` of the state reached, kick that)."""
+        dv = _finite("dv", dv, (3,))
+        return InitialState(R=self.R, V=self.V + orbit_frame(self.R, self.V) @ dv,
+                            primary_attitude=self.primary_attitude, primary_omega=self.primary_omega,
+                            secondary_attitude=self.secondary_attitude,
+                            secondary_omega=self.secondary_omega)
+
     def angular_momentum(self, system):
         """Total angular momentum about the centre of mass, inertial frame (kg m²/s):
         m R × V + A1 I1 ω1 + A2 I2 ω2 (docs/physics.md §4.2)."""

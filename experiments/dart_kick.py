@@ -1,0 +1,167 @@
+"""A post-DART-like Didymos–Dimorphos: period change, excited libration and tumbling after a kick.
+
+Beyond the paper. On 2022-09-26 NASA's DART spacecraft hit Dimorphos, the secondary of
+(65803) Didymos; the mutual orbital period fell from 11.92 h by about 33 minutes (Thagard
+et al. 2023; Thomas et al. 2023, Nature 616, 448: −33.0 ± 1.0 min), which corresponds to an
+along-track velocity change of about −2.7 mm/s (Cheng et al. 2023, Nature 616, 457). Whether
+the kick also excited Dimorphos' libration or set it tumbling depends on its shape and on the
+momentum transferred (Agrusa et al. 2021, Icarus 370, 114624, studied this excitation with a
+full-two-body code and found that it can leave the secondary librating strongly or, for some
+shapes, in non-principal-axis rotation). The script shows the same dependence; it does not
+restate their numbers.
+
+Set-up (an illustration, not a fit to the mission data): a spinning oblate primary, semi-axes
+400 × 400 × 300 m, spin period 2.26 h; the secondary an ellipsoid with the catalogue's volume
+(a·b·c = 5625 × 65 m³) and a/b ∈ {1.2, 1.3, 1.4, 1.5}, b/c ∈ {1.05, 1.15, 1.3}; a circular
+orbit of a = 1180 m with both densities scaled so the Keplerian period is 11.92 h
+(``BinarySystem(orbital_period=...)``). Each member starts in its exact synchronous
+equilibrium: long axis on the line of centres, circular speed and spin rate from the full
+fourth-order force at that position (the oblate primary and the elongated secondary make the
+orbit faster than Keplerian, by about 0.5 %), so the unkicked member neither librates nor
+drifts; then it receives at t = 0 a kick Δv along-track ∈ {0, −1, −2, −2.7, −4} mm/s
+plus an out-of-plane component ``--normal-fraction`` × |Δv| (default 0.1: DART's momentum
+transfer was not exactly in the orbit plane; it also seeds out-of-plane motion). All 60
+members run in ONE launch of the 3-D model (each with its own shape), rtol 1e-11, sampled 32
+times per orbit.
+
+Measured per member: the orbital period (slope of the unwrapped inertial longitude of the
+secondary, least squares over the run) and its change against the Δv = 0 member of the same
+shape; the Keplerian first-order estimate ΔP/P = 3 Δv/v for comparison; the largest |yaw| of
+the secondary in the orbit frame (its libration amplitude; docs/physics.md §6.9) and the
+attitude class (planar/3-D libration, circulation, tumbling).
+"""
+
+import numpy as np
+
+import _common
+
+DV_MM_S = (0.0, -1.0, -2.0, -2.7, -4.0)
+ELONGATIONS = (1.2, 1.3, 1.4, 1.5)
+FLATTENINGS = (1.05, 1.15, 1.3)          # b/c
+PERIOD_H = 11.92
+DART_DP_MIN = -33.0
+
+
+def system_for(a_over_b, b_over_c):
+    import ti_spinorbit as tso
+
+    volume = 5625.0 * 65.0                     # a b c of the catalogue's Dimorphos, m³
+    c = (volume / (a_over_b * b_over_c**2)) ** (1.0 / 3.0)
+    b = b_over_c * c
+    primary = tso.Ellipsoid(400.0, 400.0, 300.0, density=2170.0, name="Didymos (oblate)")
+    secondary = tso.Ellipsoid(a_over_b * b, b, c, density=2170.0, name="Dimorphos")
+    return tso.BinarySystem(primary, secondary, a=1180.0, e=0.0, primary_spin_period=2.26 * 3600,
+                            orbital_period=PERIOD_H * 3600, name=f"a/b {a_over_b}, b/c {b_over_c}")
+
+
+def circular_speed(system):
+    """Speed (m/s) of a circular orbit of radius a with the secondary's long axis on the line
+    of centres, from the radial component of the full (fourth-order) mutual force."""
+    import ti_spinorbit as tso
+
+    _, force, _, _ = tso.mutual_potential(system.primary, system.secondary,
+                                          np.array([system.a, 0.0, 0.0]), np.eye(3))
+    m_red = system.primary.mass * system.secondary.mass / system.total_mass
+    return float(np.sqrt(system.a * -force[0] / m_red))
+
+
+def inertial_longitude(samples):
+    """Unwrapped angle of the secondary's position in the inertial xy plane (rad)."""
+    R = samples[:, 1:4]
+    S1 = samples[:, 22:31].reshape(-1, 3, 3)
+    Rin = np.einsum("mij,mj->mi", S1, R)
+    return np.unwrap(np.arctan2(Rin[:, 1], Rin[:, 0]))
+
+
+def main():
+    def extra(p):
+        p.add_argument("--orbits", type=float, default=None, help="orbits (default 100; quick 8)")
+        p.add_argument("--normal-fraction", type=float, default=0.1,
+                       help="out-of-plane kick as a fraction of |Δv| (default 0.1)")
+
+    args, started = _common.parse(__doc__.splitlines()[0], extra=extra)
+    import matplotlib.pyplot as plt
+
+    from ti_spinorbit import attitude
+    from ti_spinorbit.ensemble import Ensemble
+
+    orbits = args.orbits or (8.0 if args.quick else 100.0)
+    shapes = [(q, r) for q in ELONGATIONS for r in FLATTENINGS]
+    if args.quick:
+        shapes = [(1.3, 1.15), (1.5, 1.3)]
+    members, par, y0 = [], [], []
+    for q, r in shapes:
+        system = system_for(q, r)
+        v_circular = circular_speed(system)
+        spin = v_circular / system.a / system.mean_motion
+        for dv in DV_MM_S:
+            state = system.tilted_start(0.0, spin)
+            kick = np.array([0.0, v_circular - system.a * system.mean_motion + 1e-3 * dv,
+                             1e-3 * args.normal_fraction * abs(dv)])
+            members.append((q, r, dv, system))
+            par.append(system.parameter_row())
+            y0.append(state.kicked(kick).to_scaled(system))
+    ens = Ensemble(np.array(par), np.array(y0), rtol=1e-11, model="3d")
+    out = ens.run(2 * np.pi * orbits, sample_dt=2 * np.pi / 32)
+    ok = out.status == 1
+    if not np.all(ok):
+        print(f"[dart_kick] {np.count_nonzero(~ok)} members stopped early: statuses "
+              f"{sorted(set(out.status.tolist()))} (kept, excluded from the table)")
+    n = members[0][3].mean_motion
+    period_h = np.full(len(members), np.nan)
+    amplitude = np.full(len(members), np.nan)
+    classes = np.full(len(members), -1, dtype=np.int8)
+    for k, s in enumerate(out.samples):
+        if not ok[k]:
+            continue
+        t = s[:, 0] / n
+        rate = np.polyfit(t, inertial_longitude(s), 1)[0]
+        period_h[k] = 2 * np.pi / rate / 3600
+        amplitude[k] = np.max(np.abs(attitude.euler_angles(s[:, 1:])[:, 2]))
+        classes[k] = attitude.classify([s[:, 1:]], members[k][3])[0]
+    base = {(q, r): period_h[k] for k, (q, r, dv, _) in enumerate(members) if dv == 0.0}
+    dp_min = np.array([(period_h[k] - base[(q, r)]) * 60 for k, (q, r, dv, _) in enumerate(members)])
+    v = members[0][3].a * n
+    kepler_min = np.array([3 * 1e-3 * dv / v * PERIOD_H * 60 for (_, _, dv, _) in members])
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.4))
+    dvs = np.array([m[2] for m in members])
+    for (q, r) in shapes:
+        sel = np.array([(m[0], m[1]) == (q, r) for m in members])
+        ax1.plot(dvs[sel], dp_min[sel], "o-", ms=3, lw=0.8, label=f"a/b {q}, b/c {r}")
+        ax2.plot(dvs[sel], amplitude[sel], "o-", ms=3, lw=0.8)
+        tumbling = sel & (classes == attitude.TUMBLING)
+        ax2.plot(dvs[tumbling], amplitude[tumbling], "kx", ms=7)
+    ax1.plot(DV_MM_S, [3e-3 * d / v * PERIOD_H * 60 for d in DV_MM_S], "k--", lw=0.8,
+             label=r"Kepler, $\Delta P/P = 3\,\Delta v/v$")
+    ax1.errorbar([-2.7], [DART_DP_MIN], yerr=[1.0], fmt="s", color="C3", ms=6,
+                 label="DART, measured (−33 ± 1 min)")
+    ax1.set_xlabel(r"along-track $\Delta v$ (mm/s)")
+    ax1.set_ylabel(r"orbital period change $\Delta P$ (min)")
+    ax1.legend(fontsize=6, ncol=2)
+    ax2.set_xlabel(r"along-track $\Delta v$ (mm/s)")
+    ax2.set_ylabel(r"largest $|$yaw$|$ after the kick (deg)")
+    ax2.set_title("x: tumbling", fontsize=8)
+    fig.suptitle(f"DART-like kick, Didymos–Dimorphos-like binary (P = {PERIOD_H} h, circular), "
+                 f"{orbits:g} orbits, rtol 1e-11, 3-D model", fontsize=9)
+    at_dart = dvs == -2.7
+    numbers = {
+        "members": len(members), "orbits": orbits,
+        "dP_at_dart_min": [round(float(x), 2) for x in dp_min[at_dart]],
+        "kepler_dP_at_dart_min": round(float(kepler_min[at_dart][0]), 2),
+        "amplitude_at_dart_deg": [round(float(x), 1) for x in amplitude[at_dart]],
+        "classes_at_dart": attitude.class_names(np.maximum(classes[at_dart], 0)),
+        "tumbling_members": int(np.count_nonzero(classes == attitude.TUMBLING)),
+        "amplitude_unkicked_max_deg": round(float(np.nanmax(amplitude[dvs == 0.0])), 3),
+    }
+    arrays = {"a_over_b": np.array([m[0] for m in members]), "b_over_c": np.array([m[1] for m in members]),
+              "dv_mm_s": dvs, "period_h": period_h, "dP_min": dp_min, "kepler_dP_min": kepler_min,
+              "amplitude_deg": amplitude, "attitude_class": classes, "status": out.status}
+    _common.save(args, "dart_kick", fig, arrays,
+                 {"orbits": orbits, "rtol": 1e-11, "normal_fraction": args.normal_fraction,
+                  "dv_mm_s": list(DV_MM_S), "shapes": shapes, "samples_per_orbit": 32,
+                  "system": members[0][3].describe()}, numbers, started)
+
+
+if __name__ == "__main__":
+    main()
