@@ -40,7 +40,6 @@ templates_path = ["_templates"]
 # --- API reference ---------------------------------------------------------------------
 autosummary_generate = True
 autodoc_typehints = "none"             # the numpydoc "Parameters" sections carry the types
-autodoc_default_options = {"members": False}
 numpydoc_show_class_members = False    # result classes are dataclasses: fields are listed in
                                        # the class docstring, methods get their own entries
 numpydoc_class_members_toctree = False
@@ -81,13 +80,65 @@ html_theme_options = {
 _LITERAL = re.compile(r"(``.+?``)")
 
 
-def _escape_bars(app, what, name, obj, options, lines):
+# Docstrings cite the Markdown pages as "docs/physics.md §8.6" (tests/test_readme_links.py
+# checks that every cited section exists): on the site those become links to the page and to
+# each section's heading anchor (myst_heading_anchors, GitHub-style slugs).
+_PAGES = ("physics", "design", "dask")
+_CITATION = re.compile(r"docs/(%s)\.md((?:[ ,;]*§[\d.]+(?:[–-][\d.]+)?)*)" % "|".join(_PAGES))
+_SECTION = re.compile(r"§([\d.]+)(?:[–-][\d.]+)?")
+
+
+def _slug(title):
+    """GitHub's (and MyST's default) heading anchor."""
+    return re.sub(r"[^\w\- ]", "", title.strip().lower()).replace(" ", "-")
+
+
+def _anchors(page):
+    """{"8.6": "86-width-of-the-chaotic-separatrix-layer", ...} for the numbered headings."""
+    text = (ROOT / "docs" / f"{page}.md").read_text(encoding="utf-8")
+    return {m.group(1).rstrip("."): _slug(m.group(0).lstrip("#"))
+            for m in re.finditer(r"^#{2,4} (\d+(?:\.\d+)*)\.?\s.*$", text, flags=re.M)}
+
+
+_ANCHORS = {page: _anchors(page) for page in _PAGES}
+
+
+def _link_citations(app, text):
+    try:
+        here = app.env.docname
+        uris = {page: app.builder.get_relative_uri(here, page) for page in _PAGES}
+    except Exception:          # not while a document is being read: leave the text as it is
+        return text
+
+    def link(m):
+        page, refs = m.group(1), m.group(2)
+        first = _SECTION.search(refs)
+        head_end = first.start() if first else len(refs)
+        out = [f"`docs/{page}.md{refs[:head_end]}"]
+        pos = head_end
+        if first is None:
+            return f"{out[0]} <{uris[page]}>`__"
+        for k, sec in enumerate(_SECTION.finditer(refs)):
+            anchor = _ANCHORS[page].get(sec.group(1).rstrip("."))
+            target = uris[page] + (f"#{anchor}" if anchor else "")
+            if k == 0:
+                out[0] += f"{sec.group(0)} <{target}>`__"
+            else:
+                out.append(refs[pos:sec.start()] + f"`{sec.group(0)} <{target}>`__")
+            pos = sec.end()
+        return "".join(out) + refs[pos:]
+
+    return _CITATION.sub(link, text)
+
+
+def _plain_text(app, what, name, obj, options, lines):
     for i, line in enumerate(lines):
-        if "|" in line:
+        if "|" in line or "docs/" in line:
             parts = _LITERAL.split(line)
             lines[i] = "".join(part if part.startswith("``") else
-                               re.sub(r"(?<!\\)\|", r"\\|", part) for part in parts)
+                               _link_citations(app, re.sub(r"(?<!\\)\|", r"\\|", part))
+                               for part in parts)
 
 
 def setup(app):
-    app.connect("autodoc-process-docstring", _escape_bars, priority=600)
+    app.connect("autodoc-process-docstring", _plain_text, priority=600)

@@ -73,3 +73,24 @@ def test_the_markdown_pages_keep_their_numbered_sections(site):
     physics = (site / "physics.html").read_text(encoding="utf-8")
     assert "6.7 Section coordinates: inertial and apsidal" in physics
     assert 'id="units-frames-and-sign-conventions"' in physics
+
+
+def test_docstring_citations_link_to_sections_that_exist(site):
+    """"docs/physics.md §8.6" in a docstring becomes a link to that heading's anchor
+    (docs/conf.py); every such link on the site lands on an id of the page it names."""
+    ids, links, broken = {}, 0, []
+    for page in site.rglob("*.html"):
+        text = page.read_text(encoding="utf-8")
+        for href in re.findall(r'href="([^":]*(?:physics|design|dask)\.html#[^"]+)"', text):
+            path, anchor = href.split("#", 1)
+            target = (page.parent / path).resolve()
+            if target not in ids:
+                ids[target] = set(re.findall(r'id="([^"]+)"', target.read_text(encoding="utf-8")))
+            links += 1
+            if anchor not in ids[target]:
+                broken.append(f"{page.relative_to(site)}: {href}")
+    assert not broken, broken[:10]
+    surface = (site / "api" / "generated" / "ti_spinorbit.surface_of_section.html").read_text(
+        encoding="utf-8")
+    assert 'href="../../physics.html#67-section-coordinates-inertial-and-apsidal"' in surface
+    assert links > 20
