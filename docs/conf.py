@@ -14,6 +14,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")   # no network for Taichi's version check
+# the gallery shows what each example prints, not Taichi's banner (printed at its import) nor
+# its "Starting on arch" line (at ti.init: _start_taichi below runs it before the examples)
+os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "false")
 
 import ti_spinorbit  # noqa: E402
 
@@ -140,5 +143,12 @@ def _plain_text(app, what, name, obj, options, lines):
                                for part in parts)
 
 
+def _start_taichi(app):
+    """Start Taichi once, before sphinx-gallery runs the examples (when it does)."""
+    if str(app.config.plot_gallery).lower() not in ("0", "false", "no", "off", ""):
+        ti_spinorbit.init()
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _plain_text, priority=600)
+    app.connect("builder-inited", _start_taichi, priority=100)   # before the gallery (500)
