@@ -49,8 +49,8 @@ numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
 
 # --- Markdown pages (physics, design, Dask) ----------------------------------------------
-myst_heading_anchors = 3               # "#6-section-coordinates"-style anchors like GitHub's
-myst_enable_extensions = ["dollarmath"]
+# GitHub's heading anchors (physics.html#67-section-coordinates-inertial-and-apsidal), down to ####
+myst_heading_anchors = 4
 
 # --- gallery: examples/plot_*.py, executed at build time ----------------------------------
 sphinx_gallery_conf = {
