@@ -17,7 +17,7 @@ import ti_spinorbit as tso
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOLS = ["sphinx", "numpydoc", "pydata_sphinx_theme", "sphinx_gallery", "myst_parser"]
 MISSING = [name for name in TOOLS if importlib.util.find_spec(name) is None]
-GENERATED = ("_build", "auto_examples", "generated", "figures", "sg_execution_times.rst")
+GENERATED = ("_build", "auto_examples", "generated", "sg_execution_times.rst")
 
 pytestmark = pytest.mark.skipif(
     bool(MISSING), reason=f"documentation tools not installed ({', '.join(MISSING)}): "
