@@ -1,0 +1,96 @@
+"""The documentation site builds with warnings as errors (issue 14 §8), quickly: the gallery's
+pages are generated but its examples are not executed (``-D plot_gallery=0``; CI's full build
+in .ci/run executes them). The build runs on a copy of docs/ and examples/ in a temporary
+folder, so the checkout gains no generated files."""
+
+import importlib.util
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+import ti_spinorbit as tso
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TOOLS = ["sphinx", "numpydoc", "pydata_sphinx_theme", "sphinx_gallery", "myst_parser"]
+MISSING = [name for name in TOOLS if importlib.util.find_spec(name) is None]
+GENERATED = ("_build", "auto_examples", "generated", "sg_execution_times.rst")
+
+pytestmark = pytest.mark.skipif(
+    bool(MISSING), reason=f"documentation tools not installed ({', '.join(MISSING)}): "
+                          'pip install -e ".[docs]"')
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    """Build the site once for this module; the HTML folder."""
+    tmp = tmp_path_factory.mktemp("docs")
+    shutil.copytree(os.path.join(ROOT, "docs"), tmp / "docs",
+                    ignore=shutil.ignore_patterns(*GENERATED))
+    shutil.copytree(os.path.join(ROOT, "examples"), tmp / "examples")
+    env = {**os.environ, "MPLBACKEND": "Agg",
+           # document this checkout's package, whatever else is installed
+           "PYTHONPATH": os.pathsep.join(filter(None, [ROOT, os.environ.get("PYTHONPATH")]))}
+    out = tmp / "html"
+    proc = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q",
+                           "-b", "html", "-D", "plot_gallery=0", str(tmp / "docs"), str(out)],
+                          cwd=tmp, env=env, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, f"sphinx -W failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-6000:]}"
+    return out
+
+
+def test_the_site_builds_with_warnings_as_errors(site):
+    index = (site / "index.html").read_text(encoding="utf-8")
+    for page in ("auto_examples/index.html", "api/index.html", "physics.html", "design.html",
+                 "dask.html"):
+        assert (site / page).is_file(), page
+        assert f'href="{page}"' in index, f"the index does not link {page}"
+
+
+def test_every_public_name_has_an_api_page(site):
+    """Everything in ti_spinorbit.__all__ (a name added there needs a line in
+    docs/api/index.rst)."""
+    missing = [name for name in tso.__all__ if name != "__version__"
+               and not (site / "api" / "generated" / f"ti_spinorbit.{name}.html").is_file()]
+    assert not missing, f"add to docs/api/index.rst: {missing}"
+
+
+def test_every_example_is_in_the_gallery(site):
+    examples = sorted(f[:-3] for f in os.listdir(os.path.join(ROOT, "examples"))
+                      if re.fullmatch(r"plot_\w+\.py", f))
+    assert len(examples) >= 5
+    gallery = (site / "auto_examples" / "index.html").read_text(encoding="utf-8")
+    for name in examples:
+        assert (site / "auto_examples" / f"{name}.html").is_file(), name
+        assert f"{name}.html" in gallery, name
+
+
+def test_the_markdown_pages_keep_their_numbered_sections(site):
+    """MyST renders docs/physics.md with its headings (the docstrings cite "§N")."""
+    physics = (site / "physics.html").read_text(encoding="utf-8")
+    assert "6.7 Section coordinates: inertial and apsidal" in physics
+    assert 'id="units-frames-and-sign-conventions"' in physics
+
+
+def test_docstring_citations_link_to_sections_that_exist(site):
+    """"docs/physics.md §8.6" in a docstring becomes a link to that heading's anchor
+    (docs/conf.py); every such link on the site lands on an id of the page it names."""
+    ids, links, broken = {}, 0, []
+    for page in site.rglob("*.html"):
+        text = page.read_text(encoding="utf-8")
+        for href in re.findall(r'href="([^":]*(?:physics|design|dask)\.html#[^"]+)"', text):
+            path, anchor = href.split("#", 1)
+            target = (page.parent / path).resolve()
+            if target not in ids:
+                ids[target] = set(re.findall(r'id="([^"]+)"', target.read_text(encoding="utf-8")))
+            links += 1
+            if anchor not in ids[target]:
+                broken.append(f"{page.relative_to(site)}: {href}")
+    assert not broken, broken[:10]
+    surface = (site / "api" / "generated" / "ti_spinorbit.surface_of_section.html").read_text(
+        encoding="utf-8")
+    assert 'href="../../physics.html#67-section-coordinates-inertial-and-apsidal"' in surface
+    assert links > 20
