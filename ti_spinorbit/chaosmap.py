@@ -34,6 +34,7 @@ from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
+from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, unit  # noqa: F401
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -91,7 +92,7 @@ def _mean_spin(section):
 
 
 @dataclass(repr=False)
-class ChaosMap(accuracy.StatusSummary, _display.Readable):
+class ChaosMap(Result, _display.Readable):
     """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
     (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
 
@@ -104,32 +105,32 @@ class ChaosMap(accuracy.StatusSummary, _display.Readable):
     spin coordinate of ``thetadot_p`` and ``mean_spin`` ("inertial" or "apsidal",
     docs/physics.md §6.7)."""
 
-    theta_p: np.ndarray
-    thetadot_p: np.ndarray
-    megno: np.ndarray
-    lyapunov: np.ndarray
-    classification: np.ndarray
-    mean_spin: np.ndarray
-    status: np.ndarray
-    chaotic_fraction: float
-    orbits: float
-    rtol: float
-    seconds: float
-    megno_chaotic: float = 4.0
+    theta_p: np.ndarray = unit('deg')
+    thetadot_p: np.ndarray = unit(SPIN)
+    megno: np.ndarray = unit('1')
+    lyapunov: np.ndarray = unit('1/orbit')
+    classification: np.ndarray = unit(CLASS)
+    mean_spin: np.ndarray = unit(SPIN)
+    status: np.ndarray = unit(STATUS)
+    chaotic_fraction: float = unit('1')
+    orbits: float = unit(ORBITS)
+    rtol: float = unit('1')
+    seconds: float = unit('s')
+    megno_chaotic: float = unit('1', default=4.0)
     section: SectionResult = field(default=None, repr=False)
-    energy_drift: np.ndarray = None
-    angmom_drift: np.ndarray = None
-    max_drift: float = float("nan")
-    n_inaccurate: int = 0
-    include_inaccurate: bool = False
-    coordinates: str = "inertial"
+    energy_drift: np.ndarray = unit(RELATIVE, default=None)
+    angmom_drift: np.ndarray = unit(RELATIVE, default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    n_inaccurate: int = unit('members', default=0)
+    include_inaccurate: bool = unit('bool', default=False)
+    coordinates: str = unit(COORDINATES, default="inertial")
     # chaotic fraction against integration length (chaos_map(fraction_orbits=...)): the
     # lengths (orbits, ascending, the map's own last) and the fraction at each; whether it
     # never decreases (⟨Y⟩ of a chaotic orbit only grows) and a one-line verdict
-    fraction_lengths: np.ndarray = None
-    fraction_by_length: np.ndarray = None
-    fraction_monotone: bool = True
-    fraction_message: str = ""
+    fraction_lengths: np.ndarray = unit(ORBITS, default=None)
+    fraction_by_length: np.ndarray = unit('1', default=None)
+    fraction_monotone: bool = unit('bool', default=True)
+    fraction_message: str = unit('text', default="")
 
     @property
     def shape(self):
@@ -345,14 +346,13 @@ def fraction_evidence(lengths, fractions):
 
 
 def _inaccurate_code():
-    """The "inaccurate" status code (imported here: importing the kernels imports Taichi,
-    which ``import ti_spinorbit`` must not)."""
-    from .kernels.ensemble import INACCURATE
-    return INACCURATE
+    """The "inaccurate" status code (:class:`ti_spinorbit.results.Status`)."""
+    from .results import Status
+    return int(Status.INACCURATE)
 
 
 @dataclass(repr=False)
-class ParameterMap(accuracy.StatusSummary, _display.Readable):
+class ParameterMap(Result, _display.Readable):
     """Chaotic fraction over elongation a/b × eccentricity e.
 
     ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
@@ -365,32 +365,32 @@ class ParameterMap(accuracy.StatusSummary, _display.Readable):
     ``chaotic_fraction`` unless ``include_inaccurate``; ``coordinates`` the spin coordinate
     of ``thetadot_p`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
-    elongations: np.ndarray
-    eccentricities: np.ndarray
-    chaotic_fraction: np.ndarray
-    megno: np.ndarray
-    labels: np.ndarray
-    status: np.ndarray
-    theta_p: np.ndarray
-    thetadot_p: np.ndarray
-    omega0: np.ndarray
-    orbits: float
-    rtol: float
-    seconds: float
+    elongations: np.ndarray = unit('1 (a/b)')
+    eccentricities: np.ndarray = unit('1')
+    chaotic_fraction: np.ndarray = unit('1')
+    megno: np.ndarray = unit('1')
+    labels: np.ndarray = unit(CLASS)
+    status: np.ndarray = unit(STATUS)
+    theta_p: np.ndarray = unit('deg')
+    thetadot_p: np.ndarray = unit(SPIN)
+    omega0: np.ndarray = unit(SPIN)
+    orbits: float = unit(ORBITS)
+    rtol: float = unit('1')
+    seconds: float = unit('s')
     name: str = ""
-    energy_drift: np.ndarray = None
-    angmom_drift: np.ndarray = None
-    max_drift: float = float("nan")
-    inaccurate: np.ndarray = None
-    include_inaccurate: bool = False
-    coordinates: str = "inertial"
+    energy_drift: np.ndarray = unit(RELATIVE, default=None)
+    angmom_drift: np.ndarray = unit(RELATIVE, default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    inaccurate: np.ndarray = unit('members', default=None)
+    include_inaccurate: bool = unit('bool', default=False)
+    coordinates: str = unit(COORDINATES, default="inertial")
     # chaotic fraction against integration length (parameter_map(fraction_orbits=...)):
     # fraction_by_length has shape (len(fraction_lengths), len(elongations),
     # len(eccentricities)); fraction_monotone per grid point; fraction_message one line
-    fraction_lengths: np.ndarray = None
-    fraction_by_length: np.ndarray = None
-    fraction_monotone: np.ndarray = None
-    fraction_message: str = ""
+    fraction_lengths: np.ndarray = unit(ORBITS, default=None)
+    fraction_by_length: np.ndarray = unit('1', default=None)
+    fraction_monotone: np.ndarray = unit('bool', default=None)
+    fraction_message: str = unit('text', default="")
 
     @property
     def member_orbits_per_second(self) -> float:

@@ -651,8 +651,9 @@ def _accuracy_status(args, status, energy_drift, max_drift, what="members"):
     start, reported per member, and do not change the exit status."""
     import numpy as np
 
-    from .kernels.ensemble import INACCURATE, NONFINITE
+    from .results import Status
 
+    INACCURATE, NONFINITE = Status.INACCURATE, Status.NONFINITE
     status = np.asarray(status)
     inaccurate = int(np.count_nonzero(status == INACCURATE))
     nonfinite = int(np.count_nonzero(status == NONFINITE))
@@ -977,9 +978,9 @@ def _cmd_energy(args):
 
 
 def _status_code(name):
-    from .kernels.ensemble import STATUS_NAMES
+    from .results import Status
 
-    return STATUS_NAMES.index(name)
+    return int(Status.from_label(name))
 
 
 def _cmd_benchmark(args):

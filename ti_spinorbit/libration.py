@@ -52,6 +52,7 @@ from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
+from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, unit  # noqa: F401
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
 DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
@@ -140,7 +141,7 @@ def _psi_A_deg(omega0, e):
 
 
 @dataclass(repr=False)
-class RelaxedLibration(_display.Readable):
+class RelaxedLibration(Result, _display.Readable):
     """Centre of the synchronous island and the relaxed-mode libration amplitude.
 
     ``center_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
@@ -156,44 +157,44 @@ class RelaxedLibration(_display.Readable):
     (``ti_spinorbit.accuracy``); ``seconds`` wall time; ``coordinates`` the spin coordinate of
     ``center_thetadot_p`` and ``candidates`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
-    center_thetadot_p: float
-    amplitude: float
-    extent: float
-    psi_A: float
-    psi_A_effective: float
-    omega0: float
-    omega0_effective: float
-    iterations: int
-    converged: bool
-    candidates: List[np.ndarray] = field(repr=False)
-    extents: List[np.ndarray] = field(repr=False)
-    orbits: float = 0.0
-    rtol: float = 1e-12
-    samples_per_orbit: int = 256
-    xtol: float = 1e-6
-    seconds: float = 0.0
+    center_thetadot_p: float = unit(SPIN)
+    amplitude: float = unit('deg')
+    extent: float = unit('deg')
+    psi_A: float = unit('deg')
+    psi_A_effective: float = unit('deg')
+    omega0: float = unit(SPIN)
+    omega0_effective: float = unit(SPIN)
+    iterations: int = unit('launches')
+    converged: bool = unit('bool')
+    candidates: List[np.ndarray] = unit(SPIN, repr=False)
+    extents: List[np.ndarray] = unit('deg', repr=False)
+    orbits: float = unit(ORBITS, default=0.0)
+    rtol: float = unit('1', default=1e-12)
+    samples_per_orbit: int = unit('1/orbit', default=256)
+    xtol: float = unit(SPIN, default=1e-6)
+    seconds: float = unit('s', default=0.0)
     system: BinarySystem = field(default=None, repr=False)
-    status: str = "done"
-    energy_drift: float = float("nan")
-    angmom_drift: float = float("nan")
-    max_drift: float = float("nan")
-    coordinates: str = "inertial"
+    status: str = unit('name', default="done")
+    energy_drift: float = unit(RELATIVE, default=float("nan"))
+    angmom_drift: float = unit(RELATIVE, default=float("nan"))
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    coordinates: str = unit(COORDINATES, default="inertial")
     # convergence evidence (relaxed_libration(converge=True)): the centre and amplitude
     # found at each length of the doubling (orbits, 2·orbits, ...) and at rtol/10 at the
     # last length; the tolerances they were held to; the verdicts and a one-line message
-    search_converged: bool = True
-    lengths: np.ndarray = None
-    centers_by_length: np.ndarray = None
-    amplitudes_by_length: np.ndarray = None
-    rtol_check: float = float("nan")
-    center_rtol_check: float = float("nan")
-    amplitude_rtol_check: float = float("nan")
-    center_tol: float = float("nan")
-    amplitude_tol: float = float("nan")
-    converged_in_orbits: bool = False
-    converged_in_tolerance: bool = False
-    convergence_checked: bool = False
-    message: str = ""
+    search_converged: bool = unit('bool', default=True)
+    lengths: np.ndarray = unit(ORBITS, default=None)
+    centers_by_length: np.ndarray = unit(SPIN, default=None)
+    amplitudes_by_length: np.ndarray = unit('deg', default=None)
+    rtol_check: float = unit('1', default=float("nan"))
+    center_rtol_check: float = unit(SPIN, default=float("nan"))
+    amplitude_rtol_check: float = unit('deg', default=float("nan"))
+    center_tol: float = unit(SPIN, default=float("nan"))
+    amplitude_tol: float = unit('deg', default=float("nan"))
+    converged_in_orbits: bool = unit('bool', default=False)
+    converged_in_tolerance: bool = unit('bool', default=False)
+    convergence_checked: bool = unit('bool', default=False)
+    message: str = unit('text', default="")
 
     def evidence(self):
         """Lines: centre and amplitude against orbits and tolerance, and the verdict."""

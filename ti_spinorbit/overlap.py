@@ -53,6 +53,7 @@ from .libration import section_extent
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
+from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, unit  # noqa: F401
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
@@ -66,28 +67,28 @@ class OverlapDecision:
     (excluded from the decision unless the scan includes them); ``max_energy_drift`` the
     largest relative energy drift among its starts."""
 
-    elongation: float
-    omega0: float
+    elongation: float = unit('1 (a/b)')
+    omega0: float = unit(SPIN)
     overlap: bool
-    center_1: float
-    center_3_2: float
+    center_1: float = unit(SPIN)
+    center_3_2: float = unit(SPIN)
     center_3_2_found: bool
-    connecting_start: Optional[float]
-    connecting_range: Optional[tuple]
-    widest_range: tuple
-    connecting_megno: float = float("nan")
-    connecting_lyapunov: float = float("nan")
-    separatrix_chaotic_fraction: float = float("nan")
-    inaccurate: int = 0
-    max_energy_drift: float = float("nan")
+    connecting_start: Optional[float] = unit(SPIN)
+    connecting_range: Optional[tuple] = unit(SPIN)
+    widest_range: tuple = unit(SPIN)
+    connecting_megno: float = unit('1', default=float("nan"))
+    connecting_lyapunov: float = unit('1/orbit', default=float("nan"))
+    separatrix_chaotic_fraction: float = unit('1', default=float("nan"))
+    inaccurate: int = unit('members', default=0)
+    max_energy_drift: float = unit(RELATIVE, default=float("nan"))
     #: the MEGNO connection criterion (see :func:`megno_connects`): None without indicators
-    megno_overlap: Optional[bool] = None
+    megno_overlap: Optional[bool] = unit('bool', default=None)
     #: orbits of the run this decision comes from
-    orbits: float = float("nan")
+    orbits: float = unit(ORBITS, default=float("nan"))
 
 
 @dataclass(repr=False)
-class OverlapScan(_display.Readable):
+class OverlapScan(Result, _display.Readable):
     """Result of :func:`overlap_threshold`.
 
     ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
@@ -99,32 +100,44 @@ class OverlapScan(_display.Readable):
     ranges ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
     name: str
-    eccentricity: float
-    elongations: np.ndarray
-    overlaps: np.ndarray
-    decisions: List[OverlapDecision]
-    first_overlap: Optional[float]
-    omega0_ro: float
-    elongation_ro: float
-    orbits: float
-    seconds: float = 0.0
+    eccentricity: float = unit('1')
+    elongations: np.ndarray = unit('1 (a/b)')
+    overlaps: np.ndarray = unit('bool')
+    decisions: List[OverlapDecision] = field(metadata={"records": OverlapDecision})
+    first_overlap: Optional[float] = unit('1 (a/b)')
+    omega0_ro: float = unit(SPIN)
+    elongation_ro: float = unit('1 (a/b)')
+    orbits: float = unit(ORBITS)
+    seconds: float = unit('s', default=0.0)
     sections: object = field(default=None, repr=False)
-    max_drift: float = float("nan")
-    n_inaccurate: int = 0
-    include_inaccurate: bool = False
-    coordinates: str = "inertial"
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    n_inaccurate: int = unit('members', default=0)
+    include_inaccurate: bool = unit('bool', default=False)
+    coordinates: str = unit(COORDINATES, default="inertial")
     # convergence in integration length (doubling; see overlap_threshold): the lengths run
     # (orbits), the geometric and MEGNO decisions at each (rows: lengths, columns:
     # elongations), the verdict, and the cost in member-orbits
-    lengths: np.ndarray = None
-    overlaps_by_length: np.ndarray = None
-    megno_overlaps_by_length: np.ndarray = None
-    converged: bool = False
-    converged_orbits: float = float("nan")
-    max_orbits: float = float("nan")
-    message: str = ""
-    megno_first_overlap: Optional[float] = None
-    member_orbits: float = float("nan")
+    lengths: np.ndarray = unit(ORBITS, default=None)
+    overlaps_by_length: np.ndarray = unit('bool (lengths x elongations)', default=None)
+    megno_overlaps_by_length: np.ndarray = unit('1 = connects, 0 = not, -1 = no indicators', default=None)
+    converged: bool = unit('bool', default=False)
+    converged_orbits: float = unit(ORBITS, default=float("nan"))
+    max_orbits: float = unit(ORBITS, default=float("nan"))
+    message: str = unit('text', default="")
+    megno_first_overlap: Optional[float] = unit('1 (a/b)', default=None)
+    member_orbits: float = unit('member x orbital periods', default=float("nan"))
+    #: integrator tolerance of every trajectory (NaN in files written before it was stored)
+    rtol: float = unit('1', default=float("nan"))
+
+    def __post_init__(self):
+        if not np.isfinite(self.rtol) and self.sections is not None:
+            self.rtol = float(self.sections.rtol)
+
+    @property
+    def status(self):
+        """Status codes of the trajectories of the first run (``sections``; empty when it
+        was not saved)."""
+        return np.zeros(0, np.int32) if self.sections is None else self.sections.status
 
     @property
     def upper_bound(self) -> bool:
@@ -367,7 +380,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
             message += (f"; the MEGNO criterion already connects at a/b = "
                         f"{', '.join(waiting)}")
     n_inaccurate = sum(accuracy.count(sec.status[block], "inaccurate") for sec, block in runs)
-    scan = OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
+    scan = OverlapScan(rtol=float(rtol), name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
                        elongation_ro=float(analytic.elongation_from_omega0(w_ro)),
                        orbits=float(ran[-1]), seconds=time.perf_counter() - t0,

@@ -24,6 +24,7 @@ from ._validate import (_as_floats, require_callable, require_count, require_fin
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
+from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, unit  # noqa: F401
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -127,7 +128,7 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
 
 
 @dataclass(repr=False)
-class SectionResult(accuracy.StatusSummary, _display.Readable):
+class SectionResult(Result, _display.Readable):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
@@ -144,32 +145,32 @@ class SectionResult(accuracy.StatusSummary, _display.Readable):
     then holds ϖ̇/n at every crossing, NaN where e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``);
     θ_p is the same in both (docs/physics.md §6.7)."""
 
-    theta_p: np.ndarray
-    thetadot_p: np.ndarray
-    t: np.ndarray
-    r: np.ndarray
-    a: np.ndarray
-    e: np.ndarray
-    count: np.ndarray
-    energy_drift: np.ndarray
-    angmom_drift: np.ndarray
-    status: np.ndarray
-    accepted: np.ndarray
-    rejected: np.ndarray
-    rhs_calls: np.ndarray
-    initial_theta_p: np.ndarray
-    initial_thetadot_p: np.ndarray
+    theta_p: np.ndarray = unit('deg')
+    thetadot_p: np.ndarray = unit(SPIN)
+    t: np.ndarray = unit('s')
+    r: np.ndarray = unit('m')
+    a: np.ndarray = unit('m')
+    e: np.ndarray = unit('1')
+    count: np.ndarray = unit('crossings')
+    energy_drift: np.ndarray = unit(RELATIVE)
+    angmom_drift: np.ndarray = unit(RELATIVE)
+    status: np.ndarray = unit(STATUS)
+    accepted: np.ndarray = unit('steps')
+    rejected: np.ndarray = unit('steps')
+    rhs_calls: np.ndarray = unit('calls')
+    initial_theta_p: np.ndarray = unit('deg')
+    initial_thetadot_p: np.ndarray = unit(SPIN)
     systems: list = field(repr=False)
-    rtol: float = 1e-12
-    atol: float = 1e-12
-    order: int = 4
-    orbits: float = 0.0
-    seconds: float = 0.0
-    megno: np.ndarray = None
-    lyapunov: np.ndarray = None
-    max_drift: float = float("nan")
-    coordinates: str = "inertial"
-    apsidal_rate: np.ndarray = None
+    rtol: float = unit('1', default=1e-12)
+    atol: float = unit('1', default=1e-12)
+    order: int = unit('potential truncation order', default=4)
+    orbits: float = unit(ORBITS, default=0.0)
+    seconds: float = unit('s', default=0.0)
+    megno: np.ndarray = unit('1', default=None)
+    lyapunov: np.ndarray = unit('1/orbit', default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    coordinates: str = unit(COORDINATES, default="inertial")
+    apsidal_rate: np.ndarray = unit(SPIN, default=None)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -318,7 +319,7 @@ def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4)
 
 
 @dataclass(repr=False)
-class TimeSeriesResult(accuracy.StatusSummary, _display.Readable):
+class TimeSeriesResult(Result, _display.Readable):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
 
     ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
@@ -334,28 +335,29 @@ class TimeSeriesResult(accuracy.StatusSummary, _display.Readable):
     line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
     e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7."""
 
-    t: np.ndarray
-    alpha: np.ndarray
-    theta: np.ndarray
-    thetadot: np.ndarray
-    r: np.ndarray
-    energy: np.ndarray
-    energy_orbit: np.ndarray
-    energy_primary: np.ndarray
-    energy_secondary: np.ndarray
-    angmom_orbit: np.ndarray
-    angmom_primary: np.ndarray
-    angmom_secondary: np.ndarray
-    status: np.ndarray
+    t: np.ndarray = unit('s')
+    alpha: np.ndarray = unit('deg')
+    theta: np.ndarray = unit('deg')
+    thetadot: np.ndarray = unit(SPIN)
+    r: np.ndarray = unit('m')
+    energy: np.ndarray = unit('J')
+    energy_orbit: np.ndarray = unit('J')
+    energy_primary: np.ndarray = unit('J')
+    energy_secondary: np.ndarray = unit('J')
+    angmom_orbit: np.ndarray = unit('kg m^2 s^-1')
+    angmom_primary: np.ndarray = unit('kg m^2 s^-1')
+    angmom_secondary: np.ndarray = unit('kg m^2 s^-1')
+    status: np.ndarray = unit(STATUS)
     systems: list = field(repr=False)
-    initial_theta_p: np.ndarray = None
-    initial_thetadot_p: np.ndarray = None
-    energy_drift: np.ndarray = None
-    angmom_drift: np.ndarray = None
-    max_drift: float = float("nan")
-    rtol: float = float("nan")
-    orbits: float = float("nan")
-    coordinates: str = "inertial"
+    initial_theta_p: np.ndarray = unit('deg', default=None)
+    initial_thetadot_p: np.ndarray = unit(SPIN, default=None)
+    energy_drift: np.ndarray = unit(RELATIVE, default=None)
+    angmom_drift: np.ndarray = unit(RELATIVE, default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    rtol: float = unit('1', default=float("nan"))
+    orbits: float = unit(ORBITS, default=float("nan"))
+    coordinates: str = unit(COORDINATES, default="inertial")
+    seconds: float = unit('s', default=0.0)
 
 
 def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
@@ -405,7 +407,7 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
         **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
-        orbits=orbits, coordinates=coordinates)
+        orbits=orbits, coordinates=coordinates, seconds=out.seconds)
 
 
 def _sampled_drifts(cols, out: RunOutput):

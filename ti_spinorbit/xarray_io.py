@@ -27,6 +27,7 @@ import os
 import numpy as np
 
 from . import io
+from .results import units as field_units
 
 INSTALL_HINT = 'to_xarray needs xarray: pip install "ti-spinorbit[xarray]"'
 
@@ -207,7 +208,7 @@ def to_xarray(result_or_path):
     else:
         result = result_or_path
     kind = io.kind_of(result)
-    units = io.units(kind)
+    units = {**io.ARCHIVE_UNITS, **field_units(result)}     # units live on the fields
     data, coords = _BUILDERS[kind](result, units)
     ds = xr.Dataset(data, coords=coords, attrs=_attrs(result, kind, metadata))
     for name, var in ds.variables.items():
