@@ -24,7 +24,7 @@ def numbers_for(prefix, starts, cls):
     """One printed entry per start: its label (and resonance for resonant orbits)."""
     out = {}
     for k, w in enumerate(starts):
-        label = cls.label[k]
+        label = cls.classification[k]
         if label == "resonant" and np.isfinite(cls.resonance_p[k]):
             label += f" p={cls.resonance_p[k]:g}"
         out[f"{prefix} {w}"] = label

@@ -23,7 +23,8 @@ Layout decisions (the README's "Saved files" section documents them for users):
   file opens with ``allow_pickle=False``; :func:`load` gives them back as ``object`` arrays.
 * ``status_names`` (the status code of each member as text) is written next to ``status``
   for readers without the package; :func:`load` ignores it.
-* Format versions: 1 is this layout; 0 is the layout :func:`save_result` wrote before
+* Format versions: 2 is this layout; 1 the same with older field names (``center_1``,
+  ``mean_spin``, ... : ``RENAMED_FIELDS``), which :func:`load` renames; 0 is the layout :func:`save_result` wrote before
   ``format_version`` existed (sections and time series only), which :func:`load` still reads.
 * Reading trusts nothing in the file: :func:`load` reads only the entries the metadata names,
   checks each entry's sizes (zip directory against the ``.npy`` header, deflate's largest
@@ -44,9 +45,19 @@ from . import runtime
 from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 
 #: Layout version written into every archive's metadata; bump it when the layout changes.
-FORMAT_VERSION = 1
-#: Versions :func:`load` reads (0: files from save_result before format_version existed).
-READABLE_FORMAT_VERSIONS = (0, 1)
+FORMAT_VERSION = 2
+#: Versions :func:`load` reads (0: files from save_result before format_version existed;
+#: 1: the same layout as 2 with the old field names of ``RENAMED_FIELDS``).
+READABLE_FORMAT_VERSIONS = (0, 1, 2)
+#: Field names of format 1 that format 2 spells in the project's one vocabulary
+#: (docs/design.md "Vocabulary"), per kind (None: every kind, records included).
+RENAMED_FIELDS = {
+    None: {"center_thetadot_p": "centre_thetadot_p", "centers_by_length": "centres_by_length",
+           "center_rtol_check": "centre_rtol_check", "center_tol": "centre_tol",
+           "center_1": "centre_1", "center_3_2": "centre_3_2",
+           "center_3_2_found": "centre_3_2_found", "mean_spin": "mean_thetadot"},
+    "parameter_map": {"labels": "classification"},
+}
 
 #: Units of the archive's own entries (not result fields). The units of every result field
 #: live on the field (``ti_spinorbit.results.unit``) and are read from there.
@@ -238,7 +249,7 @@ def _encode(result, prefix, systems, arrays, units_out, include_sections):
                             "archive representation")
         if name in table:
             units_out[key] = table[name]
-        for k, v in table.items():   # units of record fields ("decisions/center_1")
+        for k, v in table.items():   # units of record fields ("decisions/centre_1")
             if k.startswith(name + "/"):
                 units_out[prefix + k] = v
     return {k: v for k, v in block.items() if v or k in ("kind", "fields")}
@@ -442,6 +453,7 @@ def _decode(block, arrays, prefix, systems):
         raise TypeError(f"a result block is a {type(block).__name__}, not a JSON object")
     cls = _kinds()[block["kind"]]
     kwargs = dict(block.get("fields", {}))
+    renamed = {**RENAMED_FIELDS[None], **RENAMED_FIELDS.get(block["kind"], {})}
     for name in block.get("arrays", []):
         value = arrays[prefix + name]
         kwargs[name] = value.astype(object) if name in block.get("object_arrays", []) else value
@@ -454,11 +466,12 @@ def _decode(block, arrays, prefix, systems):
             kwargs[name] = [_system(systems, i) for i in arrays[prefix + ref["array"]].tolist()]
     for name, rec in block.get("records", {}).items():
         rtype = _record_types()[rec["type"]] if rec["type"] else None
-        kwargs[name] = [rtype(**{k: tuple(v) if k in rec["tuples"] and v is not None else v
-                                 for k, v in item.items()}) for item in rec["items"]]
+        kwargs[name] = [rtype(**{renamed.get(k, k): tuple(v) if k in rec["tuples"] and
+                                 v is not None else v for k, v in item.items()})
+                        for item in rec["items"]]
     for name, sub in block.get("nested", {}).items():
         kwargs[name] = _decode(sub, arrays, f"{prefix}{name}/", systems)
-    return cls(**kwargs)
+    return cls(**{renamed.get(k, k): v for k, v in kwargs.items()})   # format 1's old names
 
 
 def _upgrade_v0(path, meta, arrays):
