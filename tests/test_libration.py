@@ -151,8 +151,10 @@ def test_bad_input_names_the_parameter(decoupled, kwargs, match):
 
 
 def test_bad_system():
-    with pytest.raises(TypeError, match="BinarySystem"):
-        relaxed_libration("1991 VH")
+    with pytest.raises(TypeError, match=r"^system must be a BinarySystem or a catalogue name \(got 5\)$"):
+        relaxed_libration(5)
+    with pytest.raises(ValueError, match="^unknown system '1991 XX'"):
+        relaxed_libration("1991 XX")
     round_secondary = tso.BinarySystem(tso.Sphere(1000, 2000), tso.Sphere(20, 2000), 5000, 0.01)
     with pytest.raises(ValueError, match="elongated"):
         relaxed_libration(round_secondary)

@@ -72,7 +72,7 @@ class OverlapDecision:
     overlap: bool
     centre_1: float = unit(SPIN)
     centre_3_2: float = unit(SPIN)
-    centre_3_2_found: bool
+    centre_3_2_found: bool = unit('bool')
     connecting_start: Optional[float] = unit(SPIN)
     connecting_range: Optional[tuple] = unit(SPIN)
     widest_range: tuple = unit(SPIN)

@@ -69,29 +69,36 @@ def _axes(ax, size=(6.4, 4.8)):
     return ax
 
 
-def _legend_outside(ax, **kwargs):
-    """A legend right of the axes, so it never covers the data."""
-    return ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+def _legend_outside(ax, where="right", **kwargs):
+    """A legend outside the axes (``where`` "right" or "below"), so it never covers the
+    data."""
+    if where not in ("right", "below"):
+        raise ValueError(f"legend_loc must be 'right' or 'below' (got {where!r})")
+    place = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0)) if where == "right" else \
+        dict(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4)
+    return ax.legend(borderaxespad=0.0, **place,
                      **{"fontsize": 6, "framealpha": 0.8, **kwargs})
 
 
-def class_legend(ax, classes, **kwargs):
-    """A legend of the classes present (the paper's colours), right of the axes."""
+def class_legend(ax, classes, where="right", **kwargs):
+    """A legend of the classes present (the paper's colours), outside the axes."""
     from matplotlib.lines import Line2D
 
     present = [c for c in CLASS_ORDER if c in set(map(str, classes))]
     handles = [Line2D([], [], ls="", marker="o", ms=4, color=_class_color(c), label=c)
                for c in present]
-    return _legend_outside(ax, handles=handles, title="class", title_fontsize=6, **kwargs)
+    return _legend_outside(ax, where, handles=handles, title="class", title_fontsize=6,
+                           **kwargs)
 
 
 def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legend=True,
-                 classes=None, colorbar=True):
+                 classes=None, colorbar=True, legend_loc="right"):
     """Scatter a SectionResult: θ_p (deg) against θ̇_p/n. Colours: ``classes`` (one class name
     per member, e.g. ``classify_section(result).classification``) in the paper's colours
     with a legend of the classes; else ``colors`` (one per member, colours or class names);
     else one per member with a legend for up to ``MAX_LEGEND`` members and, above that, a
-    colourbar of the start θ̇_p(0)/n. Legends sit right of the axes. Returns the Axes."""
+    colourbar of the start θ̇_p(0)/n. Legends sit outside the axes (``legend_loc`` "right"
+    or "below"). Returns the Axes."""
     import numpy as np
 
     plt = _pyplot()
@@ -137,9 +144,9 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
     if by_start is not None and colorbar:
         ax.figure.colorbar(by_start, ax=ax, pad=0.01).set_label(START_LABEL)
     elif legend and classes is not None:
-        class_legend(ax, classes)
+        class_legend(ax, classes, legend_loc)
     elif legend and per_member:
-        _legend_outside(ax, markerscale=4)
+        _legend_outside(ax, legend_loc, markerscale=4)
     return ax
 
 
@@ -462,6 +469,22 @@ def plot_libration(result, ax=None, title=None, search=None):
                           + ("" if result.converged else " (NOT converged)"))
     ax.set_title(title, fontsize=9)
     return ax
+
+
+def figure_texts(fig):
+    """Every non-empty text of a figure (titles, axis and colourbar labels, legend entries,
+    annotations, tick labels)."""
+    from matplotlib.text import Text
+
+    return [t.get_text() for t in fig.findobj(Text) if t.get_text()]
+
+
+def raw_markup(fig):
+    """The figure's texts that show a raw ``_`` or ``^`` outside mathtext (``$...$``): labels
+    must say θ_p as ``$\\theta_p$``, never the characters."""
+    import re
+
+    return [t for t in figure_texts(fig) if re.search(r"[_^]", re.sub(r"\$[^$]*\$", "", t))]
 
 
 def save_figure(ax, path):
