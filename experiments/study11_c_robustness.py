@@ -91,7 +91,7 @@ def main():
         system = system_with_c(f)
         w_eff = analytic.omega0_effective(system)
         _, cls = section_panel(ax, system, starts, orbits,
-                               title=f"c × {f:g} (c = {190 * f:.0f} m), m1/m2 = {system.mass_ratio:.1f}")
+                               what=f"c × {f:g} (c = {190 * f:.0f} m), $m_1/m_2$ = {system.mass_ratio:.1f}")
         labels = [lab if lab != "resonant" or not np.isfinite(p) else f"resonant p={p:g}"
                   for lab, p in zip(cls.classification, cls.resonance_p)]
         cmap = tso.chaos_map(system, theta, thetadot, orbits=map_orbits, rtol=1e-10)
@@ -120,9 +120,9 @@ def main():
     summary.set_ylabel("chaotic fraction", color="C0")
     summary.set_ylim(0, 1)
     twin = summary.twinx()
-    twin.plot(x, centre, "s-", color="C3", label="synchronous island centre θ̇_p(0)/n")
+    twin.plot(x, centre, "s-", color="C3", label=r"synchronous island centre $\dot\theta_p(0)/n$")
     twin.set_ylabel(r"island centre $\dot\theta_p(0)/n$", color="C3")
-    summary.set_xlabel("c / c_nominal (density fixed)")
+    summary.set_xlabel(r"$c / c_{\rm nominal}$ (density fixed)")
     summary.set_xticks(FACTORS)
     summary.legend(loc="upper left", fontsize=8)
     twin.legend(loc="upper right", fontsize=8)

@@ -11,7 +11,6 @@ import ast
 import dataclasses
 import inspect
 import json
-import math
 import re
 import warnings
 from pathlib import Path

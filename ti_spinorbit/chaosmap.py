@@ -29,12 +29,13 @@ from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_positive, require_real,
                         require_spin, show)
 from .classify import MIN_POINTS, classify_section
-from .coordinates import THETADOT_LABEL, check_coordinates
+from .coordinates import check_coordinates
 from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
-from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, alias, renamed_keywords, unit  # noqa: F401
+from .results import (CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
+                      renamed_keywords, unit)
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 MEGNO_COLOR_RANGE = (0.0, 8.0)

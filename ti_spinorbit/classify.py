@@ -90,7 +90,7 @@ import numpy as np
 
 from ._validate import require_count, require_positive, require_range
 from .analytic import _decoupled_half_orbit
-from .results import alias
+from .results import alias, renamed_keywords
 
 #: Paper colour convention (Naidu & Margot 2015, Figs. 4–5 and 7–9).
 COLORS = {"resonant": "red", "chaotic": "blue", "quasi-periodic": "green"}
@@ -401,6 +401,7 @@ def _resonance_p(center_deg, center_thetadot, low, high, centers, tolerance_deg)
 
 
 # ---- entry points ---------------------------------------------------------------------------
+@renamed_keywords(center_tolerance_deg="centre_tolerance_deg")
 def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, *,
                     libration_gap_deg=LIBRATION_GAP_DEG, order_ratio_chaotic=ORDER_RATIO_CHAOTIC,
                     megno_chaotic=MEGNO_CHAOTIC, megno_regular=MEGNO_REGULAR,
@@ -510,6 +511,7 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
                                  megno=megno_arr, parameters=params, **out)
 
 
+@renamed_keywords(center_tolerance_deg="centre_tolerance_deg")
 def classify_section(result, megno=None, island_shift=True, include_inaccurate=False,
                      **thresholds):
     """Classify every member of a :class:`~ti_spinorbit.section.SectionResult`.
@@ -563,3 +565,8 @@ def _systems_per_member(systems, n):
             return list(systems) * n
         raise ValueError(f"systems must give one system per member ({n}), got {len(systems)}")
     return [systems] * n
+
+
+# the old vocabulary (docs/design.md "Vocabulary")
+CENTER_TOLERANCE_DEG = CENTRE_TOLERANCE_DEG
+island_centers = island_centres

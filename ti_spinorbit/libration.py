@@ -52,7 +52,7 @@ from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
-from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, alias, renamed_keywords, unit  # noqa: F401
+from .results import COORDINATES, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
 DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)

@@ -53,7 +53,7 @@ from .libration import section_extent
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
-from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, alias, renamed_keywords, unit  # noqa: F401
+from .results import COORDINATES, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0

@@ -24,7 +24,7 @@ from ._validate import (_as_floats, require_callable, require_count, require_fin
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
-from .results import CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit  # noqa: F401
+from .results import COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
