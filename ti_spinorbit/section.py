@@ -396,7 +396,7 @@ class TimeSeriesResult(Result, _display.Readable):
         Returns (numbers, series): ``numbers`` a dict of floats ("energy_drift",
         "angmom_drift", "exchange_orbit", "exchange_primary", "exchange_secondary") and
         "samples"; ``series`` (t s, ΔE/|E0|, |ΔL|/|L0|, {part: ΔE_part/|E0|}) per sample."""
-        member = require_count("member", member, 0, len(self.status) - 1)
+        member = require_count("member", member, 0, len(self.t) - 1)
         ok = np.isfinite(self.t[member])
         t = self.t[member][ok]
         energy = self.energy[member][ok]
