@@ -63,6 +63,7 @@ def save(args, name, fig, arrays, parameters, numbers, started):
 
     import ti_spinorbit as tso
     from ti_spinorbit.io import write_archive
+    from ti_spinorbit.plotting import raw_markup
 
     png = os.path.join(args.out, f"{name}.png")
     npz = os.path.join(args.out, f"{name}.npz")
@@ -74,8 +75,9 @@ def save(args, name, fig, arrays, parameters, numbers, started):
             old = texts[0]
             fig.suptitle(f"Naidu & Margot 2015, {paper}" + (f": {old}" if old else ""),
                          fontsize=10)
+    raw = raw_markup(fig)        # labels use mathtext: θ_p as $\theta_p$, never "_" or "^"
     fig.tight_layout()
-    fig.savefig(png, dpi=150)
+    fig.savefig(png, dpi=150, bbox_inches="tight")   # legends outside the axes stay in
     plt.close(fig)
     meta = {"study": name, "package_version": tso.__version__, "quick": bool(args.quick),
             "arch": tso.runtime.current_arch(),
@@ -86,6 +88,8 @@ def save(args, name, fig, arrays, parameters, numbers, started):
     what = f"Naidu & Margot 2015 {paper}: " if paper else ""
     print(f"[{name}] {what}" + ", ".join(f"{k} = {_fmt(v)}" for k, v in numbers.items()))
     print(f"[{name}] wrote {png} and {npz} in {meta['seconds']:.1f} s")
+    if raw:                      # after the files: the numbers are never lost to a label
+        raise ValueError(f"{name}: figure texts with raw '_' or '^' outside mathtext: {raw[:5]}")
     return png, npz
 
 

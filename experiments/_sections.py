@@ -4,17 +4,20 @@ convention (resonant red, chaotic blue, quasi-periodic green)."""
 import numpy as np
 
 
-def section_panel(ax, system, starts, orbits, rtol=1e-12, title=None, coordinates="apsidal"):
-    """Integrate the starts (θ_p = 0), classify, draw; returns (result, classification).
-    ``coordinates`` defaults to the paper's apsidal ones (docs/physics.md §6.7): the starts
-    θ̇_p/n are the paper's numbers."""
+def section_panel(ax, system, starts, orbits, rtol=1e-12, what=None, coordinates="apsidal"):
+    """Integrate the starts (θ_p = 0), classify, draw (the classes in the paper's colours,
+    with a legend of the classes below the panel; the title names system, a/b, e, orbits,
+    rtol, then ``what``); returns (result, classification). ``coordinates`` defaults to the
+    paper's apsidal ones (docs/physics.md §6.7): the starts θ̇_p/n are the paper's numbers."""
     import ti_spinorbit as tso
     from ti_spinorbit.classify import classify_section
+    from ti_spinorbit.plotting import run_title
 
     result = tso.surface_of_section(system, 0.0, np.array(starts, dtype=float), orbits=orbits,
                                     rtol=rtol, coordinates=coordinates)
     cls = classify_section(result)
-    result.plot(ax=ax, colors=cls.colors, markersize=1.0, legend=False, title=title)  # grey: undetermined
+    result.plot(ax=ax, classes=cls.classification, markersize=1.0, legend_loc="below",
+                title=run_title([system], orbits, rtol, what))       # grey: undetermined
     for k, w in enumerate(starts):   # label each trace by its start, at its first point
         ax.annotate(f"{w}", (result.theta_p[k, 0] + 2, result.thetadot_p[k, 0]), fontsize=6)
     return result, cls
@@ -24,7 +27,7 @@ def numbers_for(prefix, starts, cls):
     """One printed entry per start: its label (and resonance for resonant orbits)."""
     out = {}
     for k, w in enumerate(starts):
-        label = cls.label[k]
+        label = cls.classification[k]
         if label == "resonant" and np.isfinite(cls.resonance_p[k]):
             label += f" p={cls.resonance_p[k]:g}"
         out[f"{prefix} {w}"] = label

@@ -65,7 +65,7 @@ def main():
     orbits = args.orbits or (20.0 if args.quick else 40.0)
     tilt0 = 1e-4                                                    # degrees
     hyp = hyperion_system()
-    centre = tso.relaxed_libration(hyp, orbits=50, rtol=1e-11).center_thetadot_p
+    centre = tso.relaxed_libration(hyp, orbits=50, rtol=1e-11).centre_thetadot_p
     didymos = tso.catalog.system("Didymos")
     cases = [("Hyperion, synchronous centre", hyp, centre), ("Hyperion, chaotic zone", hyp, 1.6),
              ("Hyperion, 2.5 n", hyp, 2.5), ("Didymos, synchronous", didymos, 1.0)]

@@ -58,7 +58,7 @@ def main():
         arrays.update({f"{key}_theta_p": cmap.theta_p, f"{key}_thetadot_p": cmap.thetadot_p,
                        f"{key}_megno": cmap.megno, f"{key}_lyapunov": cmap.lyapunov,
                        f"{key}_classification": cmap.classification.astype("U16"),
-                       f"{key}_mean_spin": cmap.mean_spin, f"{key}_status": cmap.status})
+                       f"{key}_mean_thetadot": cmap.mean_thetadot, f"{key}_status": cmap.status})
         megno_all.append(cmap.megno[np.isfinite(cmap.megno)].ravel())
         print(f"[chaos_maps] {name}: {size}x{size} x {orbits} orbits in {cmap.seconds:.1f} s "
               f"= {cmap.member_orbits_per_second:.0f} member-orbits/s; chaotic fraction "

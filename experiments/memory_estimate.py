@@ -200,7 +200,7 @@ def main():
     ax.plot(lim, lim, "k-", lw=0.8, label="estimate = measured")
     ax.fill_between(lim, lim / 1.5, lim * 1.5, color="0.9", label="factor 1.5")
     for (label, *_), x, y in zip(rows, got, est):
-        ax.annotate(label, (x, y), fontsize=5)
+        ax.annotate(label.replace("_", " "), (x, y), fontsize=5)   # no raw "_" in figures
     ax.set_xlabel("measured peak RSS growth (MiB)")
     ax.set_ylabel("estimate before the run (MiB)")
     ax.legend(fontsize=7)

@@ -22,7 +22,7 @@ def main():
     from ti_spinorbit.overlap import overlap_vs_eccentricity
 
     if args.quick:
-        ecc, elong, kw = [0.05, 0.3], [1.01, 1.03, 1.06], dict(orbits=120, center_starts=24,
+        ecc, elong, kw = [0.05, 0.3], [1.01, 1.03, 1.06], dict(orbits=120, centre_starts=24,
                                                               separatrix_starts=12)
     else:
         ecc, elong, kw = [0.01, 0.05, 0.1, 0.2, 0.3], np.round(np.arange(1.01, 1.105, 0.01), 10), \

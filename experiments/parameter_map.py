@@ -56,7 +56,7 @@ def main():
     save(args, "parameter_map", fig,
          {"elongations": elongations, "eccentricities": eccentricities,
           "chaotic_fraction": pmap.chaotic_fraction, "megno": pmap.megno,
-          "labels": pmap.labels.astype("U16"), "status": pmap.status,
+          "labels": pmap.classification.astype("U16"), "status": pmap.status,
           "theta_p": pmap.theta_p, "thetadot_p": pmap.thetadot_p,
           "overlap_elongation": overlap},
          {"system": SYSTEM, "rtol": RTOL, "orbits": orbits, "starts": starts},

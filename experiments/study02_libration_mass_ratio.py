@@ -59,12 +59,12 @@ def main():
         system = tso.catalog.system(SYSTEM, elongation=ELONGATION, secondary_density=f * rho_s)
         lib = relaxed_libration(system, orbits=orbits, rtol=rtol, coordinates="apsidal")
         nonlinear = np.degrees(analytic.decoupled_relaxed_libration(
-            lib.omega0_effective, system.e, guess=lib.center_thetadot_p)[1])
-        row = (system.mass_ratio, lib.center_thetadot_p, lib.amplitude, abs(lib.psi_A),
+            lib.omega0_effective, system.e, guess=lib.centre_thetadot_p)[1])
+        row = (system.mass_ratio, lib.centre_thetadot_p, lib.amplitude, abs(lib.psi_A),
                nonlinear, lib.extent, lib.converged)
         for k, v in zip(keys, row):
             rows[k].append(v)
-        print(f"x{f:<5g} {system.mass_ratio:7.3f} {lib.center_thetadot_p:10.6f} "
+        print(f"x{f:<5g} {system.mass_ratio:7.3f} {lib.centre_thetadot_p:10.6f} "
               f"{lib.amplitude:9.3f} {abs(lib.psi_A):8.3f} {nonlinear:10.3f} "
               f"{lib.omega0_effective:10.4f} {lib.extent:8.1e}"
               f"{'' if lib.converged else '  search NOT converged'}")

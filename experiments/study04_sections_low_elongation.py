@@ -33,7 +33,7 @@ def main():
     for ax, (q, starts) in zip(axes, CASES.items()):
         system = tso.catalog.system("1991 VH", elongation=q)
         result, cls = section_panel(ax, system, starts, orbits,
-                                    title=f"1991 VH, a/b = {q}, ω0 = {system.omega0:.3f}",
+                                    what=rf"$\omega_0$ = {system.omega0:.3f}",
                                     coordinates=args.coordinates)
         numbers.update(numbers_for(f"a/b={q}", starts, cls))
         arrays.update(arrays_for(f"ab{q}", result))

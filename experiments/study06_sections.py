@@ -31,7 +31,7 @@ def main():
         starts = tso.catalog.section_starts(name)
         q = system.secondary.semi_axes[0] / system.secondary.semi_axes[1]
         result, cls = section_panel(ax, system, starts, orbits,
-                                    title=f"{name}, a/b = {q:.2f}, e = {system.e}, ω0 = {system.omega0:.3f}")
+                                    what=rf"$\omega_0$ = {system.omega0:.3f}")
         numbers.update(numbers_for(name, starts, cls))
         arrays.update(arrays_for(name.replace(" ", ""), result))
     save(args, "study06_sections", fig, arrays, {"orbits": orbits, "rtol": 1e-12,

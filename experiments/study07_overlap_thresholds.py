@@ -44,7 +44,7 @@ def main():
     orbits = args.orbits or (50 if args.quick else 300)
     max_orbits = args.max_orbits or (2 * orbits if args.quick else 8 * orbits)
     elong = np.round(np.arange(1.01, 1.035, 0.01) if args.quick else np.arange(1.01, 1.125, 0.01), 10)
-    kw = dict(center_starts=24, separatrix_starts=12) if args.quick else {}
+    kw = dict(centre_starts=24, separatrix_starts=12) if args.quick else {}
     fig, axes = plt.subplots(2, len(SYSTEMS), figsize=(14, 8), gridspec_kw={"height_ratios": [1, 2]})
     numbers, arrays = {}, {}
     for col, name in enumerate(SYSTEMS):
@@ -70,8 +70,8 @@ def main():
             m = lo + nc + sep
             ax.plot(sec.theta_p[m], sec.thetadot_p[m], ".", ms=1.0, color="tab:blue",
                     label=f"connecting orbit (start {d.connecting_start:.3f})")
-        ax.axhline(d.center_1, color="tab:red", lw=0.6)
-        ax.axhline(d.center_3_2, color="tab:red", lw=0.6, ls=":")
+        ax.axhline(d.centre_1, color="tab:red", lw=0.6)
+        ax.axhline(d.centre_3_2, color="tab:red", lw=0.6, ls=":")
         ax.set_xlim(0, 180)
         ax.set_xlabel(r"$\theta_p$ (deg)")
         ax.set_ylabel(rf"$\dot\theta_p/n$ ({args.coordinates})")

@@ -124,13 +124,13 @@ def main():
             if not lib.extent < MAX_CENTER_EXTENT_DEG:
                 # no stable centre on θ_p = 0 (e.g. chaos near the ω0 ≈ 1/2 libration resonance)
                 reason = (f"no island centre on theta_p = 0: smallest section extent "
-                          f"{lib.extent:.1f} deg at thetadot_p/n = {lib.center_thetadot_p:.5f} "
+                          f"{lib.extent:.1f} deg at thetadot_p/n = {lib.centre_thetadot_p:.5f} "
                           f"(omega0_eff = {lib.omega0_effective:.3f}, free libration period "
                           f"{1 / lib.omega0_effective:.2f} orbits)")
                 failures[f"{name} a/b={q}"] = reason
                 print(f"FAILED {name} a/b = {q}: {reason}")
                 continue
-            for k, v in zip(fields, (lib.center_thetadot_p, lib.amplitude, abs(lib.psi_A),
+            for k, v in zip(fields, (lib.centre_thetadot_p, lib.amplitude, abs(lib.psi_A),
                                      abs(lib.psi_A_effective), lib.extent)):
                 table[k][i, j] = v
 

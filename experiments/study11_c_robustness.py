@@ -91,17 +91,17 @@ def main():
         system = system_with_c(f)
         w_eff = analytic.omega0_effective(system)
         _, cls = section_panel(ax, system, starts, orbits,
-                               title=f"c × {f:g} (c = {190 * f:.0f} m), m1/m2 = {system.mass_ratio:.1f}")
+                               what=f"c × {f:g} (c = {190 * f:.0f} m), $m_1/m_2$ = {system.mass_ratio:.1f}")
         labels = [lab if lab != "resonant" or not np.isfinite(p) else f"resonant p={p:g}"
-                  for lab, p in zip(cls.label, cls.resonance_p)]
+                  for lab, p in zip(cls.classification, cls.resonance_p)]
         cmap = tso.chaos_map(system, theta, thetadot, orbits=map_orbits, rtol=1e-10)
         lib = relaxed_libration(system, orbits=lib_orbits, rtol=1e-12)
         for k, v in zip(rows, (system.mass_ratio, system.omega0, w_eff, cmap.chaotic_fraction,
-                               lib.center_thetadot_p, lib.amplitude, labels)):
+                               lib.centre_thetadot_p, lib.amplitude, labels)):
             rows[k].append(v)
         numbers[f"c x {f:g}"] = (f"m1/m2 {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
                                  f"omega0_eff {w_eff:.4f}, chaotic fraction "
-                                 f"{cmap.chaotic_fraction:.3f}, centre {lib.center_thetadot_p:.4f}, "
+                                 f"{cmap.chaotic_fraction:.3f}, centre {lib.centre_thetadot_p:.4f}, "
                                  f"amplitude {lib.amplitude:.2f} deg, starts {labels}")
         print(f"c x {f:<4g} {numbers[f'c x {f:g}']}")
     nominal = FACTORS.index(1.0)
@@ -120,9 +120,9 @@ def main():
     summary.set_ylabel("chaotic fraction", color="C0")
     summary.set_ylim(0, 1)
     twin = summary.twinx()
-    twin.plot(x, centre, "s-", color="C3", label="synchronous island centre θ̇_p(0)/n")
+    twin.plot(x, centre, "s-", color="C3", label=r"synchronous island centre $\dot\theta_p(0)/n$")
     twin.set_ylabel(r"island centre $\dot\theta_p(0)/n$", color="C3")
-    summary.set_xlabel("c / c_nominal (density fixed)")
+    summary.set_xlabel(r"$c / c_{\rm nominal}$ (density fixed)")
     summary.set_xticks(FACTORS)
     summary.legend(loc="upper left", fontsize=8)
     twin.legend(loc="upper right", fontsize=8)

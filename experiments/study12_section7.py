@@ -58,11 +58,11 @@ def main():
     lib_orbits = 30 if args.quick else 200
     yt1 = tso.catalog.system("2003 YT1")
     lib = relaxed_libration(yt1, orbits=lib_orbits, rtol=1e-12)
-    numbers["§7.2 2003 YT1 island centre thetadot_p(0)/n"] = round(lib.center_thetadot_p, 5)
+    numbers["§7.2 2003 YT1 island centre thetadot_p(0)/n"] = round(lib.centre_thetadot_p, 5)
     numbers["§7.2 2003 YT1 relaxed libration amplitude (deg)"] = round(lib.amplitude, 2)
     numbers["§7.2 2003 YT1 |psi_A| (deg)"] = round(abs(lib.psi_A), 2)
     numbers["§7.2 2003 YT1 search converged"] = bool(lib.converged)
-    ts = tso.time_series(yt1, 0.0, lib.center_thetadot_p, orbits=3, samples_per_orbit=256)
+    ts = tso.time_series(yt1, 0.0, lib.centre_thetadot_p, orbits=3, samples_per_orbit=256)
 
     # §7.3 -------------------------------------------------------------------------------
     grid = (4, 4) if args.quick else (24, 24)
@@ -88,7 +88,7 @@ def main():
                 ok, ext, why = False, float("nan"), "no start in 0.2–1.3 librates"
         cmap = tso.chaos_map(s, theta, thetadot, orbits=map_orbits, rtol=1e-10)
         cls = classify_section(cmap.section)         # members in the map's C order
-        lab = np.asarray(cls.label).reshape(cmap.shape)
+        lab = np.asarray(cls.classification).reshape(cmap.shape)
         p = np.asarray(cls.resonance_p).reshape(cmap.shape)
         synchronous = (lab == "resonant") & (p == 1.0)
         frac = float(np.mean(synchronous))

@@ -98,7 +98,7 @@ def main():
     for ax in axes:
         ax.legend(fontsize=8)
     axes[0].set_title(f"Paper §3: energy-check system, rtol {RTOL:.0e}, {days:g} days "
-                      f"(energy exchanged {E_exch / abs(E_orb[0]):.1e} of |E_orb|)", fontsize=9)
+                      f"(energy exchanged {E_exch / abs(E_orb[0]):.1e} of $|E_{{\\rm orb}}|$)", fontsize=9)
     save(args, "study13_energy_drift_year", fig,
          {"t_days": td, "dE_J": dE, "dLz": dL, "E_orbit_J": E_orb, "L_orbit_z": L_orb},
          {"paper": "§3", "system": system.describe(), "rtol": RTOL, "days": days,

@@ -74,7 +74,7 @@ def parameter_map():
 
 @pytest.fixture(scope="module")
 def overlap_scan():
-    return tso.overlap_threshold("2004 DC", elongations=[1.01, 1.03], orbits=5, center_starts=6,
+    return tso.overlap_threshold("2004 DC", elongations=[1.01, 1.03], orbits=5, centre_starts=6,
                                  separatrix_starts=4)
 
 

@@ -25,7 +25,7 @@ def test_shapes_and_axes(vh):
     assert isinstance(cmap, ChaosMap)
     np.testing.assert_array_equal(cmap.theta_p, [10.0, 100.0])
     np.testing.assert_array_equal(cmap.thetadot_p, [0.5, 1.5, 2.5])
-    for arr in (cmap.megno, cmap.lyapunov, cmap.classification, cmap.mean_spin, cmap.status):
+    for arr in (cmap.megno, cmap.lyapunov, cmap.classification, cmap.mean_thetadot, cmap.status):
         assert arr.shape == (2, 3)
     # indexing="ij": member [i, j] started at (theta_p[i], thetadot_p[j])
     np.testing.assert_allclose(cmap.section.initial_theta_p.reshape(2, 3)[:, 0], [10.0, 100.0])
@@ -47,7 +47,7 @@ def test_vh_map_mixes_regular_and_chaotic(vh_map):
     assert np.all(vh_map.megno[chaotic] >= 4.0)
     # the regular row's section mean spin stays between the 3:2 and 3:1 zones (forced
     # libration moves it by up to ~0.35 n from the start: measured 2.21-2.73)
-    assert np.all((vh_map.mean_spin[:, -1] > 2.0) & (vh_map.mean_spin[:, -1] < 3.0))
+    assert np.all((vh_map.mean_thetadot[:, -1] > 2.0) & (vh_map.mean_thetadot[:, -1] < 3.0))
 
 
 def test_classification_stable_under_halved_tolerance(vh, vh_map):

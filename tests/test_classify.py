@@ -13,7 +13,7 @@ import ti_spinorbit as tso
 from ti_spinorbit.analytic import omega0_effective
 from ti_spinorbit.classify import (COLORS, ORDER_RATIO_CHAOTIC, SectionClassification,
                                    classify_points, classify_section, horizontal_extent,
-                                   island_centers, libration_arc, order_ratio)
+                                   island_centres, libration_arc, order_ratio)
 
 N = 512
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
@@ -72,12 +72,12 @@ def test_synthetic_traces_are_labelled_and_stable_under_subsampling(rng, subsamp
     assert np.all(cls.order_ratio[regular] < 0.5 * ORDER_RATIO_CHAOTIC)
     assert np.all(cls.order_ratio[~regular] > 2.0 * ORDER_RATIO_CHAOTIC)
     # the island about 0 wraps through 180°: centre 0, half extent the ellipse's 25°
-    assert abs(cls.libration_center_deg[1]) < 0.5
+    assert abs(cls.libration_centre_deg[1]) < 0.5
     assert cls.libration_half_extent_deg[1] == pytest.approx(25.0, abs=0.5)
-    assert cls.libration_center_thetadot[1] == pytest.approx(1.5, abs=0.01)
-    assert abs(cls.libration_center_deg[2]) == pytest.approx(90.0, abs=0.5)
+    assert cls.libration_centre_thetadot[1] == pytest.approx(1.5, abs=0.01)
+    assert abs(cls.libration_centre_deg[2]) == pytest.approx(90.0, abs=0.5)
     assert cls.libration_half_extent_deg[2] == pytest.approx(20.0, abs=0.5)
-    assert np.all(np.isnan(cls.libration_center_deg[cls.label != "resonant"]))
+    assert np.all(np.isnan(cls.libration_centre_deg[cls.label != "resonant"]))
 
 
 def test_chain_round_the_circle_librates_but_gets_no_p():
@@ -177,7 +177,7 @@ def test_island_centers_match_an_independent_solver():
     """The 1:1 island of 1991 VH (a/b = 1.5, ω0,eff ≈ 1.03) is pushed far below 1 by the
     near-resonant forced libration; the 2:1 island sits above 2."""
     vh = tso.catalog.system("1991 VH")
-    centers = island_centers(vh, p_max=3.0)
+    centers = island_centres(vh, p_max=3.0)
     omega0 = omega0_effective(vh)
     for p, theta0 in ((1.0, 0.0), (2.0, 0.0), (2.5, 0.0), (0.5, math.pi / 2)):
         assert centers[p] == pytest.approx(decoupled_center(omega0, vh.e, p, theta0), abs=2e-3), p
@@ -200,7 +200,7 @@ def vh_section():
     one launch."""
     vh = tso.catalog.system("1991 VH")
     theta_p = [0.0, 0.0, 0.0, 0.0, 0.0, 90.0]
-    thetadot_p = [0.43, 0.83, 1.63, 2.31, 2.53, round(island_centers(vh)[0.5], 3)]
+    thetadot_p = [0.43, 0.83, 1.63, 2.31, 2.53, round(island_centres(vh)[0.5], 3)]
     return tso.surface_of_section(vh, theta_p, thetadot_p, orbits=400, rtol=1e-10)
 
 
@@ -218,13 +218,13 @@ def test_paper_starts_of_1991VH(vh_section):
     assert np.all(np.delete(cls.order_ratio, 2) < 0.2 * ORDER_RATIO_CHAOTIC)
     # same island, centred on θ_p = 0; the excited-mode amplitude grows with the distance of
     # the start from the island centre (≈ 0.45)
-    assert np.all(np.abs(cls.libration_center_deg[[0, 1, 3]]) < 1.0)
+    assert np.all(np.abs(cls.libration_centre_deg[[0, 1, 3]]) < 1.0)
     assert cls.libration_half_extent_deg[0] < 5.0 < 20.0 < cls.libration_half_extent_deg[1]
     assert cls.libration_half_extent_deg[5] < 5.0
     # the 2:1 island centre is where the decoupled problem puts it, far from 2 and 2.5
-    centers = island_centers(r.systems[0])
-    assert abs(cls.libration_center_thetadot[3] - centers[2.0]) < 0.05
-    assert abs(cls.libration_center_thetadot[5] - centers[0.5]) < 0.02
+    centers = island_centres(r.systems[0])
+    assert abs(cls.libration_centre_thetadot[3] - centers[2.0]) < 0.05
+    assert abs(cls.libration_centre_thetadot[5] - centers[0.5]) < 0.02
     assert cls.colors[:5] == [COLORS[k] for k in cls.label[:5]]
 
 

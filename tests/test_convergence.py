@@ -17,7 +17,7 @@ from ti_spinorbit.overlap import OverlapScan, _lengths, megno_connects, overlap_
 
 from conftest import run_cli
 
-STARTS = dict(center_starts=24, separatrix_starts=16)
+STARTS = dict(centre_starts=24, separatrix_starts=16)
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +67,7 @@ def test_cap_reports_not_converged_and_an_upper_bound(tmp_path):
 def test_megno_criterion_agrees_with_a_long_geometric_run():
     """1991 VH at a/b = 1.04: at 150 orbits the geometric rule sees no connection yet, the
     MEGNO criterion does; 2400 orbits later a trajectory has crossed both island levels."""
-    kw = dict(elongations=[1.04], center_starts=16, separatrix_starts=16)
+    kw = dict(elongations=[1.04], centre_starts=16, separatrix_starts=16)
     short = overlap_threshold("1991 VH", orbits=150, max_orbits=150, **kw).decisions[0]
     long = overlap_threshold("1991 VH", orbits=2400, max_orbits=2400, **kw).decisions[0]
     assert (short.overlap, short.megno_overlap) == (False, True)
@@ -136,7 +136,7 @@ def test_libration_converged_in_orbits_and_tolerance(checked):
     assert r.converged and r.search_converged and r.convergence_checked
     assert r.converged_in_orbits and r.converged_in_tolerance
     assert r.lengths.tolist() == [30.0, 60.0] and r.rtol_check == pytest.approx(1e-10)
-    assert abs(r.centers_by_length[1] - r.centers_by_length[0]) <= r.center_tol == 1e-4
+    assert abs(r.centres_by_length[1] - r.centres_by_length[0]) <= r.centre_tol == 1e-4
     assert abs(r.amplitude_rtol_check - r.amplitudes_by_length[-1]) <= r.amplitude_tol
     assert r.message == ("converged: centre and amplitude agree at 30 and 60 orbits and at "
                          "rtol 1e-09 and 1e-10")
@@ -150,7 +150,7 @@ def test_libration_tolerance_check_can_fail(decoupled, monkeypatch):
     def shifted(system, orbits, rtol, *args, **kwargs):
         out = real(system, orbits, rtol, *args, **kwargs)
         if rtol < 1e-9:
-            out.center_thetadot_p += 1e-3
+            out.centre_thetadot_p += 1e-3
         return out
 
     monkeypatch.setattr(libration, "_search", shifted)
@@ -169,7 +169,7 @@ def test_libration_cap_without_doubling_is_not_converged(decoupled):
 
 def test_libration_evidence_saved_and_loaded(checked, tmp_path):
     back = io.load(io.save(checked, tmp_path / "lib.npz"))
-    assert np.array_equal(back.centers_by_length, checked.centers_by_length)
+    assert np.array_equal(back.centres_by_length, checked.centres_by_length)
     assert np.array_equal(back.amplitudes_by_length, checked.amplitudes_by_length)
     assert (back.converged, back.message, back.rtol_check) == \
         (True, checked.message, checked.rtol_check)

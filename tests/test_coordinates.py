@@ -282,7 +282,7 @@ def test_relaxed_libration_centre_shifts_by_the_initial_apsidal_rate():
     _, par, y0, _, _ = build_members(vh, 0.0, 1.0)
     rate0 = C.states_rate(par, y0)[0]
     assert aps.coordinates == "apsidal"
-    assert aps.center_thetadot_p == pytest.approx(ine.center_thetadot_p - rate0, abs=2e-4)
+    assert aps.centre_thetadot_p == pytest.approx(ine.centre_thetadot_p - rate0, abs=2e-4)
     assert aps.amplitude == pytest.approx(ine.amplitude, abs=0.05)
 
 

@@ -73,7 +73,7 @@ def test_chaos_map_with_client_equals_local(client, vh, vh_local):
     fractions = []
     cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL, client=client,
                      progress=fractions.append)
-    for name in ("theta_p", "thetadot_p", "megno", "lyapunov", "classification", "mean_spin",
+    for name in ("theta_p", "thetadot_p", "megno", "lyapunov", "classification", "mean_thetadot",
                  "status"):
         np.testing.assert_array_equal(getattr(cmap, name), getattr(vh_local, name),
                                       err_msg=name)
@@ -114,12 +114,12 @@ def test_parameter_map_with_client_equals_local(client):
                   thetadot_p=[0.7, 1.5], theta_p=[0.0], rtol=RTOL)
     local = parameter_map("1991 VH", **kwargs)
     got = parameter_map("1991 VH", client=client, chunk_size=3, **kwargs)
-    for name in ("chaotic_fraction", "megno", "labels", "status", "theta_p", "thetadot_p"):
+    for name in ("chaotic_fraction", "megno", "classification", "status", "theta_p", "thetadot_p"):
         np.testing.assert_array_equal(getattr(got, name), getattr(local, name), err_msg=name)
 
 
 def test_overlap_scans_with_client_equal_local(client):
-    kwargs = dict(elongations=[1.01, 1.08], orbits=8, rtol=RTOL, center_starts=6,
+    kwargs = dict(elongations=[1.01, 1.08], orbits=8, rtol=RTOL, centre_starts=6,
                   separatrix_starts=4)
     local = overlap_threshold("1991 VH", **kwargs)
     got = overlap_threshold("1991 VH", client=client, **kwargs)

@@ -11,7 +11,7 @@ from ti_spinorbit.overlap import overlap_threshold
 @pytest.fixture(scope="module")
 def vh_scan():
     return overlap_threshold("1991 VH", elongations=[1.01, 1.03, 1.08], orbits=300,
-                             center_starts=32, separatrix_starts=16)
+                             centre_starts=32, separatrix_starts=16)
 
 
 def test_overlap_decision_and_monotonic(vh_scan):
@@ -21,11 +21,11 @@ def test_overlap_decision_and_monotonic(vh_scan):
     assert vh_scan.monotonic
     d = vh_scan.decisions[-1]
     lo, hi = d.connecting_range
-    assert lo <= d.center_1 and hi >= d.center_3_2          # the evidence says what it claims
+    assert lo <= d.centre_1 and hi >= d.centre_3_2          # the evidence says what it claims
     assert d.connecting_megno > 4 and d.connecting_lyapunov > 0.05   # and it is chaotic
-    assert 0.9 < d.center_1 < 1.1 and 1.4 < d.center_3_2 < 1.7
+    assert 0.9 < d.centre_1 < 1.1 and 1.4 < d.centre_3_2 < 1.7
     sep = vh_scan.decisions[0]
-    assert sep.connecting_start is None and sep.widest_range[1] < sep.center_3_2
+    assert sep.connecting_start is None and sep.widest_range[1] < sep.centre_3_2
 
 
 def test_analytic_threshold_reported(vh_scan):
@@ -45,7 +45,7 @@ def test_bad_inputs():
 def test_overlap_vs_eccentricity_reports_per_e():
     from ti_spinorbit.overlap import overlap_vs_eccentricity
     ecc, first, analytic_ab, scans = overlap_vs_eccentricity(
-        "2004 DC", [0.1, 0.3], elongations=[1.01, 1.06], orbits=150, center_starts=24,
+        "2004 DC", [0.1, 0.3], elongations=[1.01, 1.06], orbits=150, centre_starts=24,
         separatrix_starts=12)
     assert len(scans) == 2 and ecc.tolist() == [0.1, 0.3]
     assert analytic_ab[1] < analytic_ab[0]                   # overlap comes earlier at higher e

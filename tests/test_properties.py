@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 import ti_spinorbit as tso
 from ti_spinorbit import _validate, analytic
 from ti_spinorbit.classify import wrap_half_turn
-from ti_spinorbit.cli import energy_check
+from ti_spinorbit.section import TimeSeriesResult
 from ti_spinorbit.observables import derive
 from ti_spinorbit.progress import eta_seconds, format_duration
 
@@ -261,7 +261,8 @@ def test_energy_check_is_relative(scale, seed):
         fields["energy"] = sum(fields[f"energy_{p}"] for p in ("orbit", "primary", "secondary"))
         return SimpleNamespace(t=np.arange(k, dtype=float)[None], **fields)
 
-    base, scaled = energy_check(series(1.0))[0], energy_check(series(scale))[0]
+    base = TimeSeriesResult.conservation(series(1.0))[0]
+    scaled = TimeSeriesResult.conservation(series(scale))[0]
     assume(base["energy_drift"] > 0)
     for key, value in base.items():
         assert scaled[key] == pytest.approx(value, rel=1e-9)

@@ -202,7 +202,7 @@ def test_parameter_map_counts_inaccurate_starts_per_cell():
 
 
 def test_overlap_decisions_leave_inaccurate_trajectories_out():
-    kw = dict(elongations=[1.3], orbits=10, center_starts=6, separatrix_starts=4,
+    kw = dict(elongations=[1.3], orbits=10, centre_starts=6, separatrix_starts=4,
               indicators=False)
     scan = tso.overlap_threshold("1991 VH", rtol=1e-4, **kw)
     d = scan.decisions[0]

@@ -30,7 +30,9 @@ from .chaosmap import chaos_map, parameter_map
 from .classify import classify_section
 from .libration import libration_amplitude, relaxed_libration
 from .overlap import overlap_threshold
-from .io import load, save, to_xarray
+from .io import load, save
+from .xarray_io import to_xarray
+from .results import Result, Status
 from .initial import InitialState
 
 __version__ = "0.1.0"
@@ -39,5 +41,5 @@ __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_p
            "ImplausibleInputWarning", "NearCircularWarning", "InitialState",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
-           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray",
+           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray", "Result", "Status",
            "__version__"]

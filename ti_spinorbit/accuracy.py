@@ -36,6 +36,8 @@ the default with a number in (0, 1].
 
 import numpy as np
 
+from .results import STATUS_NAMES, Result, Status
+
 #: Drift limit per orbit per unit of rtol (50x what healthy runs show, see module docstring).
 DRIFT_PER_ORBIT = 1000.0
 #: Tolerance-independent ceiling of the default limit (relative drift).
@@ -78,62 +80,36 @@ def verdict(status, energy_drift, angmom_drift, limit):
     """Status codes after the accuracy check (a new int32 array): ``done`` members whose
     drift is not finite become ``non-finite``, those above ``limit`` become ``inaccurate``;
     every other status is kept."""
-    from .kernels.ensemble import DONE, INACCURATE, NONFINITE
-
     status = np.array(status, dtype=np.int32, copy=True)
     energy_drift = np.asarray(energy_drift, dtype=np.float64)
     angmom_drift = np.asarray(angmom_drift, dtype=np.float64)
-    done = status == DONE
+    done = status == Status.DONE
     finite = np.isfinite(energy_drift) & np.isfinite(angmom_drift)
-    status[done & ~finite] = NONFINITE
+    status[done & ~finite] = Status.NONFINITE
     worst = np.fmax(energy_drift, angmom_drift)
-    status[done & finite & (worst > limit)] = INACCURATE
+    status[done & finite & (worst > limit)] = Status.INACCURATE
     return status
 
 
 def usable(status, include_inaccurate=False):
     """Boolean mask of members whose results count in summaries: ``done``, plus
     ``inaccurate`` when ``include_inaccurate``."""
-    from .kernels.ensemble import DONE, INACCURATE
-
     status = np.asarray(status)
-    ok = status == DONE
-    return ok | (status == INACCURATE) if include_inaccurate else ok
+    ok = status == Status.DONE
+    return ok | (status == Status.INACCURATE) if include_inaccurate else ok
 
 
 def count(status, name):
     """Members with the status called ``name`` ("inaccurate", "done", ...)."""
-    from .kernels.ensemble import STATUS_NAMES
-
-    return int(np.count_nonzero(np.asarray(status) == STATUS_NAMES.index(name)))
+    return int(np.count_nonzero(np.asarray(status) == Status.from_label(name)))
 
 
 def counts(status):
     """{status name: members} for the statuses present, e.g. {"done": 30, "inaccurate": 2}."""
-    from .kernels.ensemble import STATUS_NAMES
-
     codes, n = np.unique(np.asarray(status).ravel(), return_counts=True)
     return {STATUS_NAMES[int(c)]: int(k) for c, k in zip(codes, n)}
 
 
-class StatusSummary:
-    """Status views shared by every result class with a ``status`` array of codes."""
-
-    @property
-    def status_names(self):
-        """Each member's status as text ("done", "inaccurate", "collision", ...), a list in
-        the order (and, flattened, the shape) of ``status``."""
-        from .kernels.ensemble import STATUS_NAMES
-
-        return [STATUS_NAMES[s] for s in np.asarray(self.status).ravel()]
-
-    @property
-    def status_counts(self) -> dict:
-        """Members per status name, e.g. {"done": 30, "inaccurate": 2}."""
-        return counts(self.status)
-
-    @property
-    def n_inaccurate(self) -> int:
-        """Members that finished with a drift above ``max_drift`` (data kept, status
-        "inaccurate")."""
-        return count(self.status, "inaccurate")
+#: The status views every result shares (kept under its old name: the protocol is
+#: :class:`ti_spinorbit.results.Result`).
+StatusSummary = Result

@@ -118,3 +118,22 @@ def heliocentric_orbit(name):
     if "heliocentric_a_au" not in d:
         return None
     return d["heliocentric_a_au"], d["heliocentric_e"]
+
+
+def as_system(system, allow_list=False):
+    """The ``system`` argument of every entry point as a BinarySystem: a catalogue name
+    (str, e.g. "1991 VH") is looked up (unknown names raise ValueError listing the known
+    ones), a BinarySystem is returned as it is; with ``allow_list`` a list of either gives a
+    list of systems. Anything else: TypeError naming what is accepted."""
+    if isinstance(system, str):
+        return globals()["system"](system)
+    if isinstance(system, BinarySystem):
+        return system
+    if allow_list and isinstance(system, (list, tuple)) and system \
+            and all(isinstance(s, (str, BinarySystem)) for s in system):
+        return [as_system(s) for s in system]
+    accepted = "a BinarySystem or a catalogue name" + (" or a non-empty list of them"
+                                                         if allow_list else "")
+    from ._validate import show
+
+    raise TypeError(f"system must be {accepted} (got {show(system)})")

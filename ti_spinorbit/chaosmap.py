@@ -29,11 +29,13 @@ from . import accuracy, analytic, catalog, resources
 from ._validate import (_as_floats, require_callable, require_positive, require_real,
                         require_spin, show)
 from .classify import MIN_POINTS, classify_section
-from .coordinates import THETADOT_LABEL, check_coordinates
+from .coordinates import check_coordinates
 from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
+from .results import (CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
+                      renamed_keywords, unit)
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -80,10 +82,10 @@ def _labels(section, megno_chaotic, orbits):
     min_points = int(min(MIN_POINTS, max(8, np.floor(0.8 * orbits))))
     # inaccurate members are labelled too (their data are kept); summaries exclude them
     return classify_section(section, megno_chaotic=megno_chaotic, min_points=min_points,
-                            geometric=False, include_inaccurate=True).label
+                            geometric=False, include_inaccurate=True).classification
 
 
-def _mean_spin(section):
+def _mean_thetadot(section):
     with np.errstate(invalid="ignore"):
         counts = section.count
         total = np.nansum(section.thetadot_p, axis=1)
@@ -91,45 +93,47 @@ def _mean_spin(section):
 
 
 @dataclass(repr=False)
-class ChaosMap(accuracy.StatusSummary, _display.Readable):
+class ChaosMap(Result, _display.Readable):
     """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
     (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
 
     ``theta_p`` initial θ_p, deg; ``thetadot_p`` initial θ̇_p/n; ``megno`` MEGNO ⟨Y⟩;
     ``lyapunov`` finite-time maximal Lyapunov exponent, 1/orbit; ``classification`` labels
-    ("resonant", "quasi-periodic", "chaotic", "undetermined"); ``mean_spin`` mean θ̇_p/n over
+    ("resonant", "quasi-periodic", "chaotic", "undetermined"); ``mean_thetadot`` mean θ̇_p/n over
     the section points; ``status`` integrator status codes (``SectionResult.status_names``); ``chaotic_fraction``
     share of finished members labelled chaotic; ``section`` the underlying SectionResult (flat
     members in the same C order); ``seconds`` wall time of the launch; ``coordinates`` the
-    spin coordinate of ``thetadot_p`` and ``mean_spin`` ("inertial" or "apsidal",
+    spin coordinate of ``thetadot_p`` and ``mean_thetadot`` ("inertial" or "apsidal",
     docs/physics.md §6.7)."""
 
-    theta_p: np.ndarray
-    thetadot_p: np.ndarray
-    megno: np.ndarray
-    lyapunov: np.ndarray
-    classification: np.ndarray
-    mean_spin: np.ndarray
-    status: np.ndarray
-    chaotic_fraction: float
-    orbits: float
-    rtol: float
-    seconds: float
-    megno_chaotic: float = 4.0
+    theta_p: np.ndarray = unit('deg')
+    thetadot_p: np.ndarray = unit(SPIN)
+    megno: np.ndarray = unit('1')
+    lyapunov: np.ndarray = unit('1/orbit')
+    classification: np.ndarray = unit(CLASS)
+    mean_thetadot: np.ndarray = unit(SPIN)
+    status: np.ndarray = unit(STATUS)
+    chaotic_fraction: float = unit('1')
+    orbits: float = unit(ORBITS)
+    rtol: float = unit('1')
+    seconds: float = unit('s')
+    megno_chaotic: float = unit('1', default=4.0)
     section: SectionResult = field(default=None, repr=False)
-    energy_drift: np.ndarray = None
-    angmom_drift: np.ndarray = None
-    max_drift: float = float("nan")
-    n_inaccurate: int = 0
-    include_inaccurate: bool = False
-    coordinates: str = "inertial"
+    energy_drift: np.ndarray = unit(RELATIVE, default=None)
+    angmom_drift: np.ndarray = unit(RELATIVE, default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    n_inaccurate: int = unit('members', default=0)
+    include_inaccurate: bool = unit('bool', default=False)
+    coordinates: str = unit(COORDINATES, default="inertial")
     # chaotic fraction against integration length (chaos_map(fraction_orbits=...)): the
     # lengths (orbits, ascending, the map's own last) and the fraction at each; whether it
     # never decreases (⟨Y⟩ of a chaotic orbit only grows) and a one-line verdict
-    fraction_lengths: np.ndarray = None
-    fraction_by_length: np.ndarray = None
-    fraction_monotone: bool = True
-    fraction_message: str = ""
+    fraction_lengths: np.ndarray = unit(ORBITS, default=None)
+    fraction_by_length: np.ndarray = unit('1', default=None)
+    fraction_monotone: bool = unit('bool', default=True)
+    fraction_message: str = unit('text', default="")
+
+    mean_spin = alias("mean_thetadot")      # old name (read-only)
 
     @property
     def shape(self):
@@ -142,72 +146,13 @@ class ChaosMap(accuracy.StatusSummary, _display.Readable):
 
     def plot(self, ax=None, quantity="megno", overlay=False, overlay_members=64, colorbar=True,
              title=None):
-        """pcolormesh of MEGNO (clipped to 0-8; 2 = regular), the Lyapunov exponent
-        (``quantity="lyapunov"``, 1/orbit) or the labels (``"classification"``) over θ_p (x,
-        deg) and θ̇_p/n (y). ``overlay=True`` adds the section points of up to
-        ``overlay_members`` evenly spaced members as small black dots. Returns the Axes."""
-        import matplotlib.pyplot as plt
-        from matplotlib.colors import ListedColormap
+        """pcolormesh of MEGNO (colours 0-8, the colourbar's top marks ⟨Y⟩ ≥ 8), the Lyapunov
+        exponent (``quantity="lyapunov"``) or the classes (``"classification"``) over θ_p and
+        θ̇_p/n: :func:`ti_spinorbit.plotting.plot_chaos_map`. Returns the Axes."""
+        from .plotting import plot_chaos_map
 
-        if ax is None:
-            _, ax = plt.subplots(figsize=(6.4, 4.8), dpi=150)
-        x, y = _edges(self.theta_p, 0.0, 180.0), _edges(self.thetadot_p)
-        if quantity == "megno":
-            z, kw, label = self.megno, dict(cmap="magma", vmin=MEGNO_COLOR_RANGE[0],
-                                            vmax=MEGNO_COLOR_RANGE[1]), r"MEGNO $\langle Y\rangle$"
-            z = np.clip(z, *MEGNO_COLOR_RANGE)
-        elif quantity == "lyapunov":
-            z, kw, label = self.lyapunov, dict(cmap="magma", vmin=0.0), r"$\lambda$ (1/orbit)"
-        elif quantity == "classification":
-            from .classify import COLORS
-            order = ["resonant", "quasi-periodic", "chaotic", "undetermined"]
-            z = np.vectorize(order.index)(self.classification).astype(float)
-            kw = dict(cmap=ListedColormap([COLORS.get(k, "0.7") for k in order]), vmin=-0.5,
-                      vmax=3.5)
-            label = "class"
-        else:
-            raise ValueError(f"quantity must be 'megno', 'lyapunov' or 'classification' "
-                             f"(got {quantity!r})")
-        mesh = ax.pcolormesh(x, y, z.T, shading="flat", **kw)
-        if colorbar:
-            cb = ax.figure.colorbar(mesh, ax=ax, pad=0.01)
-            cb.set_label(label)
-            if quantity == "classification":
-                cb.set_ticks(range(4))
-                cb.set_ticklabels(order)
-        if overlay and self.section is not None:
-            sec = self.section
-            pick = np.unique(np.linspace(0, len(sec.count) - 1,
-                                         min(overlay_members, len(sec.count))).astype(int))
-            ax.plot(sec.theta_p[pick].ravel(), sec.thetadot_p[pick].ravel(), ".", ms=0.6,
-                    color="k", alpha=0.6, rasterized=True)
-        ax.set_xlim(0, 180)
-        ax.set_ylim(y[0], y[-1])
-        ax.set_xticks(range(0, 181, 30))
-        ax.set_xlabel(r"$\theta_p$ (deg)")
-        ax.set_ylabel(THETADOT_LABEL[self.coordinates])
-        if title is None and self.section is not None:
-            s = self.section.systems[0]
-            title = (f"{s.name}, {self.orbits:g} orbits, rtol {self.rtol:.0e}, chaotic "
-                     f"fraction {self.chaotic_fraction:.2f}")
-            if self.n_inaccurate:
-                title += (f" ({self.n_inaccurate} inaccurate members "
-                          f"{'included' if self.include_inaccurate else 'excluded'})")
-        if title:
-            ax.set_title(title, fontsize=9)
-        return ax
-
-
-def _edges(centres, low=None, high=None):
-    """Cell edges for pcolormesh from cell centres (midpoints; outer cells mirrored)."""
-    c = np.asarray(centres, dtype=np.float64)
-    if c.size == 1:
-        half = 0.5 if low is None else 0.5 * (high - low)
-        e = np.array([c[0] - half, c[0] + half])
-    else:
-        mid = 0.5 * (c[1:] + c[:-1])
-        e = np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
-    return e
+        return plot_chaos_map(self, ax=ax, quantity=quantity, overlay=overlay,
+                              overlay_members=overlay_members, colorbar=colorbar, title=title)
 
 
 def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, megno_chaotic=4.0,
@@ -220,7 +165,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
 
     Parameters
     ----------
-    system : BinarySystem
+    system : BinarySystem or str
+        The system, or a catalogue name (``ti_spinorbit.catalog``).
     theta_p : 1-D array
         Initial θ_p values, deg (x axis of the map).
     thetadot_p : 1-D array
@@ -266,8 +212,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     ChaosMap
     """
     check_coordinates(coordinates)
-    if not isinstance(system, BinarySystem):
-        raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
+    system = catalog.as_system(system)
     theta_p = _axis("theta_p", theta_p)
     thetadot_p = require_spin("thetadot_p", _axis("thetadot_p", thetadot_p))
     check_orbits(orbits)
@@ -303,7 +248,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     return ChaosMap(
         theta_p=theta_p, thetadot_p=thetadot_p, megno=section.megno.reshape(shape),
         lyapunov=section.lyapunov.reshape(shape), classification=labels.reshape(shape),
-        mean_spin=_mean_spin(section).reshape(shape), status=section.status.reshape(shape),
+        mean_thetadot=_mean_thetadot(section).reshape(shape), status=section.status.reshape(shape),
         chaotic_fraction=_chaotic_fraction(labels, section.status, include_inaccurate),
         orbits=float(orbits), rtol=float(rtol), seconds=seconds,
         megno_chaotic=float(megno_chaotic), section=section,
@@ -345,18 +290,17 @@ def fraction_evidence(lengths, fractions):
 
 
 def _inaccurate_code():
-    """The "inaccurate" status code (imported here: importing the kernels imports Taichi,
-    which ``import ti_spinorbit`` must not)."""
-    from .kernels.ensemble import INACCURATE
-    return INACCURATE
+    """The "inaccurate" status code (:class:`ti_spinorbit.results.Status`)."""
+    from .results import Status
+    return int(Status.INACCURATE)
 
 
 @dataclass(repr=False)
-class ParameterMap(accuracy.StatusSummary, _display.Readable):
+class ParameterMap(Result, _display.Readable):
     """Chaotic fraction over elongation a/b × eccentricity e.
 
     ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
-    (len(elongations), len(eccentricities)); ``megno``, ``labels``, ``status`` per start,
+    (len(elongations), len(eccentricities)); ``megno``, ``classification``, ``status`` per start,
     shape (len(elongations), len(eccentricities), starts); ``theta_p`` (deg) and
     ``thetadot_p`` (units of n) the starts used at every grid point; ``omega0`` ω0(a/b) of the
     ellipsoid; ``seconds`` wall time of the one launch; ``energy_drift``, ``angmom_drift``
@@ -365,78 +309,49 @@ class ParameterMap(accuracy.StatusSummary, _display.Readable):
     ``chaotic_fraction`` unless ``include_inaccurate``; ``coordinates`` the spin coordinate
     of ``thetadot_p`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
-    elongations: np.ndarray
-    eccentricities: np.ndarray
-    chaotic_fraction: np.ndarray
-    megno: np.ndarray
-    labels: np.ndarray
-    status: np.ndarray
-    theta_p: np.ndarray
-    thetadot_p: np.ndarray
-    omega0: np.ndarray
-    orbits: float
-    rtol: float
-    seconds: float
+    elongations: np.ndarray = unit('1 (a/b)')
+    eccentricities: np.ndarray = unit('1')
+    chaotic_fraction: np.ndarray = unit('1')
+    megno: np.ndarray = unit('1')
+    classification: np.ndarray = unit(CLASS)
+    status: np.ndarray = unit(STATUS)
+    theta_p: np.ndarray = unit('deg')
+    thetadot_p: np.ndarray = unit(SPIN)
+    omega0: np.ndarray = unit(SPIN)
+    orbits: float = unit(ORBITS)
+    rtol: float = unit('1')
+    seconds: float = unit('s')
     name: str = ""
-    energy_drift: np.ndarray = None
-    angmom_drift: np.ndarray = None
-    max_drift: float = float("nan")
-    inaccurate: np.ndarray = None
-    include_inaccurate: bool = False
-    coordinates: str = "inertial"
+    energy_drift: np.ndarray = unit(RELATIVE, default=None)
+    angmom_drift: np.ndarray = unit(RELATIVE, default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    inaccurate: np.ndarray = unit('members', default=None)
+    include_inaccurate: bool = unit('bool', default=False)
+    coordinates: str = unit(COORDINATES, default="inertial")
     # chaotic fraction against integration length (parameter_map(fraction_orbits=...)):
     # fraction_by_length has shape (len(fraction_lengths), len(elongations),
     # len(eccentricities)); fraction_monotone per grid point; fraction_message one line
-    fraction_lengths: np.ndarray = None
-    fraction_by_length: np.ndarray = None
-    fraction_monotone: np.ndarray = None
-    fraction_message: str = ""
+    fraction_lengths: np.ndarray = unit(ORBITS, default=None)
+    fraction_by_length: np.ndarray = unit('1', default=None)
+    fraction_monotone: np.ndarray = unit('bool', default=None)
+    fraction_message: str = unit('text', default="")
 
     @property
     def member_orbits_per_second(self) -> float:
         return float(self.orbits * self.megno.size / self.seconds) if self.seconds else float("nan")
 
+    labels = alias("classification")        # old name (read-only)
+
     def plot(self, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=True, title=None):
-        """pcolormesh of the chaotic fraction over (e, a/b), with the analytic overlap line
-        a/b(ω0^RO(e)) and contours of the chaotic-layer half-width ΔE/E0(ω0(a/b), e)
-        (14π form as quoted). Returns the Axes."""
-        import matplotlib.pyplot as plt
+        """pcolormesh of the chaotic fraction over (e, a/b) with the analytic overlap line and
+        chaotic-layer contours: :func:`ti_spinorbit.plotting.plot_parameter_map`."""
+        from .plotting import plot_parameter_map
 
-        if ax is None:
-            _, ax = plt.subplots(figsize=(6.4, 4.8), dpi=150)
-        x = np.clip(_edges(self.eccentricities), 0.0, 0.999)  # physical ranges only
-        y = np.maximum(_edges(self.elongations), 1.0)
-        mesh = ax.pcolormesh(x, y, self.chaotic_fraction, shading="flat", cmap="viridis",
-                             vmin=0.0, vmax=1.0)
-        if colorbar:
-            ax.figure.colorbar(mesh, ax=ax, pad=0.01).set_label("chaotic fraction")
-        e_fine = np.linspace(max(x[0], 0.0), min(x[-1], 0.99), 200)
-        ax.plot(e_fine, analytic.overlap_elongation(e_fine), "w--", lw=1.5,
-                label=r"$\omega_0 = \omega_0^{RO}(e)$")
-        q_fine = np.linspace(max(y[0], 1.001), y[-1], 200)  # ω0(1) = 0: no layer
-        ee, qq = np.meshgrid(e_fine, q_fine)
-        with np.errstate(all="ignore"):
-            width = analytic.chaotic_layer_half_width(analytic.omega0(qq), np.maximum(ee, 1e-12))
-        if contours:
-            cs = ax.contour(ee, qq, width, levels=sorted(contours), colors="w", linewidths=0.7,
-                            alpha=0.8)
-            ax.clabel(cs, fmt=lambda v: f"ΔE/E0={v:g}", fontsize=6)
-        ax.set_xlim(x[0], x[-1])
-        ax.set_ylim(y[0], y[-1])
-        ax.set_xlabel("e")
-        ax.set_ylabel("a/b")
-        ax.legend(fontsize=7, loc="lower right", framealpha=0.5)
-        if title is None:
-            title = (f"{self.name}: chaotic fraction of {self.megno.shape[-1]} starts, "
-                     f"{self.orbits:g} orbits")
-            if self.n_inaccurate:
-                title += (f" ({self.n_inaccurate} inaccurate starts "
-                          f"{'included' if self.include_inaccurate else 'excluded'})")
-        ax.set_title(title, fontsize=9)
-        return ax
+        return plot_parameter_map(self, ax=ax, contours=contours, colorbar=colorbar, title=title)
 
 
-def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySystem]],
+@renamed_keywords(factory_or_name="system")
+def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
@@ -447,7 +362,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
 
     Parameters
     ----------
-    factory_or_name : str or callable
+    system : str or callable
         A catalogue name (``catalog.system(name, elongation=q, eccentricity=e)``) or a
         function ``(q, e) -> BinarySystem``.
     elongations, eccentricities : 1-D arrays
@@ -484,13 +399,14 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
-    if isinstance(factory_or_name, str):
-        name = factory_or_name
+    if isinstance(system, str):
+        name = system
         factory = lambda q, e: catalog.system(name, elongation=q, eccentricity=e)  # noqa: E731
-    elif callable(factory_or_name):
-        factory, name = factory_or_name, ""
+    elif callable(system):
+        factory, name = system, ""
     else:
-        raise TypeError("factory_or_name must be a catalogue name or a callable (q, e) -> system")
+        raise TypeError("system must be a catalogue name or a callable (a/b, e) -> "
+                        f"BinarySystem (got {show(system)})")
     tp, td = (x.ravel() for x in np.meshgrid(theta_p, thetadot_p, indexing="ij"))
     starts = tp.size
     resources.check_memory("parameter_map", elongations.size * eccentricities.size * starts,
@@ -533,7 +449,7 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
                   "(not converged there)"))
     return ParameterMap(
         elongations=elongations, eccentricities=eccentricities, chaotic_fraction=fraction,
-        megno=section.megno.reshape(shape), labels=labels, status=status, theta_p=tp,
+        megno=section.megno.reshape(shape), classification=labels, status=status, theta_p=tp,
         thetadot_p=td, omega0=np.asarray(analytic.omega0(elongations)), orbits=float(orbits),
         rtol=float(rtol), seconds=seconds, name=name,
         energy_drift=section.energy_drift.reshape(shape),

@@ -405,3 +405,27 @@ def load(path, settings, fingerprint):
             for i, part in zip(members, np.split(data, np.cumsum(counts)[:-1])):
                 state[name][int(i)].append(part)
     return state
+
+
+class Launches:
+    """Checkpoints of a computation made of several ensemble launches (overlap_threshold's
+    doubling, relaxed_libration's search): launch k checkpoints into ``DIR/launch-kkk``. The
+    launches of a computation are the same on every run of it, so resuming resumes each in
+    turn: a finished launch's checkpoint gives its result back without integrating, the
+    interrupted one continues, later ones start afresh. ``next()`` gives the keywords of the
+    next launch ({} without a directory)."""
+
+    def __init__(self, directory, resume=False, overwrite=False):
+        self.directory = None if directory is None else os.fspath(directory)
+        self.resume, self.overwrite, self.count = bool(resume), bool(overwrite), 0
+        if self.directory is not None and os.path.exists(self.directory) \
+                and not os.path.isdir(self.directory):
+            raise CheckpointError(f"checkpoint {self.directory!r} is a file, not a directory "
+                                  "of launch checkpoints; choose another path or delete it")
+
+    def next(self):
+        if self.directory is None:
+            return {}
+        path = os.path.join(self.directory, f"launch-{self.count:03d}")
+        self.count += 1
+        return {"checkpoint": path, "resume": self.resume, "overwrite_checkpoint": self.overwrite}

@@ -34,11 +34,11 @@ The rule, per member; it needs only the section points in time order:
    libration centre is the middle of the occupied arc; the half extent is half that arc, in
    deg. For an island this is the horizontal half extent of its trace, the excited-mode
    amplitude of docs/physics.md §9.1.
-4. **Which resonance.** p is assigned only to a trace centred within ``center_tolerance_deg``
+4. **Which resonance.** p is assigned only to a trace centred within ``centre_tolerance_deg``
    of θ_p = 0 (candidates p = 1, 3/2, 2, ...: Cayley H(p, e) > 0) or of 90° (p = 1/2:
    H(1/2, e) < 0), and only when its largest gap is at least ``dominant_gap_ratio`` times the
    second largest. Chains of a higher-order resonance, spread round the circle, get p = NaN.
-   * The island's centre in θ̇_p/n (``libration_center_thetadot``) is estimated as the middle
+   * The island's centre in θ̇_p/n (``libration_centre_thetadot``) is estimated as the middle
      of the θ̇_p range of the points near the trace's symmetry line.
    * That centre is *not* p. At pericentre the forced libration shifts it, strongly when ω0 is
      close to 1. For 1991 VH at a/b = 1.5 the 1:1 island sits at θ̇_p/n ≈ 0.45 and the 2:1
@@ -90,6 +90,7 @@ import numpy as np
 
 from ._validate import require_count, require_positive, require_range
 from .analytic import _decoupled_half_orbit
+from .results import alias, renamed_keywords
 
 #: Paper colour convention (Naidu & Margot 2015, Figs. 4–5 and 7–9).
 COLORS = {"resonant": "red", "chaotic": "blue", "quasi-periodic": "green"}
@@ -106,7 +107,7 @@ MEGNO_REGULAR = 2.5
 #: Fewer section points than this: undetermined.
 MIN_POINTS = 64
 #: A confined trace centred within this of θ_p = 0° or 90° (deg) gets a resonance p ...
-CENTER_TOLERANCE_DEG = 20.0
+CENTRE_TOLERANCE_DEG = 20.0
 #: ... if its largest empty arc is at least this many times the second largest.
 DOMINANT_GAP_RATIO = 2.0
 
@@ -126,24 +127,24 @@ _EXACT_PAIRS_MAX = 2000
 class SectionClassification:
     """Per-member classification of a surface of section (arrays of length N).
 
-    ``label`` one of "resonant", "quasi-periodic", "chaotic", "undetermined";
-    ``label_geometric`` the same from the section points alone (before any MEGNO);
+    ``classification`` one of "resonant", "quasi-periodic", "chaotic", "undetermined";
+    ``classification_geometric`` the same from the section points alone (before any MEGNO);
     ``resonance_p`` p of the p:1 resonance (1 = synchronous, 1.5, 2, ...; 0.5), NaN unless
-    resonant and centred on θ_p = 0° or 90°; ``libration_center_deg`` middle of the occupied
+    resonant and centred on θ_p = 0° or 90°; ``libration_centre_deg`` middle of the occupied
     θ_p arc, deg in (−90, 90], and ``libration_half_extent_deg`` half its width, deg (the
     excited-mode amplitude), both NaN for traces that run round the circle;
-    ``libration_center_thetadot`` island centre in θ̇_p/n (see the module notes), NaN unless
+    ``libration_centre_thetadot`` island centre in θ̇_p/n (see the module notes), NaN unless
     confined; ``mean_thetadot`` mean θ̇_p/n over the section points; ``largest_gap_deg``
     largest empty arc of θ_p, deg; ``order_ratio`` the regularity score (≲ 0.1 regular,
     ≳ 0.4 chaotic); ``count`` section points used; ``megno`` the indicator passed in (NaN if
     none). ``COLORS`` maps labels to the paper's colours."""
 
-    label: np.ndarray
-    label_geometric: np.ndarray
+    classification: np.ndarray
+    classification_geometric: np.ndarray
     resonance_p: np.ndarray
-    libration_center_deg: np.ndarray
+    libration_centre_deg: np.ndarray
     libration_half_extent_deg: np.ndarray
-    libration_center_thetadot: np.ndarray
+    libration_centre_thetadot: np.ndarray
     mean_thetadot: np.ndarray
     largest_gap_deg: np.ndarray
     order_ratio: np.ndarray
@@ -153,14 +154,20 @@ class SectionClassification:
 
     COLORS: ClassVar[Dict[str, str]] = COLORS
 
+    # the old vocabulary, read-only (docs/design.md "Vocabulary")
+    label = alias("classification")
+    label_geometric = alias("classification_geometric")
+    libration_center_deg = alias("libration_centre_deg")
+    libration_center_thetadot = alias("libration_centre_thetadot")
+
     @property
     def colors(self):
         """One colour per member in the paper's convention (grey when undetermined)."""
-        return [COLORS.get(lab, "grey") for lab in self.label]
+        return [COLORS.get(lab, "grey") for lab in self.classification]
 
     def counts(self) -> Dict[str, int]:
         """Number of members per label."""
-        return {lab: int(np.sum(self.label == lab)) for lab in LABELS}
+        return {lab: int(np.sum(self.classification == lab)) for lab in LABELS}
 
 
 def wrap_half_turn(angle_deg):
@@ -347,7 +354,7 @@ def _decoupled_centers(omega0, e, two_p_max, steps=1024, dw=0.005):
     return out
 
 
-def island_centers(system, p_max=6.0):
+def island_centres(system, p_max=6.0):
     """Decoupled-problem island centres θ̇_p/n at pericentre for p = 1/2, 1, 3/2, ..., p_max,
     with ω0,eff² = ω0² m1/(m1 + m2) and the system's e (see the module notes).
 
@@ -394,10 +401,11 @@ def _resonance_p(center_deg, center_thetadot, low, high, centers, tolerance_deg)
 
 
 # ---- entry points ---------------------------------------------------------------------------
+@renamed_keywords(center_tolerance_deg="centre_tolerance_deg")
 def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, *,
                     libration_gap_deg=LIBRATION_GAP_DEG, order_ratio_chaotic=ORDER_RATIO_CHAOTIC,
                     megno_chaotic=MEGNO_CHAOTIC, megno_regular=MEGNO_REGULAR,
-                    min_points=MIN_POINTS, center_tolerance_deg=CENTER_TOLERANCE_DEG,
+                    min_points=MIN_POINTS, centre_tolerance_deg=CENTRE_TOLERANCE_DEG,
                     dominant_gap_ratio=DOMINANT_GAP_RATIO, geometric=True):
     """Classify section traces given as arrays (see the module notes for the rule).
 
@@ -421,7 +429,7 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
         MEGNO thresholds (chaotic at or above, regular at or below).
     min_points : int
         Fewer section points: undetermined.
-    center_tolerance_deg : float
+    centre_tolerance_deg : float
         A confined trace centred within this of 0° or 90° gets a resonance p.
     dominant_gap_ratio : float
         ... and only if its largest empty arc is at least this many times the second largest
@@ -440,7 +448,7 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
     require_positive("order_ratio_chaotic", order_ratio_chaotic)
     require_range("megno_regular", megno_regular, 0.0, megno_chaotic, high_open=False)
     min_points = require_count("min_points", min_points, minimum=8)
-    require_range("center_tolerance_deg", center_tolerance_deg, 0.0, 45.0)
+    require_range("centre_tolerance_deg", centre_tolerance_deg, 0.0, 45.0)
     require_range("dominant_gap_ratio", dominant_gap_ratio, 1.0, math.inf)
     theta_all = np.atleast_2d(np.asarray(theta_p, dtype=np.float64))
     thetadot_all = np.atleast_2d(np.asarray(thetadot_p, dtype=np.float64))
@@ -457,8 +465,8 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
     p_max = max(3.0, math.ceil(float(finite.max())) + 1.0) if finite.size else 3.0  # candidates
 
     out = {k: np.full(n, np.nan) for k in (
-        "resonance_p", "libration_center_deg", "libration_half_extent_deg",
-        "libration_center_thetadot", "mean_thetadot", "largest_gap_deg", "order_ratio")}
+        "resonance_p", "libration_centre_deg", "libration_half_extent_deg",
+        "libration_centre_thetadot", "mean_thetadot", "largest_gap_deg", "order_ratio")}
     label = np.full(n, "undetermined", dtype=object)
     label_geometric = np.full(n, "undetermined", dtype=object)
     count = np.zeros(n, dtype=int)
@@ -474,9 +482,9 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
         out["largest_gap_deg"][i] = gap
         confined = gap > libration_gap_deg
         if confined:
-            out["libration_center_deg"][i] = center
+            out["libration_centre_deg"][i] = center
             out["libration_half_extent_deg"][i] = half
-            out["libration_center_thetadot"][i] = _center_thetadot(theta, thetadot, center, half)
+            out["libration_centre_thetadot"][i] = _center_thetadot(theta, thetadot, center, half)
         chaotic = False
         if geometric or not (megno_arr[i] >= megno_chaotic or megno_arr[i] <= megno_regular):
             ratio = order_ratio(theta, thetadot, libration_gap_deg, 0.5 * order_ratio_chaotic)
@@ -490,19 +498,20 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
         label[i] = _label(chaotic, confined)
         if label[i] == "resonant" and gap >= dominant_gap_ratio * second_gap:
             # one island (or a chain inside one island), not a chain round the circle
-            centers = (island_centers(members[i], p_max) if members[i] is not None
+            centers = (island_centres(members[i], p_max) if members[i] is not None
                        else {0.5 * k: 0.5 * k for k in range(1, int(2 * p_max) + 1)})
             out["resonance_p"][i] = _resonance_p(
-                center, out["libration_center_thetadot"][i], float(np.min(thetadot)),
-                float(np.max(thetadot)), centers, center_tolerance_deg)
+                center, out["libration_centre_thetadot"][i], float(np.min(thetadot)),
+                float(np.max(thetadot)), centers, centre_tolerance_deg)
     params = dict(libration_gap_deg=libration_gap_deg, order_ratio_chaotic=order_ratio_chaotic,
                   megno_chaotic=megno_chaotic, megno_regular=megno_regular,
-                  min_points=min_points, center_tolerance_deg=center_tolerance_deg,
+                  min_points=min_points, centre_tolerance_deg=centre_tolerance_deg,
                   dominant_gap_ratio=dominant_gap_ratio, island_shift=systems is not None)
-    return SectionClassification(label=label, label_geometric=label_geometric, count=count,
+    return SectionClassification(classification=label, classification_geometric=label_geometric, count=count,
                                  megno=megno_arr, parameters=params, **out)
 
 
+@renamed_keywords(center_tolerance_deg="centre_tolerance_deg")
 def classify_section(result, megno=None, island_shift=True, include_inaccurate=False,
                      **thresholds):
     """Classify every member of a :class:`~ti_spinorbit.section.SectionResult`.
@@ -523,7 +532,7 @@ def classify_section(result, megno=None, island_shift=True, include_inaccurate=F
         that stopped early.
     **thresholds
         ``libration_gap_deg``, ``order_ratio_chaotic``, ``megno_chaotic``, ``megno_regular``,
-        ``min_points``, ``center_tolerance_deg``, ``dominant_gap_ratio`` (see
+        ``min_points``, ``centre_tolerance_deg``, ``dominant_gap_ratio`` (see
         :func:`classify_points`).
 
     Returns
@@ -556,3 +565,8 @@ def _systems_per_member(systems, n):
             return list(systems) * n
         raise ValueError(f"systems must give one system per member ({n}), got {len(systems)}")
     return [systems] * n
+
+
+# the old vocabulary (docs/design.md "Vocabulary")
+CENTER_TOLERANCE_DEG = CENTRE_TOLERANCE_DEG
+island_centers = island_centres

@@ -651,8 +651,9 @@ def _accuracy_status(args, status, energy_drift, max_drift, what="members"):
     start, reported per member, and do not change the exit status."""
     import numpy as np
 
-    from .kernels.ensemble import INACCURATE, NONFINITE
+    from .results import Status
 
+    INACCURATE, NONFINITE = Status.INACCURATE, Status.NONFINITE
     status = np.asarray(status)
     inaccurate = int(np.count_nonzero(status == INACCURATE))
     nonfinite = int(np.count_nonzero(status == NONFINITE))
@@ -812,36 +813,8 @@ def _cmd_overlap(args):
 
 
 def _plot_libration(result):
-    """Two panels of the centre search: every launch's section extent against the start
-    θ̇_p/n (the V whose tip is the centre), and the last window around the centre."""
-    import numpy as np
-
-    from .plotting import _pyplot
-
-    plt = _pyplot()
-    fig, (left, right) = plt.subplots(1, 2, figsize=(9.6, 4.2), dpi=150)
-    for k, (x, extent) in enumerate(zip(result.candidates, result.extents)):
-        style = dict(marker="o", ms=3, lw=0.8) if k == 0 else dict(marker=".", ms=2, lw=0.6)
-        left.plot(x, extent, label="coarse" if k == 0 else ("zooms" if k == 1 else None),
-                  **style)
-    left.axvline(result.center_thetadot_p, color="k", lw=0.6, ls="--", label="centre")
-    left.set_xlabel(rf"$\dot\theta_p(0)/n$ ({result.coordinates})")
-    left.set_ylabel("section extent max |θ_p| (deg)")
-    left.legend(fontsize=7)
-    x, extent = result.candidates[-1], result.extents[-1]
-    right.plot(x - result.center_thetadot_p, extent, ".-", ms=3, lw=0.6)
-    right.axvline(0.0, color="k", lw=0.6, ls="--")
-    right.set_xlabel(r"$\dot\theta_p(0)/n$ − centre")
-    right.set_ylabel("extent (deg)")
-    right.set_title(f"last window ({len(result.candidates) - 1} zooms)", fontsize=8)
-    s = result.system
-    fig.suptitle(f"{s.name if s else ''}: centre θ̇_p/n = {result.center_thetadot_p:.8f}, "
-                 f"amplitude {result.amplitude:.3f}°, |ψ_A| {abs(result.psi_A):.3f}°"
-                 + ("" if result.converged else " (NOT converged)"), fontsize=9)
-    finite = [e[np.isfinite(e)] for e in result.extents]
-    if any(len(e) for e in finite):
-        left.set_ylim(bottom=0)
-    return left
+    from .plotting import plot_libration_search
+    return plot_libration_search(result)
 
 
 def _cmd_libration(args):
@@ -872,7 +845,7 @@ def _cmd_libration(args):
                        plot if callable(plot) else lambda: _plot_libration(result), out)
     _print(args,
            f"{system.name}: relaxed libration amplitude {result.amplitude:.4f} deg at the "
-           f"synchronous centre thetadot_p/n = {result.center_thetadot_p:.8f}",
+           f"synchronous centre thetadot_p/n = {result.centre_thetadot_p:.8f}",
            f"  psi_A = {result.psi_A:.4f} deg (omega0 {result.omega0:.4f}), "
            f"coupled psi_A = {result.psi_A_effective:.4f} deg (omega0_eff {result.omega0_effective:.4f})",
            f"  section extent at the centre {result.extent:.2e} deg, {result.iterations} zooms, "
@@ -886,47 +859,13 @@ def _cmd_libration(args):
 
 
 def energy_check(ts, member=0):
-    """Conservation numbers of one member of a TimeSeriesResult: the largest relative drift of
-    the total energy and of the total angular-momentum vector over the run, and the largest
-    change of each energy part relative to |E0| (the orbit/spin exchange). Returns a dict of
-    floats and the per-sample arrays (t, dE/|E0|, |ΔL|/|L0|, parts) used for the plot."""
-    import numpy as np
-
-    ok = np.isfinite(ts.t[member])
-    t = ts.t[member][ok]
-    energy = ts.energy[member][ok]
-    e0 = energy[0]
-    angmom = sum(getattr(ts, f"angmom_{k}")[member][ok] for k in ("orbit", "primary", "secondary"))
-    l0 = np.linalg.norm(angmom[0])
-    de = (energy - e0) / abs(e0)
-    dl = np.linalg.norm(angmom - angmom[0], axis=1) / l0
-    parts = {k: (getattr(ts, f"energy_{k}")[member][ok] - getattr(ts, f"energy_{k}")[member][ok][0])
-             / abs(e0) for k in ("orbit", "primary", "secondary")}
-    numbers = {"energy_drift": float(np.max(np.abs(de))), "angmom_drift": float(np.max(dl)),
-               **{f"exchange_{k}": float(np.max(np.abs(v))) for k, v in parts.items()},
-               "samples": int(len(t))}
-    return numbers, (t, de, dl, parts)
+    """Conservation numbers of one member of a TimeSeriesResult and the per-sample arrays:
+    :meth:`~ti_spinorbit.section.TimeSeriesResult.conservation` (kept here for callers)."""
+    return ts.conservation(member)
 
 
-def _plot_energy(system, series, orbits, rtol):
-    from .plotting import _pyplot
-
-    plt = _pyplot()
-    t, de, dl, parts = series
-    t_orbits = t / system.orbital_period
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True, dpi=150)
-    top.plot(t_orbits, de, "k", lw=0.8, label=r"energy $\Delta E/|E_0|$")
-    top.plot(t_orbits, dl, "C3", lw=0.8, label=r"angular momentum $|\Delta \mathbf{L}|/|L_0|$")
-    top.set_ylabel("relative drift")
-    top.legend(fontsize=7)
-    top.set_title(f"{system.name}: conservation at rtol {rtol:.0e} over {orbits:g} orbits",
-                  fontsize=9)
-    for name, v in parts.items():
-        bottom.plot(t_orbits, v, lw=0.8, label=f"{name}" + (" spin" if name != "orbit" else ""))
-    bottom.set_ylabel(r"energy exchange $\Delta E_i/|E_0|$")
-    bottom.set_xlabel("time (initial orbital periods)")
-    bottom.legend(fontsize=7)
-    return top
+def _plot_energy(ts):
+    return ts.plot_conservation(0)
 
 
 def _cmd_energy(args):
@@ -955,7 +894,7 @@ def _cmd_energy(args):
     status = ts.status_names[0]
     out, data = _write(ts, data, {"command": args.command_line, "energy_check": numbers,
                                   "member_status": status},
-                       lambda: _plot_energy(system, series, args.orbits, args.rtol), out)
+                       lambda: _plot_energy(ts), out)
     worst = max(numbers["energy_drift"], numbers["angmom_drift"])
     _print(args,
            f"{system.name}: {args.orbits:g} orbits at rtol {args.rtol:g}, {numbers['samples']} "
@@ -977,9 +916,9 @@ def _cmd_energy(args):
 
 
 def _status_code(name):
-    from .kernels.ensemble import STATUS_NAMES
+    from .results import Status
 
-    return STATUS_NAMES.index(name)
+    return int(Status.from_label(name))
 
 
 def _cmd_benchmark(args):

@@ -243,7 +243,7 @@ def _libration(r):
     lines = [_run(r, 1),
              [("system", name(r.system.name) if r.system is not None else "—"),
               ("ω0", f"{number(r.omega0, '.4g')} n"),
-              ("centre θ̇_p/n", number(r.center_thetadot_p, ".6g"))],
+              ("centre θ̇_p/n", number(r.centre_thetadot_p, ".6g"))],
              [("amplitude", f"{number(r.amplitude, '.4g')} deg"),
               # an amplitude: the sign of 2e/(ω0² − 1) is only the phase (below ω0 = 1 the
               # forced libration is in antiphase), so it is shown as |ψ_A|

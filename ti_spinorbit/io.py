@@ -23,7 +23,8 @@ Layout decisions (the README's "Saved files" section documents them for users):
   file opens with ``allow_pickle=False``; :func:`load` gives them back as ``object`` arrays.
 * ``status_names`` (the status code of each member as text) is written next to ``status``
   for readers without the package; :func:`load` ignores it.
-* Format versions: 1 is this layout; 0 is the layout :func:`save_result` wrote before
+* Format versions: 2 is this layout; 1 the same with older field names (``center_1``,
+  ``mean_spin``, ... : ``RENAMED_FIELDS``), which :func:`load` renames; 0 is the layout :func:`save_result` wrote before
   ``format_version`` existed (sections and time series only), which :func:`load` still reads.
 * Reading trusts nothing in the file: :func:`load` reads only the entries the metadata names,
   checks each entry's sizes (zip directory against the ``.npy`` header, deflate's largest
@@ -44,79 +45,23 @@ from . import runtime
 from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 
 #: Layout version written into every archive's metadata; bump it when the layout changes.
-FORMAT_VERSION = 1
-#: Versions :func:`load` reads (0: files from save_result before format_version existed).
-READABLE_FORMAT_VERSIONS = (0, 1)
-
-SPIN = "mean motion n"                 # spin rates and frequencies in units of n
-STATUS = "status code (metadata status_codes)"
-LABEL = "label"
-_COMMON_UNITS = {"status_names": "name", "system_index": "index into metadata systems",
-                 "rtol": "1", "atol": "1", "orbits": "orbital periods", "seconds": "s",
-                 # accuracy verdict (ti_spinorbit.accuracy)
-                 "energy_drift": "1 (relative)", "angmom_drift": "1 (relative)",
-                 "max_drift": "1 (relative)", "n_inaccurate": "members",
-                 "include_inaccurate": "bool",
-                 # section coordinates (docs/physics.md §6.7): which spin rate θ̇_p/n means
-                 "coordinates": "name: 'inertial' (θ̇ = inertial spin rate) or 'apsidal' "
-                                "(θ̇ = spin rate − apsidal rate ϖ̇, θ from the osculating "
-                                "line of apsides)",
-                 "apsidal_rate": SPIN}
-#: Units of every array and scalar field, per kind ("1": dimensionless).
-UNITS = {
-    "section": {
-        "theta_p": "deg", "thetadot_p": SPIN, "t": "s", "r": "m", "a": "m", "e": "1",
-        "count": "crossings", "energy_drift": "1 (relative)", "angmom_drift": "1 (relative)",
-        "status": STATUS, "accepted": "steps", "rejected": "steps", "rhs_calls": "calls",
-        "initial_theta_p": "deg", "initial_thetadot_p": SPIN, "megno": "1",
-        "lyapunov": "1/orbit", "order": "potential truncation order"},
-    "time_series": {
-        "t": "s", "alpha": "deg", "theta": "deg", "thetadot": SPIN, "r": "m", "energy": "J",
-        "energy_orbit": "J", "energy_primary": "J", "energy_secondary": "J",
-        "angmom_orbit": "kg m^2 s^-1", "angmom_primary": "kg m^2 s^-1",
-        "angmom_secondary": "kg m^2 s^-1", "status": STATUS, "initial_theta_p": "deg",
-        "initial_thetadot_p": SPIN},
-    "chaos_map": {
-        "theta_p": "deg", "thetadot_p": SPIN, "megno": "1", "lyapunov": "1/orbit",
-        "classification": LABEL, "mean_spin": SPIN, "status": STATUS, "chaotic_fraction": "1",
-        "megno_chaotic": "1", "fraction_lengths": "orbital periods",
-        "fraction_by_length": "1", "fraction_monotone": "bool", "fraction_message": "text"},
-    "parameter_map": {
-        "elongations": "1 (a/b)", "eccentricities": "1", "chaotic_fraction": "1",
-        "megno": "1", "labels": LABEL, "status": STATUS, "theta_p": "deg",
-        "thetadot_p": SPIN, "omega0": SPIN, "inaccurate": "members",
-        "fraction_lengths": "orbital periods", "fraction_by_length": "1",
-        "fraction_monotone": "bool", "fraction_message": "text"},
-    "overlap_scan": {
-        "eccentricity": "1", "elongations": "1 (a/b)", "overlaps": "bool",
-        "first_overlap": "1 (a/b)", "omega0_ro": SPIN, "elongation_ro": "1 (a/b)",
-        # the per-elongation decisions (metadata records), OverlapDecision fields
-        "decisions/elongation": "1 (a/b)", "decisions/omega0": SPIN,
-        "decisions/center_1": SPIN, "decisions/center_3_2": SPIN,
-        "decisions/connecting_start": SPIN, "decisions/connecting_range": SPIN,
-        "decisions/widest_range": SPIN, "decisions/connecting_megno": "1",
-        "decisions/connecting_lyapunov": "1/orbit",
-        "decisions/separatrix_chaotic_fraction": "1", "decisions/inaccurate": "members",
-        "decisions/max_energy_drift": "1 (relative)",
-        # convergence in integration length (overlap_threshold's doubling)
-        "decisions/megno_overlap": "bool", "decisions/orbits": "orbital periods",
-        "lengths": "orbital periods", "overlaps_by_length": "bool (lengths x elongations)",
-        "megno_overlaps_by_length": "1 = connects, 0 = not, -1 = no indicators",
-        "converged": "bool", "converged_orbits": "orbital periods",
-        "max_orbits": "orbital periods", "message": "text",
-        "megno_first_overlap": "1 (a/b)", "member_orbits": "member x orbital periods"},
-    "relaxed_libration": {
-        "center_thetadot_p": SPIN, "amplitude": "deg", "extent": "deg", "psi_A": "deg",
-        "psi_A_effective": "deg", "omega0": SPIN, "omega0_effective": SPIN,
-        "iterations": "launches", "converged": "bool", "candidates": SPIN, "extents": "deg",
-        "samples_per_orbit": "1/orbit", "xtol": SPIN, "status": "name",
-        # convergence in orbits and tolerance (relaxed_libration(converge=True))
-        "search_converged": "bool", "lengths": "orbital periods",
-        "centers_by_length": SPIN, "amplitudes_by_length": "deg", "rtol_check": "1",
-        "center_rtol_check": SPIN, "amplitude_rtol_check": "deg", "center_tol": SPIN,
-        "amplitude_tol": "deg", "converged_in_orbits": "bool",
-        "converged_in_tolerance": "bool", "convergence_checked": "bool", "message": "text"},
+FORMAT_VERSION = 2
+#: Versions :func:`load` reads (0: files from save_result before format_version existed;
+#: 1: the same layout as 2 with the old field names of ``RENAMED_FIELDS``).
+READABLE_FORMAT_VERSIONS = (0, 1, 2)
+#: Field names of format 1 that format 2 spells in the project's one vocabulary
+#: (docs/design.md "Vocabulary"), per kind (None: every kind, records included).
+RENAMED_FIELDS = {
+    None: {"center_thetadot_p": "centre_thetadot_p", "centers_by_length": "centres_by_length",
+           "center_rtol_check": "centre_rtol_check", "center_tol": "centre_tol",
+           "center_1": "centre_1", "center_3_2": "centre_3_2",
+           "center_3_2_found": "centre_3_2_found", "mean_spin": "mean_thetadot"},
+    "parameter_map": {"labels": "classification"},
 }
+
+#: Units of the archive's own entries (not result fields). The units of every result field
+#: live on the field (``ti_spinorbit.results.unit``) and are read from there.
+ARCHIVE_UNITS = {"status_names": "name", "system_index": "index into metadata systems"}
 
 
 def _kinds():
@@ -148,15 +93,20 @@ def kind_of(result):
 
 
 def units(kind):
-    """Units of the arrays and scalars of a result kind (a copy), e.g. ``units("section")``."""
-    if kind not in UNITS:
-        raise ValueError(f"unknown kind {kind!r}; known kinds: {', '.join(UNITS)}")
-    return {**_COMMON_UNITS, **UNITS[kind]}
+    """Units of the arrays and scalars of a result kind (a new dict), e.g.
+    ``units("section")``: the units declared on the result class's fields
+    (:func:`ti_spinorbit.results.units`) plus the archive's own entries."""
+    from .results import units as field_units
+
+    if kind not in _kinds():
+        raise ValueError(f"unknown kind {kind!r}; known kinds: {', '.join(_kinds())}")
+    return {**ARCHIVE_UNITS, **field_units(_kinds()[kind])}
 
 
 def status_codes():
-    """Integrator status code -> name, e.g. {0: "running", 1: "done", ...}."""
-    from .kernels.ensemble import STATUS_NAMES
+    """Integrator status code -> name, e.g. {0: "running", 1: "done", ...}
+    (:class:`ti_spinorbit.results.Status`)."""
+    from .results import STATUS_NAMES
 
     return dict(enumerate(STATUS_NAMES))
 
@@ -299,7 +249,7 @@ def _encode(result, prefix, systems, arrays, units_out, include_sections):
                             "archive representation")
         if name in table:
             units_out[key] = table[name]
-        for k, v in table.items():   # units of record fields ("decisions/center_1")
+        for k, v in table.items():   # units of record fields ("decisions/centre_1")
             if k.startswith(name + "/"):
                 units_out[prefix + k] = v
     return {k: v for k, v in block.items() if v or k in ("kind", "fields")}
@@ -346,8 +296,7 @@ def save(result, path, extra=None, include_sections=True):
             **{k: fields.get(k) for k in ("rtol", "atol", "order", "orbits")},
             "systems": systems.descriptions, "units": units_out,
             "status_codes": {str(k): v for k, v in status_codes().items()}}
-    status = getattr(result, "status", None)
-    if isinstance(status, np.ndarray):
+    if "status_names" in arrays:            # a top-level status array (not a nested one's)
         names, counts = np.unique(arrays["status_names"], return_counts=True)
         meta["status_counts"] = {str(n): int(c) for n, c in zip(names, counts)}
     meta.update(block)
@@ -504,6 +453,7 @@ def _decode(block, arrays, prefix, systems):
         raise TypeError(f"a result block is a {type(block).__name__}, not a JSON object")
     cls = _kinds()[block["kind"]]
     kwargs = dict(block.get("fields", {}))
+    renamed = {**RENAMED_FIELDS[None], **RENAMED_FIELDS.get(block["kind"], {})}
     for name in block.get("arrays", []):
         value = arrays[prefix + name]
         kwargs[name] = value.astype(object) if name in block.get("object_arrays", []) else value
@@ -516,11 +466,12 @@ def _decode(block, arrays, prefix, systems):
             kwargs[name] = [_system(systems, i) for i in arrays[prefix + ref["array"]].tolist()]
     for name, rec in block.get("records", {}).items():
         rtype = _record_types()[rec["type"]] if rec["type"] else None
-        kwargs[name] = [rtype(**{k: tuple(v) if k in rec["tuples"] and v is not None else v
-                                 for k, v in item.items()}) for item in rec["items"]]
+        kwargs[name] = [rtype(**{renamed.get(k, k): tuple(v) if k in rec["tuples"] and
+                                 v is not None else v for k, v in item.items()})
+                        for item in rec["items"]]
     for name, sub in block.get("nested", {}).items():
         kwargs[name] = _decode(sub, arrays, f"{prefix}{name}/", systems)
-    return cls(**kwargs)
+    return cls(**{renamed.get(k, k): v for k, v in kwargs.items()})   # format 1's old names
 
 
 def _upgrade_v0(path, meta, arrays):
@@ -551,15 +502,6 @@ def _upgrade_v0(path, meta, arrays):
             "system_refs": {"systems": {"array": "system_index"}}}
 
 
-def to_xarray(result_or_path):
-    """Labelled ``xarray.Dataset`` of a result or of a saved file: see
-    :func:`ti_spinorbit.xarray_io.to_xarray` (xarray is imported only when this is called;
-    ``pip install "ti-spinorbit[xarray]"``)."""
-    from .xarray_io import to_xarray as convert
-
-    return convert(result_or_path)
-
-
-__all__ = ["save", "load", "to_xarray", "save_result", "read_metadata", "write_archive",
+__all__ = ["save", "load", "save_result", "read_metadata", "write_archive",
            "provenance", "describe_system", "units", "status_codes", "status_names", "kind_of",
            "FORMAT_VERSION", "ArchiveError"]

@@ -52,6 +52,7 @@ from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
+from .results import COORDINATES, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
 DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
@@ -94,7 +95,8 @@ def _amplitudes(ts, include_inaccurate=False):
 
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
                         rtol=1e-12, max_drift=None, include_inaccurate=False,
-                        coordinates="inertial"):
+                        coordinates="inertial", model="auto", checkpoint=None, resume=False,
+                        overwrite_checkpoint=False):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -102,8 +104,9 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
 
     Parameters
     ----------
-    system : BinarySystem or list of BinarySystem
-        Broadcast against ``thetadot_p`` as in :func:`~ti_spinorbit.surface_of_section`.
+    system : BinarySystem, str or list of them
+        Broadcast against ``thetadot_p`` as in :func:`~ti_spinorbit.surface_of_section` (a
+        str is a catalogue name).
     thetadot_p : float or array
         Initial spin rate of the secondary, units of n.
     orbits : float
@@ -118,6 +121,8 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
     coordinates : {"inertial", "apsidal"}
         Spin coordinate of ``thetadot_p`` (docs/physics.md §6.7); α, and so the amplitude,
         is the same in both.
+    model, checkpoint, resume, overwrite_checkpoint
+        As for :func:`~ti_spinorbit.section.time_series` (one launch).
 
     Returns
     -------
@@ -127,7 +132,9 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         failed the accuracy check (unless ``include_inaccurate``).
     """
     ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
-                     rtol=rtol, max_drift=max_drift, coordinates=coordinates)
+                     rtol=rtol, max_drift=max_drift, coordinates=coordinates, model=model,
+                     checkpoint=checkpoint, resume=resume,
+                     overwrite_checkpoint=overwrite_checkpoint)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
@@ -140,10 +147,10 @@ def _psi_A_deg(omega0, e):
 
 
 @dataclass(repr=False)
-class RelaxedLibration(_display.Readable):
+class RelaxedLibration(Result, _display.Readable):
     """Centre of the synchronous island and the relaxed-mode libration amplitude.
 
-    ``center_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
+    ``centre_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
     max |α| of that trajectory; ``extent`` deg, its section's horizontal half extent (the
     excited mode left over); ``psi_A`` and ``psi_A_effective`` deg, the decoupled estimates
     2e/(ω0² − 1) with ω0 and with ω0,eff² = ω0² m1/(m1+m2); ``iterations`` zoom launches;
@@ -154,46 +161,73 @@ class RelaxedLibration(_display.Readable):
     ``status`` that trajectory's status ("done", "inaccurate", ...), ``energy_drift`` and
     ``angmom_drift`` its relative drifts and ``max_drift`` their limit
     (``ti_spinorbit.accuracy``); ``seconds`` wall time; ``coordinates`` the spin coordinate of
-    ``center_thetadot_p`` and ``candidates`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
+    ``centre_thetadot_p`` and ``candidates`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
-    center_thetadot_p: float
-    amplitude: float
-    extent: float
-    psi_A: float
-    psi_A_effective: float
-    omega0: float
-    omega0_effective: float
-    iterations: int
-    converged: bool
-    candidates: List[np.ndarray] = field(repr=False)
-    extents: List[np.ndarray] = field(repr=False)
-    orbits: float = 0.0
-    rtol: float = 1e-12
-    samples_per_orbit: int = 256
-    xtol: float = 1e-6
-    seconds: float = 0.0
+    centre_thetadot_p: float = unit(SPIN)
+    amplitude: float = unit('deg')
+    extent: float = unit('deg')
+    psi_A: float = unit('deg')
+    psi_A_effective: float = unit('deg')
+    omega0: float = unit(SPIN)
+    omega0_effective: float = unit(SPIN)
+    iterations: int = unit('launches')
+    converged: bool = unit('bool')
+    candidates: List[np.ndarray] = unit(SPIN, repr=False)
+    extents: List[np.ndarray] = unit('deg', repr=False)
+    orbits: float = unit(ORBITS, default=0.0)
+    rtol: float = unit('1', default=1e-12)
+    samples_per_orbit: int = unit('1/orbit', default=256)
+    xtol: float = unit(SPIN, default=1e-6)
+    seconds: float = unit('s', default=0.0)
     system: BinarySystem = field(default=None, repr=False)
-    status: str = "done"
-    energy_drift: float = float("nan")
-    angmom_drift: float = float("nan")
-    max_drift: float = float("nan")
-    coordinates: str = "inertial"
+    status: str = unit('name', default="done")
+    energy_drift: float = unit(RELATIVE, default=float("nan"))
+    angmom_drift: float = unit(RELATIVE, default=float("nan"))
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    coordinates: str = unit(COORDINATES, default="inertial")
     # convergence evidence (relaxed_libration(converge=True)): the centre and amplitude
     # found at each length of the doubling (orbits, 2·orbits, ...) and at rtol/10 at the
     # last length; the tolerances they were held to; the verdicts and a one-line message
-    search_converged: bool = True
-    lengths: np.ndarray = None
-    centers_by_length: np.ndarray = None
-    amplitudes_by_length: np.ndarray = None
-    rtol_check: float = float("nan")
-    center_rtol_check: float = float("nan")
-    amplitude_rtol_check: float = float("nan")
-    center_tol: float = float("nan")
-    amplitude_tol: float = float("nan")
-    converged_in_orbits: bool = False
-    converged_in_tolerance: bool = False
-    convergence_checked: bool = False
-    message: str = ""
+    search_converged: bool = unit('bool', default=True)
+    lengths: np.ndarray = unit(ORBITS, default=None)
+    centres_by_length: np.ndarray = unit(SPIN, default=None)
+    amplitudes_by_length: np.ndarray = unit('deg', default=None)
+    rtol_check: float = unit('1', default=float("nan"))
+    centre_rtol_check: float = unit(SPIN, default=float("nan"))
+    amplitude_rtol_check: float = unit('deg', default=float("nan"))
+    centre_tol: float = unit(SPIN, default=float("nan"))
+    amplitude_tol: float = unit('deg', default=float("nan"))
+    converged_in_orbits: bool = unit('bool', default=False)
+    converged_in_tolerance: bool = unit('bool', default=False)
+    convergence_checked: bool = unit('bool', default=False)
+    message: str = unit('text', default="")
+    #: the dense time series at the centre (the trajectory whose max |α| is ``amplitude``);
+    #: None in files written before it was stored (``trajectory()`` computes it again)
+    series: object = field(default=None, repr=False)
+
+    def trajectory(self):
+        """The time series at the centre: ``series``, or (for files written without it) the
+        same run again (θ_p = 0, θ̇_p/n = the centre, ``orbits``, ``samples_per_orbit``,
+        ``rtol``)."""
+        if self.series is None:
+            self.series = time_series(self.system, 0.0, self.centre_thetadot_p, self.orbits,
+                                      samples_per_orbit=self.samples_per_orbit, rtol=self.rtol,
+                                      coordinates=self.coordinates)
+        return self.series
+
+    def plot(self, ax=None, title=None, search=None):
+        """α(t) at the centre with the amplitude max |α| and the decoupled |ψ_A| band (and,
+        on a new figure, the search's panels): :func:`ti_spinorbit.plotting.plot_libration`.
+        Returns the Axes of α(t)."""
+        from .plotting import plot_libration
+
+        return plot_libration(self, ax=ax, title=title, search=search)
+
+    # the old vocabulary, read-only (docs/design.md "Vocabulary")
+    center_thetadot_p = alias("centre_thetadot_p")
+    centers_by_length = alias("centres_by_length")
+    center_rtol_check = alias("centre_rtol_check")
+    center_tol = alias("centre_tol")
 
     def evidence(self):
         """Lines: centre and amplitude against orbits and tolerance, and the verdict."""
@@ -201,12 +235,12 @@ class RelaxedLibration(_display.Readable):
             return [f"convergence in orbits and tolerance not checked ({self.message})"
                     if self.message else "convergence in orbits and tolerance not checked"]
         rows = [f"{'orbits':>8} {'rtol':>8} {'centre (n)':>14} {'amplitude (deg)':>16}"]
-        for L, c, a in zip(self.lengths, self.centers_by_length, self.amplitudes_by_length):
+        for L, c, a in zip(self.lengths, self.centres_by_length, self.amplitudes_by_length):
             rows.append(f"{L:8g} {self.rtol:8.0e} {c:14.9f} {a:16.6f}")
         if np.isfinite(self.rtol_check):
             rows.append(f"{self.lengths[-1]:8g} {self.rtol_check:8.0e} "
-                        f"{self.center_rtol_check:14.9f} {self.amplitude_rtol_check:16.6f}")
-        rows.append(f"(held to |Δcentre| <= {self.center_tol:.3g} n, |Δamplitude| <= "
+                        f"{self.centre_rtol_check:14.9f} {self.amplitude_rtol_check:16.6f}")
+        rows.append(f"(held to |Δcentre| <= {self.centre_tol:.3g} n, |Δamplitude| <= "
                     f"{self.amplitude_tol:.3g} deg)")
         rows.append(self.message)
         return rows
@@ -240,17 +274,21 @@ def _arm_window(x, extent, best, points):
     return np.concatenate([left, [best], right])
 
 
+@renamed_keywords(center_tol="centre_tol")
 def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=None,
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
                       samples_per_orbit=256, coarse_arm_points=3,
                       max_extent=MAX_CENTER_EXTENT_DEG, progress=None,
                       max_drift=None, coordinates="inertial", converge=True, max_orbits=None,
-                      center_tol=None, amplitude_tol=0.01, **section_kwargs) -> RelaxedLibration:
+                      centre_tol=None, amplitude_tol=0.01, model="auto", checkpoint=None,
+                      resume=False, overwrite_checkpoint=False,
+                      **section_kwargs) -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
     Parameters
     ----------
-    system : BinarySystem
+    system : BinarySystem or str
+        The system, or a catalogue name (``ti_spinorbit.catalog``).
     orbits : float
         Integration time of every trajectory, initial orbital periods (the section of each
         candidate has about this many points).
@@ -290,7 +328,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     converge : bool
         Check the answer in integration length and tolerance (default True): the search is
         repeated, bracketed around the centre found, at 2·orbits, 4·orbits, ... until two
-        successive lengths give centres within ``center_tol`` and amplitudes within
+        successive lengths give centres within ``centre_tol`` and amplitudes within
         ``amplitude_tol`` (at most ``max_orbits``, default ``4 · orbits``), then at the last
         length with rtol/10 (skipped below rtol 1e-15). ``converged`` is then True only when
         the search converged *and* both checks pass; ``message`` says which failed
@@ -298,10 +336,16 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         amplitude are those at ``orbits`` and ``rtol``; the others are the evidence.
     max_orbits : float, optional
         Cap of the doubling, in [orbits, 1e7] (default ``4 · orbits``).
-    center_tol : float, optional
+    centre_tol : float, optional
         Agreement required of the centres, units of n (default ``max(10 · xtol, 1e-5)``).
     amplitude_tol : float
         Agreement required of the amplitudes, deg (default 0.01).
+    model : {"auto", "planar", "3d"}
+        Equations of motion of every launch (see :func:`~ti_spinorbit.section.surface_of_section`).
+    checkpoint, resume, overwrite_checkpoint
+        A directory for the checkpoints of the search's launches (``DIR/launch-kkk``, one per
+        launch: :class:`ti_spinorbit.checkpoint.Launches`), whether to continue from them, and
+        whether to replace ones already there when not resuming.
     **section_kwargs
         Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
@@ -316,9 +360,10 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     RuntimeError
         No coarse candidate librates, or the trajectory at the centre found does not.
     """
-    if not isinstance(system, BinarySystem):
-        raise TypeError(f"system must be a BinarySystem (got {type(system).__name__})")
+    from . import catalog
     from .coordinates import check_coordinates
+
+    system = catalog.as_system(system)
     check_coordinates(coordinates)
     if not system.omega0 > 0:
         raise ValueError("the secondary must be elongated (B > A, omega0 > 0) to have a "
@@ -352,26 +397,29 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         resources.check_memory(what, members, orbits, spo,
                                advice="use fewer orbits, candidates or samples per orbit")
 
-    if center_tol is None:
-        center_tol = max(10.0 * float(xtol), 1e-5)
-    require_positive("center_tol", require_real("center_tol", center_tol))
+    if centre_tol is None:
+        centre_tol = max(10.0 * float(xtol), 1e-5)
+    require_positive("centre_tol", require_real("centre_tol", centre_tol))
     require_positive("amplitude_tol", require_real("amplitude_tol", amplitude_tol))
     cap = 4.0 * float(orbits) if max_orbits is None else require_real("max_orbits", max_orbits)
     if not float(orbits) <= cap <= 1e7:
         raise ValueError(f"max_orbits must lie in [orbits, 1e7] = [{float(orbits):g}, 1e7] "
                          f"(got {cap:g})")
-    section_kwargs = dict(section_kwargs, coordinates=coordinates)   # every launch alike
+    from .checkpoint import Launches
+
+    section_kwargs = dict(section_kwargs, coordinates=coordinates, model=model)  # every launch alike
     search = dict(zoom_candidates=zoom_candidates, xtol=xtol, max_iterations=max_iterations,
                   samples_per_orbit=samples_per_orbit, coarse_arm_points=coarse_arm_points,
-                  max_extent=max_extent, max_drift=max_drift, section_kwargs=section_kwargs)
+                  max_extent=max_extent, max_drift=max_drift, section_kwargs=section_kwargs,
+                  checkpoints=Launches(checkpoint, resume, overwrite_checkpoint))
     base = _search(system, orbits, rtol, candidates, progress=progress, **search)
     if not converge:
         return base
     started = time.perf_counter() - base.seconds
     # the checks start bracketed around the centre found: the coarse scan is not repeated
     spacing = float(np.max(np.diff(base.candidates[0])))
-    bracket = base.center_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
-    lengths, centres, amplitudes = [float(orbits)], [base.center_thetadot_p], [base.amplitude]
+    bracket = base.centre_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
+    lengths, centres, amplitudes = [float(orbits)], [base.centre_thetadot_p], [base.amplitude]
     in_orbits = False
     last = base
     while lengths[-1] * 2.0 <= cap * (1 + 1e-12):
@@ -379,9 +427,9 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
             warnings.simplefilter("ignore", RuntimeWarning)   # summarised in the message
             last = _search(system, lengths[-1] * 2.0, rtol, bracket, **search)
         lengths.append(lengths[-1] * 2.0)
-        centres.append(last.center_thetadot_p)
+        centres.append(last.centre_thetadot_p)
         amplitudes.append(last.amplitude)
-        if abs(centres[-1] - centres[-2]) <= center_tol and \
+        if abs(centres[-1] - centres[-2]) <= centre_tol and \
                 abs(amplitudes[-1] - amplitudes[-2]) <= amplitude_tol:
             in_orbits = True
             break
@@ -391,8 +439,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             fine = _search(system, lengths[-1], tight, bracket, **search)
-        c_tol, a_tol = fine.center_thetadot_p, fine.amplitude
-        in_tol = abs(c_tol - centres[-1]) <= center_tol and \
+        c_tol, a_tol = fine.centre_thetadot_p, fine.amplitude
+        in_tol = abs(c_tol - centres[-1]) <= centre_tol and \
             abs(a_tol - amplitudes[-1]) <= amplitude_tol and fine.converged
     messages = []
     if not base.converged:
@@ -418,11 +466,11 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     base.search_converged = base.converged
     base.converged = converged
     base.lengths = np.array(lengths)
-    base.centers_by_length = np.array(centres)
+    base.centres_by_length = np.array(centres)
     base.amplitudes_by_length = np.array(amplitudes)
-    base.rtol_check, base.center_rtol_check, base.amplitude_rtol_check = \
+    base.rtol_check, base.centre_rtol_check, base.amplitude_rtol_check = \
         (tight if np.isfinite(c_tol) else float("nan")), c_tol, a_tol
-    base.center_tol, base.amplitude_tol = float(center_tol), float(amplitude_tol)
+    base.centre_tol, base.amplitude_tol = float(centre_tol), float(amplitude_tol)
     base.converged_in_orbits, base.converged_in_tolerance = in_orbits, bool(in_tol)
     base.convergence_checked = True
     base.message = "; ".join(messages)
@@ -432,10 +480,11 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
 
 def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterations,
             samples_per_orbit, coarse_arm_points, max_extent, max_drift, section_kwargs,
-            progress=None) -> RelaxedLibration:
+            checkpoints, progress=None) -> RelaxedLibration:
     """The search of :func:`relaxed_libration` at one length and tolerance (inputs checked)."""
     limit = accuracy.drift_limit(rtol, orbits, max_drift)
     coordinates = section_kwargs.get("coordinates", "inertial")
+    model = section_kwargs.get("model", "auto")
     x = DEFAULT_CANDIDATES.copy() if candidates is None else \
         np.asarray(candidates, dtype=np.float64).ravel()
     shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
@@ -461,7 +510,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
     half_width = float(np.max(np.diff(x)))
     coarse = surface_of_section(system, 0.0, x, orbits, rtol=rtol, max_drift=limit,
-                                **section_kwargs)
+                                **section_kwargs, **checkpoints.next())
     if coarse.n_inaccurate == len(x):
         raise RuntimeError(f"every candidate's conservation drift exceeds max_drift {limit:.3g} "
                            f"(largest energy drift {np.nanmax(coarse.energy_drift):.3g}); "
@@ -470,7 +519,8 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     launched(1 + zooms_left(half_width, 0) + 2)
     librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol, max_drift=limit,
                                                samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT,
-                                               coordinates=coordinates))
+                                               coordinates=coordinates, model=model,
+                                               **checkpoints.next()))
     launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
     tried, extents = [x], [extent]
@@ -488,7 +538,8 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     while half_width > xtol and iterations < max_iterations:
         x = center + np.linspace(-half_width, half_width, zoom_candidates)
         extent = section_extent(surface_of_section(system, 0.0, x, orbits, rtol=rtol,
-                                                   max_drift=limit, **section_kwargs))
+                                                   max_drift=limit, **section_kwargs,
+                                                   **checkpoints.next()))
         extent[extent >= LIBRATION_LIMIT_DEG] = np.nan
         tried.append(x)
         extents.append(extent)
@@ -506,7 +557,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     # 4. the centre itself
     final_extent = float(section_extent(surface_of_section(system, 0.0, center, orbits,
                                                            rtol=rtol, max_drift=limit,
-                                                           **section_kwargs),
+                                                           **section_kwargs, **checkpoints.next()),
                                         include_inaccurate=True)[0])
     launched(1)
     # a narrow window is not enough: at a true centre the trace shrinks to a point (a chaotic
@@ -518,7 +569,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
                       f"{max_extent:g} deg) after {iterations} launches", RuntimeWarning,
                       stacklevel=2)
     ts = time_series(system, 0.0, center, orbits, samples_per_orbit=samples_per_orbit, rtol=rtol,
-                     max_drift=limit, coordinates=coordinates)
+                     max_drift=limit, coordinates=coordinates, model=model, **checkpoints.next())
     amplitude = float(_amplitudes(ts, include_inaccurate=True)[0])   # kept, flagged below
     launched(0)
     if not np.isfinite(amplitude):
@@ -531,11 +582,11 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
                       "not trustworthy: tighten rtol", RuntimeWarning, stacklevel=2)
     omega0_effective = analytic.omega0_effective(system)
     return RelaxedLibration(
-        center_thetadot_p=center, amplitude=float(amplitude), extent=final_extent,
+        centre_thetadot_p=center, amplitude=float(amplitude), extent=final_extent,
         psi_A=_psi_A_deg(system.omega0, system.e), psi_A_effective=_psi_A_deg(omega0_effective, system.e),
         omega0=system.omega0, omega0_effective=omega0_effective,
         iterations=iterations, converged=converged, candidates=tried, extents=extents,
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
         seconds=time.perf_counter() - start, system=system, status=status,
         energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
-        max_drift=limit, coordinates=coordinates)
+        max_drift=limit, coordinates=coordinates, series=ts)

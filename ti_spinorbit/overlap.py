@@ -53,6 +53,7 @@ from .libration import section_extent
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
+from .results import COORDINATES, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
@@ -66,28 +67,33 @@ class OverlapDecision:
     (excluded from the decision unless the scan includes them); ``max_energy_drift`` the
     largest relative energy drift among its starts."""
 
-    elongation: float
-    omega0: float
+    elongation: float = unit('1 (a/b)')
+    omega0: float = unit(SPIN)
     overlap: bool
-    center_1: float
-    center_3_2: float
-    center_3_2_found: bool
-    connecting_start: Optional[float]
-    connecting_range: Optional[tuple]
-    widest_range: tuple
-    connecting_megno: float = float("nan")
-    connecting_lyapunov: float = float("nan")
-    separatrix_chaotic_fraction: float = float("nan")
-    inaccurate: int = 0
-    max_energy_drift: float = float("nan")
+    centre_1: float = unit(SPIN)
+    centre_3_2: float = unit(SPIN)
+    centre_3_2_found: bool = unit('bool')
+    connecting_start: Optional[float] = unit(SPIN)
+    connecting_range: Optional[tuple] = unit(SPIN)
+    widest_range: tuple = unit(SPIN)
+    connecting_megno: float = unit('1', default=float("nan"))
+    connecting_lyapunov: float = unit('1/orbit', default=float("nan"))
+    separatrix_chaotic_fraction: float = unit('1', default=float("nan"))
+    inaccurate: int = unit('members', default=0)
+    max_energy_drift: float = unit(RELATIVE, default=float("nan"))
     #: the MEGNO connection criterion (see :func:`megno_connects`): None without indicators
-    megno_overlap: Optional[bool] = None
+    megno_overlap: Optional[bool] = unit('bool', default=None)
     #: orbits of the run this decision comes from
-    orbits: float = float("nan")
+    orbits: float = unit(ORBITS, default=float("nan"))
+
+    # the old vocabulary, read-only (docs/design.md "Vocabulary")
+    center_1 = alias("centre_1")
+    center_3_2 = alias("centre_3_2")
+    center_3_2_found = alias("centre_3_2_found")
 
 
 @dataclass(repr=False)
-class OverlapScan(_display.Readable):
+class OverlapScan(Result, _display.Readable):
     """Result of :func:`overlap_threshold`.
 
     ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
@@ -99,32 +105,44 @@ class OverlapScan(_display.Readable):
     ranges ("inertial" or "apsidal", docs/physics.md §6.7)."""
 
     name: str
-    eccentricity: float
-    elongations: np.ndarray
-    overlaps: np.ndarray
-    decisions: List[OverlapDecision]
-    first_overlap: Optional[float]
-    omega0_ro: float
-    elongation_ro: float
-    orbits: float
-    seconds: float = 0.0
+    eccentricity: float = unit('1')
+    elongations: np.ndarray = unit('1 (a/b)')
+    overlaps: np.ndarray = unit('bool')
+    decisions: List[OverlapDecision] = field(metadata={"records": OverlapDecision})
+    first_overlap: Optional[float] = unit('1 (a/b)')
+    omega0_ro: float = unit(SPIN)
+    elongation_ro: float = unit('1 (a/b)')
+    orbits: float = unit(ORBITS)
+    seconds: float = unit('s', default=0.0)
     sections: object = field(default=None, repr=False)
-    max_drift: float = float("nan")
-    n_inaccurate: int = 0
-    include_inaccurate: bool = False
-    coordinates: str = "inertial"
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    n_inaccurate: int = unit('members', default=0)
+    include_inaccurate: bool = unit('bool', default=False)
+    coordinates: str = unit(COORDINATES, default="inertial")
     # convergence in integration length (doubling; see overlap_threshold): the lengths run
     # (orbits), the geometric and MEGNO decisions at each (rows: lengths, columns:
     # elongations), the verdict, and the cost in member-orbits
-    lengths: np.ndarray = None
-    overlaps_by_length: np.ndarray = None
-    megno_overlaps_by_length: np.ndarray = None
-    converged: bool = False
-    converged_orbits: float = float("nan")
-    max_orbits: float = float("nan")
-    message: str = ""
-    megno_first_overlap: Optional[float] = None
-    member_orbits: float = float("nan")
+    lengths: np.ndarray = unit(ORBITS, default=None)
+    overlaps_by_length: np.ndarray = unit('bool (lengths x elongations)', default=None)
+    megno_overlaps_by_length: np.ndarray = unit('1 = connects, 0 = not, -1 = no indicators', default=None)
+    converged: bool = unit('bool', default=False)
+    converged_orbits: float = unit(ORBITS, default=float("nan"))
+    max_orbits: float = unit(ORBITS, default=float("nan"))
+    message: str = unit('text', default="")
+    megno_first_overlap: Optional[float] = unit('1 (a/b)', default=None)
+    member_orbits: float = unit('member x orbital periods', default=float("nan"))
+    #: integrator tolerance of every trajectory (NaN in files written before it was stored)
+    rtol: float = unit('1', default=float("nan"))
+
+    def __post_init__(self):
+        if not np.isfinite(self.rtol) and self.sections is not None:
+            self.rtol = float(self.sections.rtol)
+
+    @property
+    def status(self):
+        """Status codes of the trajectories of the first run (``sections``; empty when it
+        was not saved)."""
+        return np.zeros(0, np.int32) if self.sections is None else self.sections.status
 
     @property
     def upper_bound(self) -> bool:
@@ -158,25 +176,11 @@ class OverlapScan(_display.Readable):
         return rows
 
     def plot(self, ax=None, title=None):
-        """Decision per elongation (overlap blue, separate green) with the numerical and the
-        analytic thresholds; returns the matplotlib Axes."""
-        if ax is None:
-            from .plotting import _pyplot
-            _, ax = _pyplot().subplots(figsize=(6.4, 3.2), dpi=150)
-        ax.scatter(self.elongations, self.overlaps.astype(int),
-                   c=["tab:blue" if o else "tab:green" for o in self.overlaps], s=25)
-        ax.axvline(self.elongation_ro, color="k", ls="--", lw=0.8, label="analytic ω0^RO")
-        if self.first_overlap is not None:
-            ax.axvline(self.first_overlap, color="tab:red", lw=1.0, label="numerical")
-        ax.set_yticks([0, 1], ["separate", "overlap"])
-        ax.set_xlabel("a/b")
-        verdict = "" if self.lengths is None else \
-            (f", converged at {self.converged_orbits:g} orbits" if self.converged
-             else f", not converged by {self.max_orbits:g} orbits (upper bound)")
-        ax.set_title((title or f"{self.name}, e = {self.eccentricity}: 1:1 / 3:2 overlap")
-                     + verdict, fontsize=9)
-        ax.legend(fontsize=7)
-        return ax
+        """Decision per elongation with the numerical and analytic thresholds and the largest
+        ⟨Y⟩ per elongation: :func:`ti_spinorbit.plotting.plot_overlap`. Returns the Axes."""
+        from .plotting import plot_overlap
+
+        return plot_overlap(self, ax=ax, title=title)
 
     @property
     def monotonic(self) -> bool:
@@ -188,28 +192,30 @@ class OverlapScan(_display.Readable):
 SystemFactory = Callable[[float], BinarySystem]
 
 
-def _factory(system_name_or_factory, eccentricity):
-    if callable(system_name_or_factory):
-        return system_name_or_factory, "custom"
-    name = system_name_or_factory
+def _factory(system, eccentricity):
+    if callable(system):
+        return system, "custom"
+    name = system
     catalog.entry(name)  # raises for unknown names, listing the known ones
     return (lambda q: catalog.system(name, elongation=q, eccentricity=eccentricity)), name
 
 
-def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongations=None,
-                      eccentricity=None, orbits=1000, rtol=1e-10, center_starts=48,
+@renamed_keywords(system_name_or_factory="system", center_starts="centre_starts")
+def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
+                      eccentricity=None, orbits=1000, rtol=1e-10, centre_starts=48,
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
                       indicators=True, progress=None, client=None,
                       chunk_size=None, model="auto", max_drift=None,
                       include_inaccurate=False, coordinates="inertial", max_orbits=None,
+                      checkpoint=None, resume=False, overwrite_checkpoint=False,
                       **section_kwargs) -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
     Parameters
     ----------
-    system_name_or_factory : str or callable
-        A catalogued name, or ``f(elongation) -> BinarySystem``.
+    system : str or callable
+        A catalogue name, or a factory ``f(elongation) -> BinarySystem`` (the family scanned).
     elongations : array, optional
         a/b values (default 1.01 ... 1.15 in steps of 0.01).
     eccentricity : float, optional
@@ -229,7 +235,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         ``lengths``); ``member_orbits`` the cost.
     rtol : float
         Integrator tolerance (chaos detection needs no more than ~1e-10).
-    center_starts, separatrix_starts : int
+    centre_starts, separatrix_starts : int
         Starts per elongation in the θ_p = 0 and θ_p = 90° columns, each in [2, 100000].
     libration_limit : float
         Section extent (deg, in (0, 90]) below which a θ_p = 0 trace counts as librating.
@@ -248,6 +254,11 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     coordinates : {"inertial", "apsidal"}
         Spin coordinate of the starts and of the centres and ranges in the decisions
         (docs/physics.md §6.7; "apsidal" is the paper's).
+    checkpoint, resume, overwrite_checkpoint
+        A directory for the checkpoints of the scan's launches (one per length, in
+        ``DIR/launch-kkk``: :class:`ti_spinorbit.checkpoint.Launches`), whether to continue
+        from them, and whether to replace ones already there when not resuming (single
+        process only).
     **section_kwargs
         Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
@@ -277,14 +288,16 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
         raise ValueError(f"max_orbits must lie in [orbits, 1e7] = [{float(orbits):g}, 1e7] "
                          f"(got {max_orbits:g})")
     check_tolerances(rtol, None)
-    center_starts = require_count("center_starts", center_starts, 2, 100000)
+    centre_starts = require_count("centre_starts", centre_starts, 2, 100000)
     separatrix_starts = require_count("separatrix_starts", separatrix_starts, 2, 100000)
     require_scalar("libration_limit", libration_limit, 0.0, 90.0, low_open=True, unit="deg")
     require_callable("progress", progress)
-    if not (isinstance(system_name_or_factory, str) or callable(system_name_or_factory)):
-        raise TypeError(f"system_name_or_factory must be a catalogue name or a callable "
-                        f"(elongation) -> BinarySystem (got {type(system_name_or_factory).__name__})")
-    make, name = _factory(system_name_or_factory, eccentricity)
+    if not (isinstance(system, str) or callable(system)):
+        raise TypeError(f"system must be a catalogue name or a callable "
+                        f"(elongation) -> BinarySystem (got {type(system).__name__})")
+    make, name = _factory(system, eccentricity)
+    from .checkpoint import Launches
+    launches = Launches(checkpoint, resume, overwrite_checkpoint)
     if elongations is not None and (np.ndim(elongations) != 1 or np.size(elongations) == 0):
         raise ValueError(f"elongations must be a non-empty 1-D array of a/b values in (1, 10] "
                          f"(got {show(elongations)})")
@@ -294,7 +307,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     try:
-        per_elongation = int(center_starts) + int(separatrix_starts)
+        per_elongation = int(centre_starts) + int(separatrix_starts)
     except (TypeError, ValueError):
         per_elongation = None                  # named by the checks that build the columns
     if per_elongation is not None and per_elongation > 0:
@@ -305,7 +318,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
     systems = [make(float(x)) for x in q]
     e = systems[0].e
     # θ_p = 0 column for the centres; θ_p = 90° column for the connection
-    centre_rates = np.linspace(0.6, 2.0, int(center_starts))
+    centre_rates = np.linspace(0.6, 2.0, int(centre_starts))
     sep_rates = np.linspace(0.8, 1.8, int(separatrix_starts))
     per = len(centre_rates) + len(sep_rates)
     run = dict(chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
@@ -330,7 +343,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                 theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
                 rates += list(centre_rates) + list(sep_rates)
             sec = sections(client, members, np.array(theta0), np.array(rates), orbits=length,
-                           **run)
+                           **run, **launches.next())
             member_orbits += len(members) * float(length)
             first_sec = sec if first_sec is None else first_sec
             for j, k in enumerate(todo):
@@ -367,7 +380,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
             message += (f"; the MEGNO criterion already connects at a/b = "
                         f"{', '.join(waiting)}")
     n_inaccurate = sum(accuracy.count(sec.status[block], "inaccurate") for sec, block in runs)
-    scan = OverlapScan(name=name, eccentricity=e, elongations=q, overlaps=overlaps,
+    scan = OverlapScan(rtol=float(rtol), name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
                        elongation_ro=float(analytic.elongation_from_omega0(w_ro)),
                        orbits=float(ran[-1]), seconds=time.perf_counter() - t0,
@@ -453,8 +466,8 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
     k = int(np.argmax(connects)) if connects.any() else None
     megno = sec.megno[sep_idx]
     return OverlapDecision(
-        elongation=q, omega0=system.omega0, overlap=bool(connects.any()), center_1=c1,
-        center_3_2=c32, center_3_2_found=found,
+        elongation=q, omega0=system.omega0, overlap=bool(connects.any()), centre_1=c1,
+        centre_3_2=c32, centre_3_2_found=found,
         connecting_start=None if k is None else float(sep_rates[k]),
         connecting_range=None if k is None else (float(lo[k]), float(hi[k])),
         widest_range=(float(lo[widest]), float(hi[widest])),
@@ -479,7 +492,7 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     args = dict(default, **kwargs)
     try:
         per_scan = (15 if elongations is None else np.size(elongations)) * \
-            (int(args["center_starts"]) + int(args["separatrix_starts"]))
+            (int(args["centre_starts"]) + int(args["separatrix_starts"]))
         orbits = float(args["orbits"])
     except (TypeError, ValueError):
         per_scan = None                        # named by overlap_threshold's own checks

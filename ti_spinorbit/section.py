@@ -24,6 +24,7 @@ from ._validate import (_as_floats, require_callable, require_count, require_fin
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
+from .results import COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -52,19 +53,31 @@ def _check_run_inputs(rtol, atol, order, progress, window_orbits):
     require_callable("progress", progress)
 
 
-def check_size(what, system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit=None,
+def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None,
                model="auto"):
     """Refuse a run whose estimated peak memory (``resources.estimate_bytes``) exceeds what
     is available, from the input sizes alone: before any member is built. Inputs that do
     not broadcast are left to :func:`build_members`, which names them."""
     from . import resources
 
-    systems = () if isinstance(system_or_systems, BinarySystem) else \
-        (len(system_or_systems),) if hasattr(system_or_systems, "__len__") else None
+    systems = () if isinstance(system, BinarySystem) else \
+        (len(system),) if hasattr(system, "__len__") else None
     n = None if systems is None else resources.member_count(systems, theta_p, thetadot_p)
     if n is not None:
         resources.check_memory(what, n, orbits, samples_per_orbit,
-                               width=resources.record_width(system_or_systems, model))
+                               width=resources.record_width(system, model))
+
+
+def _system_argument(system):
+    """Catalogue names (a str, or str entries of a list) as BinarySystems; anything else as
+    given (build_members checks it)."""
+    from . import catalog
+
+    if isinstance(system, str):
+        return catalog.system(system)
+    if isinstance(system, (list, tuple)) and any(isinstance(s, str) for s in system):
+        return [catalog.system(s) if isinstance(s, str) else s for s in system]
+    return system
 
 
 def _warn_near_circular(members):
@@ -82,7 +95,7 @@ def _warn_near_circular(members):
                       NearCircularWarning, stacklevel=3)
 
 
-def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
+def build_members(system: SystemLike, theta_p, thetadot_p,
                   escape_distance=ESCAPE_DISTANCE, coordinates="inertial", order=4):
     """Broadcast systems and initial conditions into a member table.
 
@@ -96,13 +109,13 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
         raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
                          f"(got {escape_distance!r})")
     try:
-        systems = [system_or_systems] if isinstance(system_or_systems, BinarySystem) else \
-            list(system_or_systems)
+        systems = [system] if isinstance(system, BinarySystem) else \
+            list(system)
     except TypeError:                       # not iterable (a number, None)
         systems = []
     if not systems or not all(isinstance(s, BinarySystem) for s in systems):
-        raise TypeError("system_or_systems must be a BinarySystem or a non-empty list of them "
-                        f"(got {show(system_or_systems)})")
+        raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
+                        f"of them (got {show(system)})")
     # checked before the conversion, so complex values and text are refused, not cast
     theta_p = np.asarray(require_finite("theta_p", theta_p), dtype=np.float64)
     thetadot_p = np.asarray(require_spin("thetadot_p", thetadot_p), dtype=np.float64)
@@ -127,7 +140,7 @@ def build_members(system_or_systems: SystemLike, theta_p, thetadot_p,
 
 
 @dataclass(repr=False)
-class SectionResult(accuracy.StatusSummary, _display.Readable):
+class SectionResult(Result, _display.Readable):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
@@ -144,44 +157,47 @@ class SectionResult(accuracy.StatusSummary, _display.Readable):
     then holds ϖ̇/n at every crossing, NaN where e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``);
     θ_p is the same in both (docs/physics.md §6.7)."""
 
-    theta_p: np.ndarray
-    thetadot_p: np.ndarray
-    t: np.ndarray
-    r: np.ndarray
-    a: np.ndarray
-    e: np.ndarray
-    count: np.ndarray
-    energy_drift: np.ndarray
-    angmom_drift: np.ndarray
-    status: np.ndarray
-    accepted: np.ndarray
-    rejected: np.ndarray
-    rhs_calls: np.ndarray
-    initial_theta_p: np.ndarray
-    initial_thetadot_p: np.ndarray
+    theta_p: np.ndarray = unit('deg')
+    thetadot_p: np.ndarray = unit(SPIN)
+    t: np.ndarray = unit('s')
+    r: np.ndarray = unit('m')
+    a: np.ndarray = unit('m')
+    e: np.ndarray = unit('1')
+    count: np.ndarray = unit('crossings')
+    energy_drift: np.ndarray = unit(RELATIVE)
+    angmom_drift: np.ndarray = unit(RELATIVE)
+    status: np.ndarray = unit(STATUS)
+    accepted: np.ndarray = unit('steps')
+    rejected: np.ndarray = unit('steps')
+    rhs_calls: np.ndarray = unit('calls')
+    initial_theta_p: np.ndarray = unit('deg')
+    initial_thetadot_p: np.ndarray = unit(SPIN)
     systems: list = field(repr=False)
-    rtol: float = 1e-12
-    atol: float = 1e-12
-    order: int = 4
-    orbits: float = 0.0
-    seconds: float = 0.0
-    megno: np.ndarray = None
-    lyapunov: np.ndarray = None
-    max_drift: float = float("nan")
-    coordinates: str = "inertial"
-    apsidal_rate: np.ndarray = None
+    rtol: float = unit('1', default=1e-12)
+    atol: float = unit('1', default=1e-12)
+    order: int = unit('potential truncation order', default=4)
+    orbits: float = unit(ORBITS, default=0.0)
+    seconds: float = unit('s', default=0.0)
+    megno: np.ndarray = unit('1', default=None)
+    lyapunov: np.ndarray = unit('1/orbit', default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    coordinates: str = unit(COORDINATES, default="inertial")
+    apsidal_rate: np.ndarray = unit(SPIN, default=None)
 
     @property
     def member_orbits_per_second(self) -> float:
         return float(self.orbits * len(self.count) / self.seconds) if self.seconds else float("nan")
 
     def plot(self, ax=None, colors=None, **kwargs):
-        """Scatter θ̇_p/n against θ_p (deg) in the paper's convention; returns the axes."""
+        """Scatter θ̇_p/n against θ_p (deg) in the paper's convention
+        (:func:`ti_spinorbit.plotting.plot_section`: ``classes=`` colours by class with a
+        legend; many members get a colourbar of the start); returns the axes."""
         from .plotting import plot_section
         return plot_section(self, ax=ax, colors=colors, **kwargs)
 
 
-def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-12,
+@renamed_keywords(system_or_systems="system")
+def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-12,
                        atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
                        progress=None, model="auto", checkpoint=None,
@@ -191,8 +207,9 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
 
     Parameters
     ----------
-    system_or_systems : BinarySystem or list of BinarySystem
-        One system for all members, or one per member (broadcast with the other inputs).
+    system : BinarySystem, str or list of them
+        One system for all members, or one per member (broadcast with the other inputs); a
+        str is a catalogue name (``ti_spinorbit.catalog``).
     theta_p : float or array
         Initial angle of the secondary's long axis from the line of centres, degrees.
     thetadot_p : float or array
@@ -245,11 +262,12 @@ def surface_of_section(system_or_systems: SystemLike, theta_p, thetadot_p, orbit
     SectionResult
     """
     _coords.check_coordinates(coordinates)
+    system = _system_argument(system)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
-    check_size("surface_of_section", system_or_systems, theta_p, thetadot_p, orbits, model=model)
-    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance,
+    check_size("surface_of_section", system, theta_p, thetadot_p, orbits, model=model)
+    members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
                                              coordinates, order)
     _warn_near_circular(members)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
@@ -318,7 +336,7 @@ def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4)
 
 
 @dataclass(repr=False)
-class TimeSeriesResult(accuracy.StatusSummary, _display.Readable):
+class TimeSeriesResult(Result, _display.Readable):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
 
     ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
@@ -334,31 +352,69 @@ class TimeSeriesResult(accuracy.StatusSummary, _display.Readable):
     line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
     e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7."""
 
-    t: np.ndarray
-    alpha: np.ndarray
-    theta: np.ndarray
-    thetadot: np.ndarray
-    r: np.ndarray
-    energy: np.ndarray
-    energy_orbit: np.ndarray
-    energy_primary: np.ndarray
-    energy_secondary: np.ndarray
-    angmom_orbit: np.ndarray
-    angmom_primary: np.ndarray
-    angmom_secondary: np.ndarray
-    status: np.ndarray
+    t: np.ndarray = unit('s')
+    alpha: np.ndarray = unit('deg')
+    theta: np.ndarray = unit('deg')
+    thetadot: np.ndarray = unit(SPIN)
+    r: np.ndarray = unit('m')
+    energy: np.ndarray = unit('J')
+    energy_orbit: np.ndarray = unit('J')
+    energy_primary: np.ndarray = unit('J')
+    energy_secondary: np.ndarray = unit('J')
+    angmom_orbit: np.ndarray = unit('kg m^2 s^-1')
+    angmom_primary: np.ndarray = unit('kg m^2 s^-1')
+    angmom_secondary: np.ndarray = unit('kg m^2 s^-1')
+    status: np.ndarray = unit(STATUS)
     systems: list = field(repr=False)
-    initial_theta_p: np.ndarray = None
-    initial_thetadot_p: np.ndarray = None
-    energy_drift: np.ndarray = None
-    angmom_drift: np.ndarray = None
-    max_drift: float = float("nan")
-    rtol: float = float("nan")
-    orbits: float = float("nan")
-    coordinates: str = "inertial"
+    initial_theta_p: np.ndarray = unit('deg', default=None)
+    initial_thetadot_p: np.ndarray = unit(SPIN, default=None)
+    energy_drift: np.ndarray = unit(RELATIVE, default=None)
+    angmom_drift: np.ndarray = unit(RELATIVE, default=None)
+    max_drift: float = unit(RELATIVE, default=float("nan"))
+    rtol: float = unit('1', default=float("nan"))
+    orbits: float = unit(ORBITS, default=float("nan"))
+    coordinates: str = unit(COORDINATES, default="inertial")
+    seconds: float = unit('s', default=0.0)
+
+    def plot(self, ax=None, quantity="thetadot", members=None, title=None):
+        """Each member's θ̇/n (or ``quantity`` "alpha", "theta", "r") against time:
+        :func:`ti_spinorbit.plotting.plot_time_series`. Returns the Axes."""
+        from .plotting import plot_time_series
+        return plot_time_series(self, ax=ax, quantity=quantity, members=members, title=title)
+
+    def plot_conservation(self, member=0, title=None):
+        """Energy and angular-momentum drift and the orbit/spin energy exchange of one member
+        against time (:func:`ti_spinorbit.plotting.plot_conservation`). Returns the top Axes."""
+        from .plotting import plot_conservation
+        return plot_conservation(self, member=member, title=title)
+
+    def conservation(self, member=0):
+        """Conservation numbers of one member: the largest relative drift of the total energy
+        and of the total angular-momentum vector over its samples, and the largest change of
+        each energy part relative to |E0| (the orbit/spin exchange).
+
+        Returns (numbers, series): ``numbers`` a dict of floats ("energy_drift",
+        "angmom_drift", "exchange_orbit", "exchange_primary", "exchange_secondary") and
+        "samples"; ``series`` (t s, ΔE/|E0|, |ΔL|/|L0|, {part: ΔE_part/|E0|}) per sample."""
+        member = require_count("member", member, 0, len(self.t) - 1)
+        ok = np.isfinite(self.t[member])
+        t = self.t[member][ok]
+        energy = self.energy[member][ok]
+        e0 = energy[0]
+        angmom = sum(getattr(self, f"angmom_{k}")[member][ok] for k in ("orbit", "primary", "secondary"))
+        l0 = np.linalg.norm(angmom[0])
+        de = (energy - e0) / abs(e0)
+        dl = np.linalg.norm(angmom - angmom[0], axis=1) / l0
+        parts = {k: (getattr(self, f"energy_{k}")[member][ok] - getattr(self, f"energy_{k}")[member][ok][0])
+                 / abs(e0) for k in ("orbit", "primary", "secondary")}
+        numbers = {"energy_drift": float(np.max(np.abs(de))), "angmom_drift": float(np.max(dl)),
+                   **{f"exchange_{k}": float(np.max(np.abs(v))) for k, v in parts.items()},
+                   "samples": int(len(t))}
+        return numbers, (t, de, dl, parts)
 
 
-def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
+@renamed_keywords(system_or_systems="system")
+def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
                 rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                 escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
                 resume=False, overwrite_checkpoint=False,
@@ -371,13 +427,14 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
     every sample (and the end); ``max_drift`` and ``coordinates`` as for surface_of_section
     (apsidal: θ from the osculating line of apsides and θ̇ its rate, the starts' θ̇_p too)."""
     _coords.check_coordinates(coordinates)
+    system = _system_argument(system)
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
-    check_size("time_series", system_or_systems, theta_p, thetadot_p, orbits, samples_per_orbit,
+    check_size("time_series", system, theta_p, thetadot_p, orbits, samples_per_orbit,
                model)
-    members, par, y0, tp, td = build_members(system_or_systems, theta_p, thetadot_p, escape_distance,
+    members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
                                              coordinates, order)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
     out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
@@ -405,7 +462,7 @@ def time_series(system_or_systems: SystemLike, theta_p, thetadot_p, orbits, samp
         **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
-        orbits=orbits, coordinates=coordinates)
+        orbits=orbits, coordinates=coordinates, seconds=out.seconds)
 
 
 def _sampled_drifts(cols, out: RunOutput):

@@ -27,6 +27,7 @@ import os
 import numpy as np
 
 from . import io
+from .results import units as field_units
 
 INSTALL_HINT = 'to_xarray needs xarray: pip install "ti-spinorbit[xarray]"'
 
@@ -115,7 +116,7 @@ def _time_series(r, units):
 def _chaos_map(r, units):
     dims = ("theta_p", "thetadot_p")
     data = {k: (dims, _labels(getattr(r, k)))
-            for k in ("megno", "lyapunov", "classification", "mean_spin", "status",
+            for k in ("megno", "lyapunov", "classification", "mean_thetadot", "status",
                       "energy_drift", "angmom_drift") if getattr(r, k) is not None}
     data["status_name"] = (dims, io.status_names(r.status))
     return data, {"theta_p": r.theta_p, "thetadot_p": r.thetadot_p}
@@ -124,7 +125,7 @@ def _chaos_map(r, units):
 def _parameter_map(r, units):
     grid, per_start = ("elongation", "eccentricity"), ("elongation", "eccentricity", "start")
     data = {"chaotic_fraction": (grid, r.chaotic_fraction),
-            "megno": (per_start, r.megno), "labels": (per_start, _labels(r.labels)),
+            "megno": (per_start, r.megno), "classification": (per_start, _labels(r.classification)),
             "status": (per_start, r.status), "status_name": (per_start, io.status_names(r.status)),
             "omega0": ("elongation", r.omega0)}
     for k, dims in (("energy_drift", per_start), ("angmom_drift", per_start), ("inaccurate", grid)):
@@ -148,11 +149,11 @@ def _overlap_scan(r, units):
                          for x in d], dtype=np.float64).reshape(len(d), 2)
 
     data = {"overlaps": ("elongation", r.overlaps)}
-    for name in ("omega0", "center_1", "center_3_2", "connecting_start", "connecting_megno",
+    for name in ("omega0", "centre_1", "centre_3_2", "connecting_start", "connecting_megno",
                  "connecting_lyapunov", "separatrix_chaotic_fraction", "inaccurate",
                  "max_energy_drift"):
         data[name] = ("elongation", col(name))
-    data["center_3_2_found"] = ("elongation", np.array([x.center_3_2_found for x in d], dtype=bool))
+    data["centre_3_2_found"] = ("elongation", np.array([x.centre_3_2_found for x in d], dtype=bool))
     for name in ("connecting_range", "widest_range"):
         data[name] = (("elongation", "bound"), ranges(name))
     for name in list(data):
@@ -207,7 +208,7 @@ def to_xarray(result_or_path):
     else:
         result = result_or_path
     kind = io.kind_of(result)
-    units = io.units(kind)
+    units = {**io.ARCHIVE_UNITS, **field_units(result)}     # units live on the fields
     data, coords = _BUILDERS[kind](result, units)
     ds = xr.Dataset(data, coords=coords, attrs=_attrs(result, kind, metadata))
     for name, var in ds.variables.items():

@@ -1,0 +1,180 @@
+"""One protocol for every result: statuses, units on the fields, plot, save, xarray.
+
+Every result class of the package (:class:`~ti_spinorbit.section.SectionResult`,
+:class:`~ti_spinorbit.section.TimeSeriesResult`, :class:`~ti_spinorbit.chaosmap.ChaosMap`,
+:class:`~ti_spinorbit.chaosmap.ParameterMap`, :class:`~ti_spinorbit.overlap.OverlapScan`,
+:class:`~ti_spinorbit.libration.RelaxedLibration`) is a dataclass deriving from
+:class:`Result`, and so has
+
+* ``status`` (codes, :class:`Status`), ``status_names``, ``status_counts``, ``n_inaccurate``;
+* ``seconds`` (wall time), ``rtol`` (integrator tolerance), ``orbits`` (run length, orbital
+  periods);
+* ``.plot()`` (figures live in :mod:`ti_spinorbit.plotting`), ``.save(path)``
+  (:func:`ti_spinorbit.io.save`), ``.to_xarray()`` (:func:`ti_spinorbit.xarray_io.to_xarray`);
+* the unit of every field on the field itself: ``dataclasses.fields(cls)[k].metadata["unit"]``
+  (declared with :func:`unit`), which :mod:`ti_spinorbit.io` writes into every archive and
+  :mod:`ti_spinorbit.xarray_io` puts on every variable; :func:`units` collects them.
+
+The data flow one way: this module imports neither io nor xarray_io at import time (the
+methods import them when called); xarray_io imports io; io imports neither.
+"""
+
+import dataclasses
+import enum
+
+import numpy as np
+
+
+class Status(enum.IntEnum):
+    """A member's status: the integrator's verdict (kernels), then the accuracy check's
+    (``INACCURATE``, set on the host by :mod:`ti_spinorbit.accuracy`). The values are the
+    codes stored in every ``status`` array and archive."""
+
+    RUNNING = 0
+    DONE = 1
+    COLLISION = 2
+    ESCAPE = 3
+    STEP_UNDERFLOW = 4
+    NONFINITE = 5
+    INACCURATE = 6
+
+    @property
+    def label(self) -> str:
+        """The status as text: "done", "step underflow", "non-finite", ..."""
+        return STATUS_NAMES[self.value]
+
+    @classmethod
+    def from_label(cls, text):
+        """The Status called ``text`` ("done", "non-finite", ...), or ValueError."""
+        try:
+            return cls(STATUS_NAMES.index(text))
+        except ValueError:
+            raise ValueError(f"status must be one of {', '.join(STATUS_NAMES)} "
+                             f"(got {text!r})") from None
+
+
+#: Status names by code (the text of ``status_names``; equal to kernels.ensemble.STATUS_NAMES).
+STATUS_NAMES = tuple(s.name.lower().replace("_", " ").replace("nonfinite", "non-finite")
+                     for s in Status)
+
+# units shared by many fields
+SPIN = "mean motion n"                 # spin rates and frequencies in units of n
+STATUS = "status code (metadata status_codes)"
+CLASS = "label"
+RELATIVE = "1 (relative)"
+ORBITS = "orbital periods"
+COORDINATES = ("name: 'inertial' (θ̇ = inertial spin rate) or 'apsidal' (θ̇ = spin rate − "
+               "apsidal rate ϖ̇, θ from the osculating line of apsides)")
+
+
+def unit(text, **kwargs):
+    """A dataclass field whose unit is ``text`` ("deg", "mean motion n", "1" for
+    dimensionless); ``kwargs`` go to :func:`dataclasses.field` (``default=``, ``repr=``)."""
+    metadata = dict(kwargs.pop("metadata", {}), unit=text)
+    return dataclasses.field(metadata=metadata, **kwargs)
+
+
+def units(cls_or_result):
+    """{field: unit} of a result class or object; fields holding records (a ``records``
+    entry in the field metadata, e.g. ``OverlapScan.decisions``) add their records' units
+    as ``"field/name"``."""
+    cls = cls_or_result if isinstance(cls_or_result, type) else type(cls_or_result)
+    out = {}
+    for f in dataclasses.fields(cls):
+        if "unit" in f.metadata:
+            out[f.name] = f.metadata["unit"]
+        record = f.metadata.get("records")
+        if record is not None:
+            out.update({f"{f.name}/{k}": v for k, v in units(record).items()})
+    return out
+
+
+class Result:
+    """The protocol every result shares (see the module docstring). Subclasses are
+    dataclasses with ``status``, ``seconds``, ``rtol``, ``orbits`` fields (or properties)
+    and a ``plot`` that delegates to :mod:`ti_spinorbit.plotting`."""
+
+    def _status_array(self):
+        status = getattr(self, "status", None)
+        if status is None:
+            return np.zeros(0, dtype=np.int32)
+        if isinstance(status, str):            # RelaxedLibration: one trajectory, by name
+            return np.array([Status.from_label(status).value], dtype=np.int32)
+        return np.asarray(status)
+
+    @property
+    def status_names(self):
+        """Each member's status as text ("done", "inaccurate", "collision", ...), a list in
+        the order (and, flattened, the shape) of ``status``."""
+        return [STATUS_NAMES[s] for s in self._status_array().ravel()]
+
+    @property
+    def status_counts(self) -> dict:
+        """Members per status name, e.g. {"done": 30, "inaccurate": 2}."""
+        codes, n = np.unique(self._status_array().ravel(), return_counts=True)
+        return {STATUS_NAMES[int(c)]: int(k) for c, k in zip(codes, n)}
+
+    @property
+    def n_inaccurate(self) -> int:
+        """Members that finished with a drift above ``max_drift`` (data kept, status
+        "inaccurate")."""
+        return int(np.count_nonzero(self._status_array() == Status.INACCURATE))
+
+    def save(self, path, **kwargs):
+        """Write this result to ``path`` (``.npz``): :func:`ti_spinorbit.io.save` (keywords
+        ``extra``, ``include_sections``); returns the path written."""
+        from . import io
+
+        return io.save(self, path, **kwargs)
+
+    def to_xarray(self):
+        """This result as a labelled ``xarray.Dataset`` with units
+        (:func:`ti_spinorbit.xarray_io.to_xarray`; needs xarray)."""
+        from .xarray_io import to_xarray
+
+        return to_xarray(self)
+
+    @classmethod
+    def units(cls):
+        """{field: unit} of this result class (:func:`units`)."""
+        return units(cls)
+
+    def plot(self, *args, **kwargs):      # pragma: no cover - every result overrides it
+        raise NotImplementedError(f"{type(self).__name__}.plot")
+
+
+def alias(new):
+    """A read-only property giving attribute ``new`` under an old name (kept so that code and
+    tests written against the old vocabulary keep working; files are upgraded by io)."""
+    return property(lambda self: getattr(self, new), doc=f"Old name of ``{new}`` (read-only).")
+
+
+def deprecated_keyword(function, kwargs, old, new):
+    """Move ``kwargs[old]`` to ``kwargs[new]`` with a DeprecationWarning (an old keyword name
+    of an entry point); TypeError when both are given."""
+    import warnings
+
+    if old in kwargs:
+        if new in kwargs:
+            raise TypeError(f"{function}() got both {new!r} and its old name {old!r}")
+        warnings.warn(f"{function}(): {old}= is now {new}=", DeprecationWarning, stacklevel=3)
+        kwargs[new] = kwargs.pop(old)
+    return kwargs
+
+
+def renamed_keywords(**old_to_new):
+    """Decorator: an entry point still takes its old keyword names (``old=new`` pairs) with a
+    DeprecationWarning; positional use is unchanged."""
+    import functools
+
+    def wrap(function):
+        @functools.wraps(function)
+        def inner(*args, **kwargs):
+            for old, new in old_to_new.items():
+                deprecated_keyword(function.__name__, kwargs, old, new)
+            return function(*args, **kwargs)
+        return inner
+    return wrap
+
+
+__all__ = ["Status", "STATUS_NAMES", "Result", "unit", "units"]
