@@ -45,7 +45,7 @@ def test_section_writes_png_and_self_describing_data(tmp_path):
     assert meta["command"].startswith("ti-spinorbit section")
     assert "1991 VH" in p.stdout and "wrote" in p.stdout
     # not a terminal: the progress bar writes sparse plain lines, ending at 100 %
-    assert "section [" in p.stderr and p.stderr.strip().splitlines()[-1].count("100%") == 1
+    assert "section: " in p.stderr and p.stderr.strip().splitlines()[-1].count("100%") == 1
 
 
 def test_systems_lists_the_catalogue(tmp_path):
@@ -105,7 +105,10 @@ def test_libration_command(tmp_path):
     assert 0.0 < result.amplitude < 90.0 and result.converged
     # the printed numbers are the saved ones
     assert f"amplitude {result.amplitude:.4f} deg" in p.stdout
-    assert f"psi_A = {result.psi_A:.4f} deg" in p.stdout
+    # ψ_A as an amplitude with its phase in words, never a negative angle (issue 14 §7)
+    assert f"|ψ_A| = {abs(result.psi_A):.4f} deg" in p.stdout
+    assert result.psi_A < 0 and f"{result.psi_A:.4f}" not in p.stdout
+    assert "(phase: ψ = −|ψ_A| sin M, in antiphase with M" in p.stdout
 
 
 def test_energy_command_reports_drift_and_exchange(tmp_path):
@@ -198,93 +201,6 @@ def test_top_level_help_lists_every_subcommand(capsys):
     text = capsys.readouterr().out
     for command in cli.HANDLERS:
         assert command in text and f"ti-spinorbit {command}" in text
-
-
-# ---- progress bar (fake clock, in-memory stream) ---------------------------------------
-
-class FakeClock:
-    def __init__(self):
-        self.now = 100.0
-
-    def __call__(self):
-        return self.now
-
-
-def make_bar(tty, **kwargs):
-    import io
-
-    from ti_spinorbit.progress import ProgressBar
-
-    clock, stream = FakeClock(), io.StringIO()
-    return ProgressBar("map", stream=stream, tty=tty, clock=clock, width=10, **kwargs), clock, stream
-
-
-def test_eta_and_durations():
-    from ti_spinorbit.progress import eta_seconds, format_duration
-
-    assert eta_seconds(0.25, 30.0) == 90.0         # a quarter in 30 s: 90 s to go
-    assert eta_seconds(0.0, 30.0) is None and eta_seconds(1.0, 30.0) == 0.0
-    assert [format_duration(s) for s in (0, 59.4, 59.6, 61, 3599, 3600, 3725, None, math.inf)] \
-        == ["0:00", "0:59", "1:00", "1:01", "59:59", "1:00:00", "1:02:05", "--:--", "--:--"]
-
-
-def test_terminal_bar_redraws_in_place():
-    bar, clock, stream = make_bar(tty=True)
-    bar(0.0)
-    assert stream.getvalue() == "\rmap [..........]   0%  elapsed 0:00  ETA --:--"
-    clock.now += 10.0
-    bar(0.5)
-    # padded with blanks over the longer "ETA --:--" line
-    assert stream.getvalue().split("\r")[-1] == "map [#####.....]  50%  elapsed 0:10  ETA 0:10 "
-    clock.now += 0.05                 # too soon after the last redraw: skipped
-    bar(0.6)
-    assert "60%" not in stream.getvalue()
-    clock.now += 3590.0
-    bar(0.75)                         # ETA 1:00:00 -> a longer line, then a shorter one
-    long = stream.getvalue().split("\r")[-1]
-    assert long == "map [#######...]  75%  elapsed 1:00:00  ETA 20:00"
-    clock.now += 1.0
-    bar(1.0)
-    last = stream.getvalue().split("\r")[-1]
-    assert last.startswith("map [##########] 100%  elapsed 1:00:01  ETA 0:00")
-    assert len(last) >= len(long)     # padded: no leftovers of the longer line
-    bar.close()
-    bar.close()
-    assert stream.getvalue().endswith("\n") and stream.getvalue().count("\n") == 1
-
-
-def test_plain_bar_writes_every_ten_percent():
-    bar, clock, stream = make_bar(tty=False)
-    with bar:
-        for k in range(1, 101):
-            clock.now += 1.0
-            bar(k / 100)
-        bar(1.0)                      # a repeated 100 % is not written twice
-    lines = stream.getvalue().splitlines()
-    assert "\r" not in stream.getvalue() and len(lines) == 10
-    assert [line.split("]")[1].split("%")[0].strip() for line in lines] == \
-        [str(p) for p in range(10, 101, 10)]
-    assert lines[0] == "map [#.........]  10%  elapsed 0:10  ETA 1:30"
-    assert stream.getvalue().endswith("100%  elapsed 1:40  ETA 0:00\n")
-
-
-def test_plain_bar_jumps_and_odd_fractions():
-    bar, clock, stream = make_bar(tty=False)
-    bar(float("nan"))                 # ignored
-    bar(0.35)                         # one line for the 10-30 % crossed at once
-    bar(0.36)
-    bar(2.0)                          # clipped to 100 %
-    lines = stream.getvalue().splitlines()
-    assert len(lines) == 2 and " 35%" in lines[0] and "100%" in lines[1]
-
-
-def test_quiet_bar_draws_nothing():
-    for tty in (True, False):
-        bar, clock, stream = make_bar(tty=tty, quiet=True)
-        with bar:
-            bar(0.5)
-            bar(1.0)
-        assert stream.getvalue() == ""
 
 
 def read_checkpoint_launches(path):

@@ -31,6 +31,7 @@ from .classify import classify_section
 from .libration import libration_amplitude, relaxed_libration
 from .overlap import overlap_threshold
 from .io import load, save, to_xarray
+from .compiling import warmup
 
 __version__ = "0.1.0"
 
@@ -38,5 +39,5 @@ __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_p
            "ImplausibleInputWarning", "NearCircularWarning",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
-           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray",
+           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray", "warmup",
            "__version__"]

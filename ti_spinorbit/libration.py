@@ -128,9 +128,10 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         circulates, the integration stopped early (collision, escape, ...) or the member
         failed the accuracy check (unless ``include_inaccurate``).
     """
-    ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
-                     rtol=rtol, max_drift=max_drift, coordinates=coordinates,
-                     progress=progress)
+    with _progress.reporting(progress, "libration_amplitude") as report:
+        ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
+                         rtol=rtol, max_drift=max_drift, coordinates=coordinates,
+                         progress=report)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
