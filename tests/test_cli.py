@@ -191,7 +191,7 @@ def test_help_has_examples(command, capsys):
     assert exit_.value.code == 0
     text = capsys.readouterr().out
     assert "examples:" in text and f"ti-spinorbit {command}" in text
-    if command not in ("systems", "figures"):
+    if command not in ("systems", "figures", "warmup"):
         assert "--arch" in text and "--quiet" in text and "--out" in text
 
 
@@ -236,3 +236,129 @@ def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
     with np.load(tmp_path / "m.npz") as a, np.load(tmp_path / "full.npz") as b:
         for key in ("megno", "lyapunov", "status", "section/theta_p", "section/thetadot_p"):
             np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+
+
+# ---- output hygiene (issue 14 §7) ------------------------------------------------------
+
+@pytest.mark.parametrize("argv, stem", [
+    (["section"], "sos_1991VH"),
+    (["section", "--elongation", "1.06"], "sos_1991VH_ab1.06"),
+    (["section", "--system", "2004 DC", "--density", "2500", "--eccentricity", "0.1",
+      "--theta-p", "30"], "sos_2004DC_rho2500_e0.1_tp30"),
+    (["section", "--thetadot", "1.13", "1.63"], "sos_1991VH_td1.13-1.63"),
+    (["section", "--thetadot", "1", "1.5", "2", "2.5"], "sos_1991VH_td1-2.5-4"),
+    (["section", "--orbits", "1000", "--rtol", "1e-13", "--model", "3d",
+      "--coordinates", "apsidal"], "sos_1991VH_o1000_rtol1e-13_3d_apsidal"),
+    # defaults given explicitly and flags that change no physics are not named
+    (["section", "--orbits", "500", "--max-drift", "1e-6", "--arch", "cpu", "--quiet"],
+     "sos_1991VH"),
+    (["map", "--grid", "64", "64", "--thetadot-range", "0.5", "2"], "map_1991VH_g64x64_tdr0.5-2"),
+    (["overlap", "--elongations", "1.01", "1.1", "0.01", "--max-orbits", "4000"],
+     "overlap_1991VH_ab1.01-1.1-0.01_maxo4000"),
+    (["libration", "--xtol", "1e-8", "--candidates", "0.2", "1.3", "45"],
+     "libration_Didymos_cand0.2-1.3-45_xtol1e-08"),
+    (["energy", "--samples-per-orbit", "128", "--thetadot", "1.0"], "energy_test_td1_spo128"),
+])
+def test_default_names_carry_the_overridden_physics(argv, stem):
+    args = cli._parser().parse_args(argv)
+    prefix = {"section": "sos"}.get(argv[0], argv[0])
+    assert cli.default_stem(args, prefix, args.system) == stem
+
+
+SMALL_SECTION = ["section", "--elongation", "1.06", "--thetadot", "1.13", "--orbits", "2",
+                 "--rtol", "1e-9"]
+
+
+def test_default_names_in_a_run_and_no_silent_overwrite(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    stem = "sos_1991VH_ab1.06_td1.13_o2_rtol1e-09"
+    assert cli.main(SMALL_SECTION + ["--quiet"]) == 0
+    png = (tmp_path / f"{stem}.png").read_bytes()
+    data = (tmp_path / f"{stem}.npz").read_bytes()
+    capsys.readouterr()
+    assert cli.main(SMALL_SECTION + ["--quiet"]) == cli.EXIT_ERROR       # refused, not redone
+    err = capsys.readouterr().err
+    assert err == (f"ti-spinorbit section: error: the figure (default --out): '{stem}.png' "
+                   "already exists (an earlier run's output?); pass --overwrite to replace it, "
+                   "or choose another --out\n")
+    assert (tmp_path / f"{stem}.png").read_bytes() == png
+    assert (tmp_path / f"{stem}.npz").read_bytes() == data
+    assert cli.main(SMALL_SECTION + ["--quiet", "--overwrite"]) == 0
+
+
+@pytest.mark.parametrize("existing, flags, named", [
+    ("s.png", ["--out", "s.png"], "--out: 's.png'"),
+    ("s.npz", ["--out", "s.png"], "the data file (default --data): 's.npz'"),
+    ("d.npz", ["--out", "s.png", "--data", "d.npz"], "--data: 'd.npz'"),
+])
+def test_an_existing_output_is_refused_before_any_work(tmp_path, monkeypatch, capsys, existing,
+                                                       flags, named):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / existing).write_bytes(b"an earlier run")
+    assert cli.main(SMALL_SECTION + flags) == cli.EXIT_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith(f"ti-spinorbit section: error: {named} already exists") and \
+        "--overwrite" in err and err.count("\n") == 1
+    assert (tmp_path / existing).read_bytes() == b"an earlier run"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [existing]
+
+
+def test_benchmark_report_is_not_overwritten(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "benchmark.json").write_text("{}")
+    assert cli.main(["benchmark", "--members", "2", "--orbits", "1"]) == cli.EXIT_ERROR
+    assert "'benchmark.json' already exists" in capsys.readouterr().err
+    assert (tmp_path / "benchmark.json").read_text() == "{}"
+
+
+@pytest.mark.parametrize("keep", [False, True])
+def test_checkpoint_is_removed_after_success_unless_kept(tmp_path, monkeypatch, capsys, keep):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    argv = SMALL_SECTION + ["--out", "s.png", "--resume"] + (["--keep-checkpoint"] if keep else [])
+    assert cli.main(argv) == 0
+    out = capsys.readouterr().out
+    assert (tmp_path / "s.ckpt").is_dir() == keep
+    assert (tmp_path / "s.npz").is_file()
+    if keep:
+        assert "kept checkpoint s.ckpt (--keep-checkpoint)" in out
+        assert (tmp_path / "s.ckpt" / "state.npz").is_file()
+    else:
+        assert "removed checkpoint s.ckpt (the run is complete; --keep-checkpoint keeps it)" in out
+
+
+def test_no_progress_hides_the_bar_but_not_the_summary(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    assert cli.main(SMALL_SECTION + ["--out", "s.png", "--no-progress"]) == 0
+    captured = capsys.readouterr()
+    assert "%" not in captured.err and "wrote s.png and s.npz" in captured.out
+    assert cli.main(SMALL_SECTION + ["--out", "t.png"]) == 0
+    assert capsys.readouterr().err.strip().splitlines()[-1].startswith("section: 100%")
+
+
+@pytest.mark.parametrize("psi, text", [
+    (-19.9, "(phase: ψ = −|ψ_A| sin M, in antiphase with M, as for omega0 < 1; ψ is the long "
+            "axis's angle from the line of centres, M the mean anomaly)"),
+    (5.0, "(phase: ψ = +|ψ_A| sin M, in phase with M, as for omega0 > 1;"),
+    (0.0, "(no forced libration: e = 0)"),
+    (math.inf, "(phase undefined: omega0 = 1 is the forced resonance)"),
+])
+def test_psi_a_phase_in_words(psi, text):
+    assert cli.psi_phase(psi).startswith(text)
+    assert "19.9" not in cli.psi_phase(psi)
+
+
+def test_warmup_command(capsys):
+    assert cli.main(["warmup", "--models", "planar", "--indicators", "off",
+                     "--sampling", "off"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("planar/plain/sections/order4/cash-karp: ")
+    assert lines[-1].startswith("1 kernel variants ready (")
+
+
+def test_warmup_refuses_an_unknown_method(capsys):
+    assert cli.main(["warmup", "--methods", "dop853"]) == cli.EXIT_ERROR
+    assert capsys.readouterr().err == ("ti-spinorbit warmup: error: --methods must be among "
+                                       "cash-karp (got 'dop853')\n")
