@@ -619,7 +619,7 @@ def _system(args):
 #: default: (dest, tag). The value follows the tag: ab1.06 (--elongation 1.06), rho2500,
 #: e0.1, tp30 (--theta-p), td1.13-1.63 (--thetadot; more than three values: first-last, count),
 #: g64x64 (--grid), tdr0.5-2 (--thetadot-range), ab1.01-1.1-0.01 (--elongations), cand0.2-1.3-45
-#: (--candidates), xtol1e-08, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
+#: (--candidates), xtol1e-8, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
 #: (--max-orbits), rtol1e-13; --model, --coordinates and --method by their value alone (3d,
 #: apsidal, dop853). --max-drift, --arch and output flags change no physics: not named.
 NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
@@ -633,6 +633,8 @@ def default_stem(args, prefix, system_name):
     """Default output name without extension: ``<prefix>_<system>`` and one ``_<tag><value>``
     per physics flag that differs from its default (:data:`NAME_TAGS`), so that runs with
     other parameters never share a file: ``sos_1991VH_ab1.06_o1000``."""
+    import re
+
     defaults = vars(_parser().parse_args([args.command]))
     parts = [prefix, system_name.replace(" ", "")]
     for dest, tag in NAME_TAGS:
@@ -649,6 +651,8 @@ def default_stem(args, prefix, system_name):
                 text = "-".join(items)
         else:
             text = _fmt(value) if isinstance(value, (int, float)) else str(value)
+        # exponents short and without "+": 1e6, 1e-13 (not 1e+06, 1e-13 stays)
+        text = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
         parts.append(tag + text.replace(" ", "").replace(os.sep, "-"))
     return "_".join(parts)
 
