@@ -250,6 +250,8 @@ def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
     (["section", "--orbits", "1000", "--rtol", "1e-13", "--model", "3d",
       "--coordinates", "apsidal"], "sos_1991VH_o1000_rtol1e-13_3d_apsidal"),
     (["section", "--orbits", "1e6", "--rtol", "1e-9"], "sos_1991VH_o1e6_rtol1e-9"),
+    (["map", "--rtol", "1e-4", "--model", "planar"], "map_1991VH_rtol1e-4_planar"),
+    (["map", "--rtol", "2.5e-11"], "map_1991VH_rtol2.5e-11"),
     # defaults given explicitly and flags that change no physics are not named
     (["section", "--orbits", "500", "--max-drift", "1e-6", "--arch", "cpu", "--quiet"],
      "sos_1991VH"),

@@ -649,6 +649,9 @@ def default_stem(args, prefix, system_name):
                 text = f"{items[0]}-{items[-1]}-{len(items)}"
             else:
                 text = "-".join(items)
+        elif dest in ("rtol", "xtol"):               # tolerances always as powers: 1e-4
+            mantissa, exponent = f"{value:.15e}".split("e")
+            text = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
         else:
             text = _fmt(value) if isinstance(value, (int, float)) else str(value)
         # exponents short and without "+": 1e6, 1e-13 (not 1e+06, 1e-13 stays)
