@@ -20,7 +20,7 @@ a tqdm bar on a terminal, a line per 10 % elsewhere; ``--no-progress`` hides it)
 use of a kernel variant says "compiling kernels ... (first use only, about N s)"; compile time
 is left out of elapsed times, ETAs and printed rates. ``--quiet`` prints nothing but errors.
 
-Outputs: default file names carry every physics flag that differs from its default
+File names: defaults carry every physics flag that differs from its default
 (:func:`default_stem`: ``sos_1991VH_ab1.06.png`` for ``--elongation 1.06``). A run never
 overwrites an existing output: it is refused before any work, naming the file, unless
 ``--overwrite``. The checkpoint directory of a run is removed once its outputs are written,
@@ -617,7 +617,7 @@ def _system(args):
 
 #: Physics flags named in default file names, in this order, when they differ from their
 #: default: (dest, tag). The value follows the tag: ab1.06 (--elongation 1.06), rho2500,
-#: e0.1, tp30 (--theta-p), td1.13-1.63 (--thetadot; more than three values: first-last, count),
+#: e0.1, tp30 (--theta-p), td1.13-1.63 (--thetadot; over three values: first-last n count),
 #: g64x64 (--grid), tdr0.5-2 (--thetadot-range), ab1.01-1.1-0.01 (--elongations), cand0.2-1.3-45
 #: (--candidates), xtol1e-8, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
 #: (--max-orbits), rtol1e-13; --model, --coordinates and --method by their value alone (3d,
@@ -646,7 +646,7 @@ def default_stem(args, prefix, system_name):
             if dest == "grid":
                 text = "x".join(items)
             elif len(items) > 3:
-                text = f"{items[0]}-{items[-1]}-{len(items)}"
+                text = f"{items[0]}-{items[-1]}n{len(items)}"
             else:
                 text = "-".join(items)
         elif dest in ("rtol", "xtol"):               # tolerances always as powers: 1e-4
