@@ -45,7 +45,7 @@ def test_section_writes_png_and_self_describing_data(tmp_path):
     assert meta["command"].startswith("ti-spinorbit section")
     assert "1991 VH" in p.stdout and "wrote" in p.stdout
     # not a terminal: the progress bar writes sparse plain lines, ending at 100 %
-    assert "section [" in p.stderr and p.stderr.strip().splitlines()[-1].count("100%") == 1
+    assert "section: " in p.stderr and p.stderr.strip().splitlines()[-1].count("100%") == 1
 
 
 def test_systems_lists_the_catalogue(tmp_path):
@@ -105,7 +105,10 @@ def test_libration_command(tmp_path):
     assert 0.0 < result.amplitude < 90.0 and result.converged
     # the printed numbers are the saved ones
     assert f"amplitude {result.amplitude:.4f} deg" in p.stdout
-    assert f"psi_A = {result.psi_A:.4f} deg" in p.stdout
+    # ψ_A as an amplitude with its phase in words, never a negative angle (issue 14 §7)
+    assert f"|ψ_A| = {abs(result.psi_A):.4f} deg" in p.stdout
+    assert result.psi_A < 0 and f"{result.psi_A:.4f}" not in p.stdout
+    assert "(phase: ψ = −|ψ_A| sin M, in antiphase with M" in p.stdout
 
 
 def test_energy_command_reports_drift_and_exchange(tmp_path):
@@ -188,7 +191,7 @@ def test_help_has_examples(command, capsys):
     assert exit_.value.code == 0
     text = capsys.readouterr().out
     assert "examples:" in text and f"ti-spinorbit {command}" in text
-    if command not in ("systems", "figures"):
+    if command not in ("systems", "figures", "warmup"):
         assert "--arch" in text and "--quiet" in text and "--out" in text
 
 
@@ -198,93 +201,6 @@ def test_top_level_help_lists_every_subcommand(capsys):
     text = capsys.readouterr().out
     for command in cli.HANDLERS:
         assert command in text and f"ti-spinorbit {command}" in text
-
-
-# ---- progress bar (fake clock, in-memory stream) ---------------------------------------
-
-class FakeClock:
-    def __init__(self):
-        self.now = 100.0
-
-    def __call__(self):
-        return self.now
-
-
-def make_bar(tty, **kwargs):
-    import io
-
-    from ti_spinorbit.progress import ProgressBar
-
-    clock, stream = FakeClock(), io.StringIO()
-    return ProgressBar("map", stream=stream, tty=tty, clock=clock, width=10, **kwargs), clock, stream
-
-
-def test_eta_and_durations():
-    from ti_spinorbit.progress import eta_seconds, format_duration
-
-    assert eta_seconds(0.25, 30.0) == 90.0         # a quarter in 30 s: 90 s to go
-    assert eta_seconds(0.0, 30.0) is None and eta_seconds(1.0, 30.0) == 0.0
-    assert [format_duration(s) for s in (0, 59.4, 59.6, 61, 3599, 3600, 3725, None, math.inf)] \
-        == ["0:00", "0:59", "1:00", "1:01", "59:59", "1:00:00", "1:02:05", "--:--", "--:--"]
-
-
-def test_terminal_bar_redraws_in_place():
-    bar, clock, stream = make_bar(tty=True)
-    bar(0.0)
-    assert stream.getvalue() == "\rmap [..........]   0%  elapsed 0:00  ETA --:--"
-    clock.now += 10.0
-    bar(0.5)
-    # padded with blanks over the longer "ETA --:--" line
-    assert stream.getvalue().split("\r")[-1] == "map [#####.....]  50%  elapsed 0:10  ETA 0:10 "
-    clock.now += 0.05                 # too soon after the last redraw: skipped
-    bar(0.6)
-    assert "60%" not in stream.getvalue()
-    clock.now += 3590.0
-    bar(0.75)                         # ETA 1:00:00 -> a longer line, then a shorter one
-    long = stream.getvalue().split("\r")[-1]
-    assert long == "map [#######...]  75%  elapsed 1:00:00  ETA 20:00"
-    clock.now += 1.0
-    bar(1.0)
-    last = stream.getvalue().split("\r")[-1]
-    assert last.startswith("map [##########] 100%  elapsed 1:00:01  ETA 0:00")
-    assert len(last) >= len(long)     # padded: no leftovers of the longer line
-    bar.close()
-    bar.close()
-    assert stream.getvalue().endswith("\n") and stream.getvalue().count("\n") == 1
-
-
-def test_plain_bar_writes_every_ten_percent():
-    bar, clock, stream = make_bar(tty=False)
-    with bar:
-        for k in range(1, 101):
-            clock.now += 1.0
-            bar(k / 100)
-        bar(1.0)                      # a repeated 100 % is not written twice
-    lines = stream.getvalue().splitlines()
-    assert "\r" not in stream.getvalue() and len(lines) == 10
-    assert [line.split("]")[1].split("%")[0].strip() for line in lines] == \
-        [str(p) for p in range(10, 101, 10)]
-    assert lines[0] == "map [#.........]  10%  elapsed 0:10  ETA 1:30"
-    assert stream.getvalue().endswith("100%  elapsed 1:40  ETA 0:00\n")
-
-
-def test_plain_bar_jumps_and_odd_fractions():
-    bar, clock, stream = make_bar(tty=False)
-    bar(float("nan"))                 # ignored
-    bar(0.35)                         # one line for the 10-30 % crossed at once
-    bar(0.36)
-    bar(2.0)                          # clipped to 100 %
-    lines = stream.getvalue().splitlines()
-    assert len(lines) == 2 and " 35%" in lines[0] and "100%" in lines[1]
-
-
-def test_quiet_bar_draws_nothing():
-    for tty in (True, False):
-        bar, clock, stream = make_bar(tty=tty, quiet=True)
-        with bar:
-            bar(0.5)
-            bar(1.0)
-        assert stream.getvalue() == ""
 
 
 def read_checkpoint_launches(path):
@@ -320,3 +236,133 @@ def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
     with np.load(tmp_path / "m.npz") as a, np.load(tmp_path / "full.npz") as b:
         for key in ("megno", "lyapunov", "status", "section/theta_p", "section/thetadot_p"):
             np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+
+
+# ---- output hygiene (issue 14 §7) ------------------------------------------------------
+
+@pytest.mark.parametrize("argv, stem", [
+    (["section"], "sos_1991VH"),
+    (["section", "--elongation", "1.06"], "sos_1991VH_ab1.06"),
+    (["section", "--system", "2004 DC", "--density", "2500", "--eccentricity", "0.1",
+      "--theta-p", "30"], "sos_2004DC_rho2500_e0.1_tp30"),
+    (["section", "--thetadot", "1.13", "1.63"], "sos_1991VH_td1.13-1.63"),
+    (["section", "--thetadot", "1", "1.5", "2", "2.5"], "sos_1991VH_td1-2.5n4"),
+    (["section", "--thetadot", "1", "2.5", "4"], "sos_1991VH_td1-2.5-4"),
+    (["section", "--orbits", "1000", "--rtol", "1e-13", "--model", "3d",
+      "--coordinates", "apsidal"], "sos_1991VH_o1000_rtol1e-13_3d_apsidal"),
+    (["section", "--orbits", "1e6", "--rtol", "1e-9"], "sos_1991VH_o1e6_rtol1e-9"),
+    (["map", "--rtol", "1e-4", "--model", "planar"], "map_1991VH_rtol1e-4_planar"),
+    (["map", "--rtol", "2.5e-11"], "map_1991VH_rtol2.5e-11"),
+    # defaults given explicitly and flags that change no physics are not named
+    (["section", "--orbits", "500", "--max-drift", "1e-6", "--arch", "cpu", "--quiet"],
+     "sos_1991VH"),
+    (["map", "--grid", "64", "64", "--thetadot-range", "0.5", "2"], "map_1991VH_g64x64_tdr0.5-2"),
+    (["overlap", "--elongations", "1.01", "1.1", "0.01", "--max-orbits", "4000"],
+     "overlap_1991VH_ab1.01-1.1-0.01_maxo4000"),
+    (["libration", "--xtol", "1e-8", "--candidates", "0.2", "1.3", "45"],
+     "libration_Didymos_cand0.2-1.3-45_xtol1e-8"),
+    (["energy", "--samples-per-orbit", "128", "--thetadot", "1.0"], "energy_test_td1_spo128"),
+])
+def test_default_names_carry_the_overridden_physics(argv, stem):
+    args = cli._parser().parse_args(argv)
+    prefix = {"section": "sos"}.get(argv[0], argv[0])
+    assert cli.default_stem(args, prefix, args.system) == stem
+
+
+SMALL_SECTION = ["section", "--elongation", "1.06", "--thetadot", "1.13", "--orbits", "2",
+                 "--rtol", "1e-9"]
+
+
+def test_default_names_in_a_run_and_no_silent_overwrite(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    stem = "sos_1991VH_ab1.06_td1.13_o2_rtol1e-9"
+    assert cli.main(SMALL_SECTION + ["--quiet"]) == 0
+    png = (tmp_path / f"{stem}.png").read_bytes()
+    data = (tmp_path / f"{stem}.npz").read_bytes()
+    capsys.readouterr()
+    assert cli.main(SMALL_SECTION + ["--quiet"]) == cli.EXIT_ERROR       # refused, not redone
+    err = capsys.readouterr().err
+    assert err == (f"ti-spinorbit section: error: the figure (default --out): '{stem}.png' "
+                   "already exists (an earlier run's output?); pass --overwrite to replace it, "
+                   "or choose another --out\n")
+    assert (tmp_path / f"{stem}.png").read_bytes() == png
+    assert (tmp_path / f"{stem}.npz").read_bytes() == data
+    assert cli.main(SMALL_SECTION + ["--quiet", "--overwrite"]) == 0
+
+
+@pytest.mark.parametrize("existing, flags, named", [
+    ("s.png", ["--out", "s.png"], "--out: 's.png'"),
+    ("s.npz", ["--out", "s.png"], "the data file (default --data): 's.npz'"),
+    ("d.npz", ["--out", "s.png", "--data", "d.npz"], "--data: 'd.npz'"),
+])
+def test_an_existing_output_is_refused_before_any_work(tmp_path, monkeypatch, capsys, existing,
+                                                       flags, named):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / existing).write_bytes(b"an earlier run")
+    assert cli.main(SMALL_SECTION + flags) == cli.EXIT_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith(f"ti-spinorbit section: error: {named} already exists") and \
+        "--overwrite" in err and err.count("\n") == 1
+    assert (tmp_path / existing).read_bytes() == b"an earlier run"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [existing]
+
+
+def test_benchmark_report_is_not_overwritten(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "benchmark.json").write_text("{}")
+    assert cli.main(["benchmark", "--members", "2", "--orbits", "1"]) == cli.EXIT_ERROR
+    assert "'benchmark.json' already exists" in capsys.readouterr().err
+    assert (tmp_path / "benchmark.json").read_text() == "{}"
+
+
+@pytest.mark.parametrize("keep", [False, True])
+def test_checkpoint_is_removed_after_success_unless_kept(tmp_path, monkeypatch, capsys, keep):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    argv = SMALL_SECTION + ["--out", "s.png", "--resume"] + (["--keep-checkpoint"] if keep else [])
+    assert cli.main(argv) == 0
+    out = capsys.readouterr().out
+    assert (tmp_path / "s.ckpt").is_dir() == keep
+    assert (tmp_path / "s.npz").is_file()
+    if keep:
+        assert "kept checkpoint s.ckpt (--keep-checkpoint)" in out
+        assert (tmp_path / "s.ckpt" / "state.npz").is_file()
+    else:
+        assert "removed checkpoint s.ckpt (the run is complete; --keep-checkpoint keeps it)" in out
+
+
+def test_no_progress_hides_the_bar_but_not_the_summary(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    assert cli.main(SMALL_SECTION + ["--out", "s.png", "--no-progress"]) == 0
+    captured = capsys.readouterr()
+    assert "%" not in captured.err and "wrote s.png and s.npz" in captured.out
+    assert cli.main(SMALL_SECTION + ["--out", "t.png"]) == 0
+    assert capsys.readouterr().err.strip().splitlines()[-1].startswith("section: 100%")
+
+
+@pytest.mark.parametrize("psi, text", [
+    (-19.9, "(phase: ψ = −|ψ_A| sin M, in antiphase with M, as for omega0 < 1; ψ is the long "
+            "axis's angle from the line of centres, M the mean anomaly)"),
+    (5.0, "(phase: ψ = +|ψ_A| sin M, in phase with M, as for omega0 > 1;"),
+    (0.0, "(no forced libration: e = 0)"),
+    (math.inf, "(phase undefined: omega0 = 1 is the forced resonance)"),
+])
+def test_psi_a_phase_in_words(psi, text):
+    assert cli.psi_phase(psi).startswith(text)
+    assert "19.9" not in cli.psi_phase(psi)
+
+
+def test_warmup_command(capsys):
+    assert cli.main(["warmup", "--models", "planar", "--indicators", "off",
+                     "--sampling", "off"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("planar/plain/sections/order4/cash-karp: ")
+    assert lines[-1].startswith("1 kernel variants ready (")
+
+
+def test_warmup_refuses_an_unknown_method(capsys):
+    assert cli.main(["warmup", "--methods", "dop853"]) == cli.EXIT_ERROR
+    assert capsys.readouterr().err == ("ti-spinorbit warmup: error: --methods must be among "
+                                       "cash-karp (got 'dop853')\n")

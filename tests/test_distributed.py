@@ -80,8 +80,10 @@ def test_chaos_map_with_client_equals_local(client, vh, vh_local):
     assert cmap.chaotic_fraction == vh_local.chaotic_fraction or \
         np.isnan(cmap.chaotic_fraction) and np.isnan(vh_local.chaotic_fraction)
     assert_sections_equal(cmap.section, vh_local.section)
-    # default chunking: 12 members, 2 workers -> 3 chunks per worker of 2 members
-    assert len(fractions) == 6 and np.all(np.diff(fractions) > 0) and fractions[-1] == 1.0
+    # default chunking: 12 members, 2 workers -> 3 chunks per worker of 2 members, for each
+    # of the three lengths (orbits/4, orbits/2 for the fraction against length, then orbits)
+    assert len(fractions) == 18 and np.all(np.diff(fractions) > 0) and fractions[-1] == 1.0
+    assert fractions[5] == pytest.approx(1 / 7) and fractions[11] == pytest.approx(3 / 7)
 
 
 @pytest.mark.parametrize("chunk_size", [1, 5, 12, 100])

@@ -235,8 +235,8 @@ def test_cli_map_with_a_loose_tolerance_exits_3_and_keeps_the_data(tmp_path):
                 cwd=tmp_path)
     assert p.returncode == cli.EXIT_INACCURATE == 3, p.stderr
     assert "4 of 4 members inaccurate" in p.stderr and "--allow-inaccurate" in p.stderr
-    m = tso.load(tmp_path / "map_1991VH.npz")
-    assert m.n_inaccurate == 4 and (tmp_path / "map_1991VH.png").exists()
+    m = tso.load(tmp_path / "map_1991VH_g2x2_o10_rtol1e-4.npz")      # the default name
+    assert m.n_inaccurate == 4 and (tmp_path / "map_1991VH_g2x2_o10_rtol1e-4.png").exists()
 
 
 def test_cli_allow_inaccurate_exits_0_and_counts_them(tmp_path):
@@ -257,7 +257,7 @@ def test_cli_energy_fails_its_check_and_saves_the_verdict(tmp_path):
     p = run_cli("energy", "--orbits", "1", "--rtol", "1e-8", "--max-drift", "1e-12",
                 "--quiet", cwd=tmp_path)
     assert p.returncode == 1 and "exceeds --max-drift" in p.stderr
-    ts = tso.load(tmp_path / "energy_test.npz")
+    ts = tso.load(tmp_path / "energy_test_o1_rtol1e-8.npz")     # the default name
     assert ts.status_names == ["inaccurate"] and ts.max_drift == 1e-12
 
 
@@ -300,7 +300,7 @@ def test_cli_output_problems_fail_before_any_work(case, tmp_path):
 
 
 def test_cli_default_data_path_is_checked_too(tmp_path):
-    (tmp_path / "sos_1991VH.npz").mkdir()
+    (tmp_path / "sos_1991VH_o1e6.npz").mkdir()        # the default name carries --orbits
     p = run_cli("section", "--orbits", "1e6", cwd=tmp_path)
     assert p.returncode == 2 and "the data file (default --data)" in p.stderr
 
@@ -337,8 +337,8 @@ def test_cli_plotting_failure_keeps_the_data(tmp_path, monkeypatch, capsys):
     status = cli.main(["section", "--thetadot", "0.83", "--orbits", "2", "--quiet"])
     err = capsys.readouterr().err
     assert status == 2 and "could not be written (disk full)" in err
-    assert "the data are saved in sos_1991VH.npz" in err
-    assert tso.load(tmp_path / "sos_1991VH.npz").count[0] >= 1
+    assert "the data are saved in sos_1991VH_td0.83_o2.npz" in err      # the default name
+    assert tso.load(tmp_path / "sos_1991VH_td0.83_o2.npz").count[0] >= 1
 
 
 # ---- --debug ----------------------------------------------------------------------------

@@ -290,7 +290,8 @@ def test_cli_refuses_overwrite_and_overwrites_on_request(ckpt, tmp_path):
                              "destroy it)")
     assert snapshot(ckpt) == before
     assert not (tmp_path / "s.npz").exists()
-    r = run_cli(*CLI_SECTION, "--checkpoint", str(ckpt), "--overwrite-checkpoint", cwd=tmp_path)
+    r = run_cli(*CLI_SECTION, "--checkpoint", str(ckpt), "--overwrite-checkpoint",
+                "--keep-checkpoint", cwd=tmp_path)          # kept: removed after success else
     assert r.returncode == 0, r.stderr
     assert snapshot(ckpt) != before and (tmp_path / "s.npz").exists()
 
@@ -508,12 +509,13 @@ def test_intact_checkpoint_loads_with_its_digests(ckpt):
 
 def test_cli_damaged_checkpoint_exits_2_with_one_line(ckpt, tmp_path):
     # the CLI's default window (16 orbits) differs from the fixture's: a CLI checkpoint
-    r = run_cli(*CLI_SECTION, "--checkpoint", str(tmp_path / "c.ckpt"), cwd=tmp_path)
+    r = run_cli(*CLI_SECTION, "--checkpoint", str(tmp_path / "c.ckpt"), "--keep-checkpoint",
+                cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     rewrite_zip(tmp_path / "c.ckpt" / "records-000000.npz",
                 rename={"events_data.npy": "x.npy"})
     r = run_cli(*CLI_SECTION, "--checkpoint", str(tmp_path / "c.ckpt"), "--resume",
-                cwd=tmp_path)
+                "--overwrite", cwd=tmp_path)
     assert r.returncode == 2
     assert error_line(r).startswith("ti-spinorbit section: error: checkpoint damaged: ")
     assert "records-000000.npz is not the file this run wrote" in r.stderr

@@ -19,14 +19,14 @@ member), to compare with the analytic overlap criterion ω0 > ω0^RO = 1/(2 + sq
 chaotic-layer estimate ΔE/E0 (Wisdom, Peale & Mignard 1984; docs/physics.md §8.6).
 """
 
-import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Union
 
 import numpy as np
 
-from . import accuracy, analytic, catalog, resources
-from ._validate import (_as_floats, require_callable, require_positive, require_real,
+from . import accuracy, analytic, catalog, compiling, resources
+from . import progress as _progress
+from ._validate import (_as_floats, require_positive, require_real,
                         require_spin, show)
 from .classify import MIN_POINTS, classify_section
 from .coordinates import check_coordinates
@@ -64,7 +64,7 @@ def _check_map_inputs(rtol, megno_chaotic, progress):
     check_tolerances(rtol, None)
     require_real("megno_chaotic", megno_chaotic)
     require_positive("megno_chaotic", megno_chaotic)
-    require_callable("progress", progress)
+    _progress.check(progress)
 
 
 def _chaotic_fraction(labels, status, include_inaccurate=False):
@@ -178,8 +178,11 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         Integrator tolerance (also atol).
     megno_chaotic : float
         ⟨Y⟩ at and above which a member is chaotic (default 4; ⟨Y⟩ → 2 when regular).
-    progress : callable, optional
-        ``progress(fraction)`` after every window (with ``client``: after every chunk).
+    progress : bool or callable, optional
+        None (default): a bar in a terminal or Jupyter for runs over 2 s; True/False:
+        always/never; a callable: ``progress(fraction)`` after every window (with
+        ``client``: after every chunk), the shorter lengths included
+        (:mod:`ti_spinorbit.progress`).
     client : dask.distributed.Client, optional
         Run the grid in chunks on the cluster's workers (:mod:`ti_spinorbit.distributed`);
         the map is identical to the single-process one.
@@ -224,24 +227,32 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
                            advice="use a coarser grid or fewer orbits",
                            width=resources.record_width(system, model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
-    started = time.perf_counter()
+    started = compiling.Stopwatch()          # compile time left out of seconds
     # the shorter lengths first, each dropped after its fraction: the peak memory stays
     # that of the map itself
     fractions = []
-    for length in shorter:
-        short = sections(client, system, tp, td, length, chunk_size=chunk_size, rtol=rtol,
-                         indicators=True, model=model, max_drift=max_drift,
-                         coordinates=coordinates, **section_kwargs)
-        fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length), short.status,
-                                           include_inaccurate))
-        del short
-    section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
-                       indicators=True, progress=progress, model=model, checkpoint=checkpoint,
-                       resume=resume, overwrite_checkpoint=overwrite_checkpoint,
-                       max_drift=max_drift, coordinates=coordinates,
-                       **section_kwargs)
+    work = float(sum(shorter)) + float(orbits)        # progress: each length its share
+    done = 0.0
+    with _progress.reporting(progress, "chaos_map") as report:
+        for length in shorter:
+            short = sections(client, system, tp, td, length, chunk_size=chunk_size, rtol=rtol,
+                             indicators=True, model=model, max_drift=max_drift,
+                             coordinates=coordinates,
+                             progress=_progress.stage(report, done / work, length / work),
+                             **section_kwargs)
+            done += float(length)
+            fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length),
+                                               short.status, include_inaccurate))
+            del short
+        section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
+                           indicators=True,
+                           progress=_progress.stage(report, done / work, orbits / work),
+                           model=model, checkpoint=checkpoint,
+                           resume=resume, overwrite_checkpoint=overwrite_checkpoint,
+                           max_drift=max_drift, coordinates=coordinates,
+                           **section_kwargs)
     labels = _labels(section, megno_chaotic, orbits)
-    seconds = time.perf_counter() - started
+    seconds = started.seconds()
     full = _chaotic_fraction(labels, section.status, include_inaccurate)
     evidence = fraction_evidence(shorter + [float(orbits)], fractions + [full])
     shape = tp.shape
@@ -422,21 +433,27 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         return lab, st, np.array([[_chaotic_fraction(lab[i, j], st[i, j], include_inaccurate)
                                    for j in range(shape[1])] for i in range(shape[0])])
 
-    started = time.perf_counter()
+    started = compiling.Stopwatch()          # compile time left out of seconds
     by_length = []
-    for length in shorter:            # first, each dropped after use (as chaos_map)
-        short = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
-                         length, chunk_size=chunk_size, rtol=rtol, indicators=True,
-                         model=model, max_drift=max_drift, coordinates=coordinates,
-                         **section_kwargs)
-        by_length.append(fractions_of(short, length)[2])
-        del short
-    section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)), orbits,
-                       chunk_size=chunk_size, rtol=rtol, indicators=True, progress=progress,
-                       model=model, checkpoint=checkpoint, resume=resume,
-                       overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
-                       coordinates=coordinates, **section_kwargs)
-    seconds = time.perf_counter() - started
+    work = float(sum(shorter)) + float(orbits)        # progress: each length its share
+    done = 0.0
+    with _progress.reporting(progress, "parameter_map") as report:
+        for length in shorter:            # first, each dropped after use (as chaos_map)
+            short = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
+                             length, chunk_size=chunk_size, rtol=rtol, indicators=True,
+                             model=model, max_drift=max_drift, coordinates=coordinates,
+                             progress=_progress.stage(report, done / work, length / work),
+                             **section_kwargs)
+            done += float(length)
+            by_length.append(fractions_of(short, length)[2])
+            del short
+        section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
+                           orbits, chunk_size=chunk_size, rtol=rtol, indicators=True,
+                           progress=_progress.stage(report, done / work, orbits / work),
+                           model=model, checkpoint=checkpoint, resume=resume,
+                           overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
+                           coordinates=coordinates, **section_kwargs)
+    seconds = started.seconds()
     labels, status, fraction = fractions_of(section, orbits)
     by_length = np.array(by_length + [fraction])
     with np.errstate(invalid="ignore"):

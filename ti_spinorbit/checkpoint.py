@@ -205,6 +205,15 @@ def holds_checkpoint(path):
     return os.path.isfile(os.path.join(os.fspath(path), STATE))
 
 
+def remove(path):
+    """Delete a finished run's checkpoint: the files a run writes in ``path`` (state, records,
+    lock, temporary files), then the directory itself when nothing else is left in it."""
+    path = os.fspath(path)
+    _clean(path, [n for n in os.listdir(path) if _is_checkpoint_file(n)])
+    with contextlib.suppress(OSError):
+        os.rmdir(path)
+
+
 def check_target(path, resume=False, overwrite=False, cli=False):
     """Refuse, before any work and without touching anything, a checkpoint path that a run
     with these flags must not write: a path that is not a directory, or (without ``resume``

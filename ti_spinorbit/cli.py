@@ -9,13 +9,22 @@ overlap    1:1 / 3:2 resonance-overlap scan over the elongation a/b, PNG + .npz
 libration  relaxed libration amplitude at the synchronous island's centre, PNG + .npz
 energy     energy and angular-momentum conservation check (exit 1 above --max-drift), PNG + .npz
 benchmark  ensemble throughput in member-orbits/s, JSON
+warmup     compile the kernel variants ahead of time (later runs start without waiting)
 figures    run the experiment scripts that reproduce the paper's studies (needs a source
            checkout: the scripts live in experiments/)
 
 Conventions: every flag is checked before any work starts; a bad value, like any other error
 in the inputs, prints ONE line naming the flag, the value and the allowed range, and exits with
-status 2 (no traceback). Long runs draw a progress bar on stderr (:mod:`ti_spinorbit.progress`);
-``--quiet`` prints nothing but errors. Data files are self-describing ``.npz``
+status 2 (no traceback). Long runs draw a progress bar on stderr (:mod:`ti_spinorbit.progress`:
+a tqdm bar on a terminal, a line per 10 % elsewhere; ``--no-progress`` hides it), and the first
+use of a kernel variant says "compiling kernels ... (first use only, about N s)"; compile time
+is left out of elapsed times, ETAs and printed rates. ``--quiet`` prints nothing but errors.
+
+File names: defaults carry every physics flag that differs from its default
+(:func:`default_stem`: ``sos_1991VH_ab1.06.png`` for ``--elongation 1.06``). A run never
+overwrites an existing output: it is refused before any work, naming the file, unless
+``--overwrite``. The checkpoint directory of a run is removed once its outputs are written,
+unless ``--keep-checkpoint``. Data files are self-describing ``.npz``
 (:func:`ti_spinorbit.io.save`); figures are PNG (or PDF/SVG by the extension of ``--out``).
 
 Outputs: every output path (and the Matplotlib backend) is checked before any work; the data
@@ -104,6 +113,9 @@ EXAMPLES_BY_COMMAND = {
     "benchmark": """\
   ti-spinorbit benchmark --members 1024 --orbits 20
   ti-spinorbit benchmark --arch cuda --members 65536 --orbits 20 --out bench_cuda.json""",
+    "warmup": """\
+  ti-spinorbit warmup                                  # every variant (minutes, once)
+  ti-spinorbit warmup --models planar --indicators off # what 'section' needs""",
     "figures": """\
   ti-spinorbit figures --quick --only 1 4 --out out/""",
 }
@@ -171,6 +183,11 @@ def _parser():
                            help=".npz path (default: the --out path with .npz)")
         s.add_argument("--quiet", action="store_true",
                        help="print nothing but errors (no progress bar, no summary)")
+        s.add_argument("--no-progress", action="store_true",
+                       help="no progress bar (the summary and compile notices still print)")
+        s.add_argument("--overwrite", action="store_true",
+                       help="replace output files that already exist (refused by default, "
+                            "before any work)")
         if model:
             s.add_argument("--model", choices=("auto", "planar", "3d"), default="auto",
                            help="equations of motion: the reduced planar model for planar "
@@ -185,6 +202,9 @@ def _parser():
             s.add_argument("--overwrite-checkpoint", action="store_true",
                            help="without --resume, replace a checkpoint already in the "
                                 "--checkpoint directory (refused by default)")
+            s.add_argument("--keep-checkpoint", action="store_true",
+                           help="keep the checkpoint directory after a successful run "
+                                "(default: removed once the outputs are written)")
 
     def coordinates_flag(s):
         s.add_argument("--coordinates", choices=("inertial", "apsidal"), default="inertial",
@@ -288,6 +308,21 @@ def _parser():
     s.add_argument("--repeat", type=int, default=1,
                    help="timed runs, the best is reported, in [1, 100] (default 1)")
     common(s, "JSON path (default benchmark.json)", data=False, orbits=20.0, rtol=1e-12)
+
+    s = command("warmup", "compile kernel variants ahead of time, so later runs start at once")
+    s.add_argument("--models", nargs="+", choices=("planar", "3d"), default=["planar", "3d"],
+                   help="equations of motion to compile for (default both)")
+    s.add_argument("--indicators", nargs="+", choices=("off", "on"), default=["off", "on"],
+                   help="without (sections, libration) and/or with chaos indicators (map, "
+                        "overlap) (default both)")
+    s.add_argument("--sampling", nargs="+", choices=("off", "on"), default=["off", "on"],
+                   help="without (sections) and/or with dense sampling (energy, libration) "
+                        "(default both)")
+    s.add_argument("--methods", nargs="+", default=["cash-karp"],
+                   help="integration methods (default cash-karp, the only one so far)")
+    s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,
+                   help="Taichi arch (default cpu, or $TI_SPINORBIT_ARCH)")
+    s.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
     s = sub.add_parser("figures", help="reproduce the paper's studies (experiments/study*.py)",
                        parents=[debug],
@@ -409,8 +444,17 @@ def check_args(args):
         if not (float(n).is_integer() and 5 <= n <= 10001):
             raise ValueError(f"--candidates N must be an integer in [5, 10001] (got {n:g})")
     _check_system_flags(args)
-    if args.command in ("benchmark", "systems"):
+    if args.command == "warmup":
+        from .compiling import METHODS
+
+        bad = [m for m in args.methods if m not in METHODS]
+        if bad:
+            raise ValueError(f"--methods must be among {', '.join(METHODS)} (got {bad[0]!r})")
+    elif args.command in ("benchmark", "systems"):
         _check_output("--out", getattr(args, "out", None), (".json",))
+        if args.command == "benchmark":
+            _refuse_existing(args, args.out or "benchmark.json",
+                             "--out" if args.out else "the report (default --out)")
     elif args.command == "figures":                  # figures: --out is a folder
         if os.path.exists(args.out) and not os.path.isdir(args.out):
             raise ValueError(f"--out: {args.out!r} is a file; give a folder")
@@ -571,14 +615,69 @@ def _system(args):
                           eccentricity=getattr(args, "eccentricity", None))
 
 
+#: Physics flags named in default file names, in this order, when they differ from their
+#: default: (dest, tag). The value follows the tag: ab1.06 (--elongation 1.06), rho2500,
+#: e0.1, tp30 (--theta-p), td1.13-1.63 (--thetadot; over three values: first-last n count),
+#: g64x64 (--grid), tdr0.5-2 (--thetadot-range), ab1.01-1.1-0.01 (--elongations), cand0.2-1.3-45
+#: (--candidates), xtol1e-8, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
+#: (--max-orbits), rtol1e-13; --model, --coordinates and --method by their value alone (3d,
+#: apsidal, dop853). --max-drift, --arch and output flags change no physics: not named.
+NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
+             ("elongations", "ab"), ("theta_p", "tp"), ("thetadot", "td"), ("grid", "g"),
+             ("thetadot_range", "tdr"), ("candidates", "cand"), ("xtol", "xtol"),
+             ("samples_per_orbit", "spo"), ("orbits", "o"), ("max_orbits", "maxo"),
+             ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""))
+
+
+def default_stem(args, prefix, system_name):
+    """Default output name without extension: ``<prefix>_<system>`` and one ``_<tag><value>``
+    per physics flag that differs from its default (:data:`NAME_TAGS`), so that runs with
+    other parameters never share a file: ``sos_1991VH_ab1.06_o1000``."""
+    import re
+
+    defaults = vars(_parser().parse_args([args.command]))
+    parts = [prefix, system_name.replace(" ", "")]
+    for dest, tag in NAME_TAGS:
+        value = getattr(args, dest, None)
+        if value is None or value == defaults.get(dest):
+            continue
+        if isinstance(value, (list, tuple)):
+            items = [_fmt(v) for v in value]
+            if dest == "grid":
+                text = "x".join(items)
+            elif len(items) > 3:
+                text = f"{items[0]}-{items[-1]}n{len(items)}"
+            else:
+                text = "-".join(items)
+        elif dest in ("rtol", "xtol"):               # tolerances always as powers: 1e-4
+            mantissa, exponent = f"{value:.15e}".split("e")
+            text = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+        else:
+            text = _fmt(value) if isinstance(value, (int, float)) else str(value)
+        # exponents short and without "+": 1e6, 1e-13 (not 1e+06, 1e-13 stays)
+        text = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
+        parts.append(tag + text.replace(" ", "").replace(os.sep, "-"))
+    return "_".join(parts)
+
+
+def _refuse_existing(args, path, flag):
+    """A run never overwrites an existing output unless --overwrite: refused before any work,
+    one line naming the file and the flag."""
+    if not getattr(args, "overwrite", False) and os.path.exists(path):
+        raise ValueError(f"{flag}: {path!r} already exists (an earlier run's output?); pass "
+                         "--overwrite to replace it, or choose another --out")
+
+
 def _paths(args, prefix, system_name):
-    """(figure path, data path) from --out/--data or the defaults <prefix>_<system>.png/.npz,
-    both checked writable (defaults included), and the checkpoint directory checked, before
-    any work."""
-    out = args.out or f"{prefix}_{system_name.replace(' ', '')}.png"
+    """(figure path, data path) from --out/--data or the defaults :func:`default_stem`.png
+    /.npz, both checked writable (defaults included) and not already there (unless
+    --overwrite), and the checkpoint directory checked, before any work."""
+    out = args.out or default_stem(args, prefix, system_name) + ".png"
     data = args.data or os.path.splitext(out)[0] + ".npz"
     _check_output("--out" if args.out else "the figure (default --out)", out, FIGURE_EXTENSIONS)
     _check_output("--data" if args.data else "the data file (default --data)", data, (".npz",))
+    _refuse_existing(args, out, "--out" if args.out else "the figure (default --out)")
+    _refuse_existing(args, data, "--data" if args.data else "the data file (default --data)")
     checkpoint = _checkpoint_path(args, data)
     if checkpoint is not None:   # a checkpoint that would be refused: before any work
         from .checkpoint import check_target
@@ -588,9 +687,12 @@ def _paths(args, prefix, system_name):
 
 
 def _progress(args):
-    from .progress import ProgressBar
+    """The command's reporter: a bar (terminal) or a line per 10 % (log) on stderr, compile
+    announcements; nothing with --quiet, no bar with --no-progress."""
+    from .progress import Progress
 
-    return ProgressBar(args.command, quiet=args.quiet)
+    return Progress(args.command, enabled=not args.quiet,
+                    bar=not getattr(args, "no_progress", False))
 
 
 def _with_progress(func, bar):
@@ -615,6 +717,21 @@ def _run_flags(args, data):
     :func:`_paths` before any work)."""
     return {"model": args.model, "checkpoint": _checkpoint_path(args, data),
             "resume": args.resume, "overwrite_checkpoint": args.overwrite_checkpoint}
+
+
+def _finish_checkpoint(args, data):
+    """After a run's outputs are written: remove its checkpoint directory (the files a run
+    writes there, then the directory if empty) unless --keep-checkpoint. Returns the line to
+    print, or None."""
+    path = _checkpoint_path(args, data)
+    if path is None or not os.path.isdir(path):
+        return None
+    if getattr(args, "keep_checkpoint", False):
+        return f"kept checkpoint {path} (--keep-checkpoint)"
+    from .checkpoint import remove
+
+    remove(path)
+    return f"removed checkpoint {path} (the run is complete; --keep-checkpoint keeps it)"
 
 
 def _save(result, path, extra):
@@ -748,7 +865,7 @@ def _cmd_section(args):
         _print(args, f"  thetadot_p/n = {v:5.2f}: {result.count[k]} crossings, status "
                      f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}, "
                      f"angular-momentum drift {result.angmom_drift[k]:.1e}")
-    _print(args, f"wrote {out} and {data}")
+    _print(args, f"wrote {out} and {data}", *filter(None, [_finish_checkpoint(args, data)]))
     return _accuracy_status(args, result.status, result.energy_drift, result.max_drift)
 
 
@@ -775,7 +892,7 @@ def _cmd_map(args):
                  f"{cmap.chaotic_fraction:.3f} ({counted}; statuses {cmap.status_counts}) in "
                  f"{cmap.seconds:.1f} s; largest energy drift {np.nanmax(cmap.energy_drift):.1e}"
                  f" (limit {cmap.max_drift:.1e}); wrote {out} and {data}")
-    _print(args, f"  {cmap.fraction_message}")
+    _print(args, f"  {cmap.fraction_message}", *filter(None, [_finish_checkpoint(args, data)]))
     return _accuracy_status(args, cmap.status, cmap.energy_drift, cmap.max_drift)
 
 
@@ -846,8 +963,10 @@ def _cmd_libration(args):
     _print(args,
            f"{system.name}: relaxed libration amplitude {result.amplitude:.4f} deg at the "
            f"synchronous centre thetadot_p/n = {result.centre_thetadot_p:.8f}",
-           f"  psi_A = {result.psi_A:.4f} deg (omega0 {result.omega0:.4f}), "
-           f"coupled psi_A = {result.psi_A_effective:.4f} deg (omega0_eff {result.omega0_effective:.4f})",
+           f"  forced libration amplitude |ψ_A| = {abs(result.psi_A):.4f} deg (omega0 "
+           f"{result.omega0:.4f}), with spin-orbit coupling {abs(result.psi_A_effective):.4f} deg "
+           f"(omega0_eff {result.omega0_effective:.4f})",
+           f"  {psi_phase(result.psi_A)}",
            f"  section extent at the centre {result.extent:.2e} deg, {result.iterations} zooms, "
            f"{'converged' if result.converged else 'NOT converged'}, {result.seconds:.1f} s",
            f"  centre trajectory: status {result.status}, energy drift {result.energy_drift:.1e}"
@@ -856,6 +975,19 @@ def _cmd_libration(args):
            f"wrote {out} and {data}")
     return _accuracy_status(args, np.array([_status_code(result.status)]),
                             np.array([result.energy_drift]), result.max_drift, "trajectories")
+
+
+def psi_phase(psi_a):
+    """The phase of the forced libration ψ = ψ_A sin M (docs/physics.md §8.2) in words: ψ_A
+    (deg) is negative for ω0 < 1, which is a phase, not a negative amplitude."""
+    if psi_a == 0:
+        return "(no forced libration: e = 0)"
+    if not math.isfinite(psi_a):
+        return "(phase undefined: omega0 = 1 is the forced resonance)"
+    sign, how = ("−", "in antiphase with M, as for omega0 < 1") if psi_a < 0 else \
+        ("+", "in phase with M, as for omega0 > 1")
+    return (f"(phase: ψ = {sign}|ψ_A| sin M, {how}; ψ is the long axis's angle from the line "
+            "of centres, M the mean anomaly)")
 
 
 def energy_check(ts, member=0):
@@ -903,7 +1035,7 @@ def _cmd_energy(args):
            f"  max relative angular-momentum drift {numbers['angmom_drift']:.3e}",
            "  largest exchange, |ΔE_i|/|E0|: orbit {exchange_orbit:.3e}, primary spin "
            "{exchange_primary:.3e}, secondary spin {exchange_secondary:.3e}".format(**numbers),
-           f"wrote {out} and {data}")
+           f"wrote {out} and {data}", *filter(None, [_finish_checkpoint(args, data)]))
     if not worst <= args.max_drift:          # also catches NaN
         print(f"ti-spinorbit energy: drift {worst:.3e} exceeds --max-drift {args.max_drift:g} "
               f"(status {status})", file=sys.stderr)
@@ -937,10 +1069,10 @@ def _cmd_benchmark(args):
     _init(args)
     started = time.perf_counter()
     surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, rtol=args.rtol,
-                       model=args.model)                                          # compile / load
+                       model=args.model, progress=False)                          # compile / load
     warmup = time.perf_counter() - started
     runs = [surface_of_section(system, 0.0, thetadot, orbits=args.orbits, rtol=args.rtol,
-                               model=args.model)
+                               model=args.model, progress=False)
             for _ in range(args.repeat)]
     best = min(runs, key=lambda r: r.seconds)
     rate = args.members * args.orbits / best.seconds
@@ -960,6 +1092,24 @@ def _cmd_benchmark(args):
     _print(args, f"{args.system}: {args.members} members x {args.orbits:g} orbits at rtol "
                  f"{args.rtol:g} on {report['arch']}: {best.seconds:.3g} s (best of {args.repeat}), "
                  f"{rate:.0f} member-orbits/s; first call {warmup:.1f} s; wrote {out}")
+    return 0
+
+
+def _cmd_warmup(args):
+    import time
+
+    from . import runtime
+    from .compiling import warmup
+
+    _init(args)
+    started = time.perf_counter()
+    done = warmup(models=args.models, indicators=[v == "on" for v in args.indicators],
+                  sampling=[v == "on" for v in args.sampling], methods=args.methods,
+                  verbose=not args.quiet)
+    compiled = sum(d["how"] == "compiled" for d in done)
+    _print(args, f"{len(done)} kernel variants ready ({compiled} compiled, "
+                 f"{len(done) - compiled} already in the cache) in "
+                 f"{time.perf_counter() - started:.1f} s; cache folder {runtime.cache_folder()}")
     return 0
 
 
@@ -1004,7 +1154,7 @@ def _cmd_figures(args):
 
 HANDLERS = {"systems": _cmd_systems, "section": _cmd_section, "map": _cmd_map,
             "overlap": _cmd_overlap, "libration": _cmd_libration, "energy": _cmd_energy,
-            "benchmark": _cmd_benchmark, "figures": _cmd_figures}
+            "benchmark": _cmd_benchmark, "warmup": _cmd_warmup, "figures": _cmd_figures}
 
 
 def _one_line(exc):

@@ -198,7 +198,9 @@ def _integrate(systems, theta_p, thetadot_p, orbits, init, kwargs):
     else:
         runtime.ensure_init()
     _THREAD["generation"] = runtime.generation()
-    return section.surface_of_section(systems, theta_p, thetadot_p, orbits, **kwargs)
+    # no bar in a worker (the client reports chunks); its stderr may well be a terminal
+    return section.surface_of_section(systems, theta_p, thetadot_p, orbits,
+                                      **dict(kwargs, progress=False))
 
 
 def concatenate(parts) -> section.SectionResult:

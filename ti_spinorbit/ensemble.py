@@ -20,7 +20,7 @@ from typing import Callable, List, Optional
 
 import numpy as np
 
-from . import planar, runtime
+from . import compiling, planar, runtime
 from ._validate import (require_count, require_memory, require_positive, require_range,
                         require_real)
 
@@ -224,8 +224,14 @@ class Ensemble:
         fingerprint = self._fingerprint(t_stop) if checkpoint is not None else None
         if checkpoint is not None and resume:
             st = ckpt.load(checkpoint, settings, fingerprint)
+        # the first use of a variant in this process compiles its kernels, announced; that
+        # time stays out of seconds, rates and window lengths (ti_spinorbit.compiling)
+        advance = compiling.FirstUse(kern.advance, compiling.variant_name(
+            self.model, indicators, sampling, self.order, self.odd,
+            getattr(self, "method", "cash-karp")), lambda: self.status)
         if st is None:
-            st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
+            with advance.other_kernels():
+                st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
         else:
             for name in ("y", "t", "h", "status", "counters"):
                 setattr(self, name, st.pop(name))
@@ -244,11 +250,13 @@ class Ensemble:
         while np.any(self.status == K.RUNNING):
             t_end = np.minimum(t_stop, self.t + span)
             launched = time.perf_counter()
-            kern.advance(self.kpar, self.y, st["yc"], st["f"], self.t, st["tc"], self.h, t_end,
+            advance(self.kpar, self.y, st["yc"], st["f"], self.t, st["tc"], self.h, t_end,
                          t_stop, self.status, self.counters, events_buf, n_events, samples_buf,
                          n_samples, st["next_sample"], st["shadow"], st["shadow_f"], st["ind"],
                          self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
                          float(separation), self.order, self.odd, sampling, bool(indicators))
+            compiled = advance.take_seconds()
+            t0, launched = t0 + compiled, launched + compiled
             st["launches"] += 1
             # the kernel's time only: draining and checkpointing do not shrink with the span
             span = _next_span(span, time.perf_counter() - launched, window)

@@ -37,16 +37,16 @@ E ≈ k |θ̇0 − c|. The search
 """
 
 import math
-import time
 import warnings
 from dataclasses import dataclass, field
 from typing import List
 
 import numpy as np
 
-from . import accuracy, analytic, resources
+from . import accuracy, analytic, compiling, resources
+from . import progress as _progress
 from .classify import horizontal_extent
-from ._validate import (require_callable, require_count, require_positive,
+from ._validate import (require_count, require_positive,
                         require_real, require_scalar, require_spin)
 from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
@@ -96,7 +96,7 @@ def _amplitudes(ts, include_inaccurate=False):
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
                         rtol=1e-12, max_drift=None, include_inaccurate=False,
                         coordinates="inertial", model="auto", checkpoint=None, resume=False,
-                        overwrite_checkpoint=False):
+                        overwrite_checkpoint=False, progress=None):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -123,6 +123,8 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         is the same in both.
     model, checkpoint, resume, overwrite_checkpoint
         As for :func:`~ti_spinorbit.section.time_series` (one launch).
+    progress : bool or callable, optional
+        As for :func:`~ti_spinorbit.section.surface_of_section` (:mod:`ti_spinorbit.progress`).
 
     Returns
     -------
@@ -131,10 +133,11 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         circulates, the integration stopped early (collision, escape, ...) or the member
         failed the accuracy check (unless ``include_inaccurate``).
     """
-    ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
-                     rtol=rtol, max_drift=max_drift, coordinates=coordinates, model=model,
-                     checkpoint=checkpoint, resume=resume,
-                     overwrite_checkpoint=overwrite_checkpoint)
+    with _progress.reporting(progress, "libration_amplitude") as report:
+        ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
+                         rtol=rtol, max_drift=max_drift, coordinates=coordinates, model=model,
+                         checkpoint=checkpoint, resume=resume,
+                         overwrite_checkpoint=overwrite_checkpoint, progress=report)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
@@ -311,8 +314,11 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     max_extent : float
         Largest section extent (deg) allowed at the centre found; above it the search is
         reported as not converged (a chaotic zone can also narrow the zoom window).
-    progress : callable, optional
-        ``progress(fraction)`` after every launch of the search (the coarse section, the
+    progress : bool or callable, optional
+        None (default): a bar in a terminal or Jupyter for runs over 2 s; True/False:
+        always/never (:mod:`ti_spinorbit.progress`); a callable: ``progress(fraction)``
+        after every launch of the search, with the convergence checks' searches after it
+        (each its share ∝ its length). Within a search: (the coarse section, the
         coarse libration check, each zoom, the final section, the final time series):
         launches done / (launches done + launches still expected), the zoom launches still
         expected estimated from the window's half-width, ``xtol`` and ``max_iterations``;
@@ -376,7 +382,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     accuracy.drift_limit(rtol, orbits, max_drift)           # max_drift checked before any work
     require_positive("xtol", xtol)
     require_scalar("max_extent", max_extent, 0.0, 90.0, low_open=True, unit="deg")
-    require_callable("progress", progress)
+    _progress.check(progress)
     zoom_candidates = require_count("zoom_candidates", zoom_candidates, 5, 100001)
     if zoom_candidates % 2 == 0:
         raise ValueError(f"zoom_candidates must be odd (got {zoom_candidates})")
@@ -412,69 +418,82 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                   samples_per_orbit=samples_per_orbit, coarse_arm_points=coarse_arm_points,
                   max_extent=max_extent, max_drift=max_drift, section_kwargs=section_kwargs,
                   checkpoints=Launches(checkpoint, resume, overwrite_checkpoint))
-    base = _search(system, orbits, rtol, candidates, progress=progress, **search)
-    if not converge:
-        return base
-    started = time.perf_counter() - base.seconds
-    # the checks start bracketed around the centre found: the coarse scan is not repeated
-    spacing = float(np.max(np.diff(base.candidates[0])))
-    bracket = base.centre_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
-    lengths, centres, amplitudes = [float(orbits)], [base.centre_thetadot_p], [base.amplitude]
-    in_orbits = False
-    last = base
-    while lengths[-1] * 2.0 <= cap * (1 + 1e-12):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)   # summarised in the message
-            last = _search(system, lengths[-1] * 2.0, rtol, bracket, **search)
-        lengths.append(lengths[-1] * 2.0)
-        centres.append(last.centre_thetadot_p)
-        amplitudes.append(last.amplitude)
-        if abs(centres[-1] - centres[-2]) <= centre_tol and \
-                abs(amplitudes[-1] - amplitudes[-2]) <= amplitude_tol:
-            in_orbits = True
-            break
-    tight = float(rtol) / 10.0
-    in_tol, c_tol, a_tol = False, float("nan"), float("nan")
-    if tight >= 1e-16 and len(lengths) > 1:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            fine = _search(system, lengths[-1], tight, bracket, **search)
-        c_tol, a_tol = fine.centre_thetadot_p, fine.amplitude
-        in_tol = abs(c_tol - centres[-1]) <= centre_tol and \
-            abs(a_tol - amplitudes[-1]) <= amplitude_tol and fine.converged
-    messages = []
-    if not base.converged:
-        messages.append("search not converged (window or extent at the centre)")
-    if len(lengths) == 1:
-        messages.append(f"not converged by {lengths[-1]:g} orbits: max_orbits leaves no "
-                        "doubling to compare")
-    elif not in_orbits:
-        messages.append(f"not converged by {lengths[-1]:g} orbits: centre/amplitude still "
-                        f"move by {abs(centres[-1] - centres[-2]):.3g} n / "
-                        f"{abs(amplitudes[-1] - amplitudes[-2]):.3g} deg")
-    if not np.isfinite(c_tol):
-        if len(lengths) > 1:
-            messages.append(f"tolerance not checked (rtol/10 = {tight:.0e} is below 1e-16)")
-    elif not in_tol:
-        messages.append(f"not converged in tolerance: rtol {tight:.0e} moves the centre by "
-                        f"{abs(c_tol - centres[-1]):.3g} n, the amplitude by "
-                        f"{abs(a_tol - amplitudes[-1]):.3g} deg")
-    converged = bool(base.converged and in_orbits and in_tol)
-    if converged:
-        messages.append(f"converged: centre and amplitude agree at {lengths[-2]:g} and "
-                        f"{lengths[-1]:g} orbits and at rtol {rtol:.0e} and {tight:.0e}")
-    base.search_converged = base.converged
-    base.converged = converged
-    base.lengths = np.array(lengths)
-    base.centres_by_length = np.array(centres)
-    base.amplitudes_by_length = np.array(amplitudes)
-    base.rtol_check, base.centre_rtol_check, base.amplitude_rtol_check = \
-        (tight if np.isfinite(c_tol) else float("nan")), c_tol, a_tol
-    base.centre_tol, base.amplitude_tol = float(centre_tol), float(amplitude_tol)
-    base.converged_in_orbits, base.converged_in_tolerance = in_orbits, bool(in_tol)
-    base.convergence_checked = True
-    base.message = "; ".join(messages)
-    base.seconds = time.perf_counter() - started
+    with _progress.reporting(progress, "relaxed_libration") as report:
+        # progress: each search its share of the work, ∝ its length (rtol/10: ~1.6x the steps)
+        planned = [float(orbits)]
+        while converge and planned[-1] * 2.0 <= cap * (1 + 1e-12):
+            planned.append(planned[-1] * 2.0)
+        tight_work = planned[-1] * 10 ** 0.2 if converge and len(planned) > 1 else 0.0
+        work = sum(planned) + tight_work
+        base = _search(system, orbits, rtol, candidates,
+                       progress=_progress.stage(report, 0.0, planned[0] / work), **search)
+        if not converge:
+            return base
+        started = compiling.Stopwatch(already=base.seconds)   # compile time left out
+        # the checks start bracketed around the centre found: the coarse scan is not repeated
+        spacing = float(np.max(np.diff(base.candidates[0])))
+        bracket = base.centre_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
+        lengths, centres, amplitudes = [float(orbits)], [base.centre_thetadot_p], [base.amplitude]
+        in_orbits = False
+        last = base
+        while lengths[-1] * 2.0 <= cap * (1 + 1e-12):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)   # summarised in the message
+                last = _search(system, lengths[-1] * 2.0, rtol, bracket,
+                               progress=_progress.stage(report, sum(lengths) / work,
+                                                        2.0 * lengths[-1] / work), **search)
+            lengths.append(lengths[-1] * 2.0)
+            centres.append(last.centre_thetadot_p)
+            amplitudes.append(last.amplitude)
+            if abs(centres[-1] - centres[-2]) <= centre_tol and \
+                    abs(amplitudes[-1] - amplitudes[-2]) <= amplitude_tol:
+                in_orbits = True
+                break
+        tight = float(rtol) / 10.0
+        in_tol, c_tol, a_tol = False, float("nan"), float("nan")
+        if tight >= 1e-16 and len(lengths) > 1:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                fine = _search(system, lengths[-1], tight, bracket,
+                               progress=_progress.stage(report, 1.0 - tight_work / work,
+                                                        tight_work / work), **search)
+            c_tol, a_tol = fine.centre_thetadot_p, fine.amplitude
+            in_tol = abs(c_tol - centres[-1]) <= centre_tol and \
+                abs(a_tol - amplitudes[-1]) <= amplitude_tol and fine.converged
+        messages = []
+        if not base.converged:
+            messages.append("search not converged (window or extent at the centre)")
+        if len(lengths) == 1:
+            messages.append(f"not converged by {lengths[-1]:g} orbits: max_orbits leaves no "
+                            "doubling to compare")
+        elif not in_orbits:
+            messages.append(f"not converged by {lengths[-1]:g} orbits: centre/amplitude still "
+                            f"move by {abs(centres[-1] - centres[-2]):.3g} n / "
+                            f"{abs(amplitudes[-1] - amplitudes[-2]):.3g} deg")
+        if not np.isfinite(c_tol):
+            if len(lengths) > 1:
+                messages.append(f"tolerance not checked (rtol/10 = {tight:.0e} is below 1e-16)")
+        elif not in_tol:
+            messages.append(f"not converged in tolerance: rtol {tight:.0e} moves the centre by "
+                            f"{abs(c_tol - centres[-1]):.3g} n, the amplitude by "
+                            f"{abs(a_tol - amplitudes[-1]):.3g} deg")
+        converged = bool(base.converged and in_orbits and in_tol)
+        if converged:
+            messages.append(f"converged: centre and amplitude agree at {lengths[-2]:g} and "
+                            f"{lengths[-1]:g} orbits and at rtol {rtol:.0e} and {tight:.0e}")
+        base.search_converged = base.converged
+        base.converged = converged
+        base.lengths = np.array(lengths)
+        base.centres_by_length = np.array(centres)
+        base.amplitudes_by_length = np.array(amplitudes)
+        base.rtol_check, base.centre_rtol_check, base.amplitude_rtol_check = \
+            (tight if np.isfinite(c_tol) else float("nan")), c_tol, a_tol
+        base.centre_tol, base.amplitude_tol = float(centre_tol), float(amplitude_tol)
+        base.converged_in_orbits, base.converged_in_tolerance = in_orbits, bool(in_tol)
+        base.convergence_checked = True
+        base.message = "; ".join(messages)
+        report(1.0)
+    base.seconds = started.seconds()
     return base
 
 
@@ -506,7 +525,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
         if progress is not None:
             progress(launches / (launches + left))
 
-    start = time.perf_counter()
+    start = compiling.Stopwatch()          # compile time left out of seconds
     # 1. coarse bracket: the section gives the extent, a dense run says which starts librate
     half_width = float(np.max(np.diff(x)))
     coarse = surface_of_section(system, 0.0, x, orbits, rtol=rtol, max_drift=limit,
@@ -587,6 +606,6 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
         omega0=system.omega0, omega0_effective=omega0_effective,
         iterations=iterations, converged=converged, candidates=tried, extents=extents,
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
-        seconds=time.perf_counter() - start, system=system, status=status,
+        seconds=start.seconds(), system=system, status=status,
         energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
         max_drift=limit, coordinates=coordinates, series=ts)

@@ -45,8 +45,9 @@ from typing import Callable, List, Optional, Union
 
 import numpy as np
 
-from . import accuracy, analytic, catalog, resources
-from ._validate import (_as_floats, require_callable, require_count, require_range,
+from . import accuracy, analytic, catalog, compiling, resources
+from . import progress as _progress
+from ._validate import (_as_floats, require_count, require_range,
                         require_scalar, show)
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
@@ -266,8 +267,6 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     ``OverlapDecision.megno_overlap``; ``megno_first_overlap`` its threshold): a chaotic
     layer spanning both islands shows in ⟨Y⟩ before a single trajectory has crossed it.
     """
-    import time
-
     from .coordinates import check_coordinates
 
     from .ensemble import check_tolerances
@@ -291,7 +290,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     centre_starts = require_count("centre_starts", centre_starts, 2, 100000)
     separatrix_starts = require_count("separatrix_starts", separatrix_starts, 2, 100000)
     require_scalar("libration_limit", libration_limit, 0.0, 90.0, low_open=True, unit="deg")
-    require_callable("progress", progress)
+    _progress.check(progress)
     if not (isinstance(system, str) or callable(system)):
         raise TypeError(f"system must be a catalogue name or a callable "
                         f"(elongation) -> BinarySystem (got {type(system).__name__})")
@@ -321,47 +320,53 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     centre_rates = np.linspace(0.6, 2.0, int(centre_starts))
     sep_rates = np.linspace(0.8, 1.8, int(separatrix_starts))
     per = len(centre_rates) + len(sep_rates)
-    run = dict(chunk_size=chunk_size, rtol=rtol, indicators=indicators, progress=progress,
+    run = dict(chunk_size=chunk_size, rtol=rtol, indicators=indicators,
                model=model, max_drift=max_drift, coordinates=coordinates, **section_kwargs)
     lengths = _lengths(orbits, max_orbits)
-    t0 = time.perf_counter()
+    t0 = compiling.Stopwatch()           # compile time left out of seconds
     decisions = [None] * q.size
     runs = [None] * q.size
     geo_rows, megno_rows = [], []
     first_sec = None
     member_orbits = 0.0
     converged_at = None
-    for step, length in enumerate(lengths):
-        # a connection seen at a shorter length is a fact (a trajectory crossed both levels):
-        # only elongations still "separate" are integrated again, longer
-        todo = [k for k in range(q.size) if decisions[k] is None or not decisions[k].overlap]
-        previous = [None if d is None else d.overlap for d in decisions]
-        if todo:
-            members, theta0, rates = [], [], []
-            for k in todo:
-                members += [systems[k]] * per
-                theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
-                rates += list(centre_rates) + list(sep_rates)
-            sec = sections(client, members, np.array(theta0), np.array(rates), orbits=length,
-                           **run, **launches.next())
-            member_orbits += len(members) * float(length)
-            first_sec = sec if first_sec is None else first_sec
-            for j, k in enumerate(todo):
-                block = slice(j * per, (j + 1) * per)
-                decisions[k] = _decide(float(q[k]), systems[k], sec, block, centre_rates,
-                                       sep_rates, libration_limit, include_inaccurate)
-                decisions[k].orbits = float(length)
-                runs[k] = (sec, block)
-        geo_rows.append([d.overlap for d in decisions])
-        megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
-                           for d in decisions])
-        # converged: the decisions no longer change with length, and no elongation is still
-        # "separate" where the MEGNO criterion already sees one chaotic layer (a slow
-        # connection the trajectories have not completed yet)
-        pending = [d.megno_overlap and not d.overlap for d in decisions]
-        if step > 0 and [d.overlap for d in decisions] == previous and not any(pending):
-            converged_at = float(length)
-            break
+    work = float(sum(lengths))          # progress: each length its share (all elongations)
+    with _progress.reporting(progress, "overlap_threshold") as report:
+        for step, length in enumerate(lengths):
+            # a connection seen at a shorter length is a fact (a trajectory crossed both levels):
+            # only elongations still "separate" are integrated again, longer
+            todo = [k for k in range(q.size) if decisions[k] is None or not decisions[k].overlap]
+            previous = [None if d is None else d.overlap for d in decisions]
+            if todo:
+                members, theta0, rates = [], [], []
+                for k in todo:
+                    members += [systems[k]] * per
+                    theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
+                    rates += list(centre_rates) + list(sep_rates)
+                share = _progress.stage(report, float(sum(lengths[:step])) / work,
+                                        float(length) / work)
+                sec = sections(client, members, np.array(theta0), np.array(rates),
+                               orbits=length, progress=share, **run,
+                               **launches.next())
+                member_orbits += len(members) * float(length)
+                first_sec = sec if first_sec is None else first_sec
+                for j, k in enumerate(todo):
+                    block = slice(j * per, (j + 1) * per)
+                    decisions[k] = _decide(float(q[k]), systems[k], sec, block, centre_rates,
+                                           sep_rates, libration_limit, include_inaccurate)
+                    decisions[k].orbits = float(length)
+                    runs[k] = (sec, block)
+            geo_rows.append([d.overlap for d in decisions])
+            megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
+                               for d in decisions])
+            # converged: the decisions no longer change with length, and no elongation is still
+            # "separate" where the MEGNO criterion already sees one chaotic layer (a slow
+            # connection the trajectories have not completed yet)
+            pending = [d.megno_overlap and not d.overlap for d in decisions]
+            if step > 0 and [d.overlap for d in decisions] == previous and not any(pending):
+                converged_at = float(length)
+                report(1.0)
+                break
     overlaps = np.array([d.overlap for d in decisions])
     first = next((float(x) for x, o in zip(q, overlaps) if o), None)
     megno_first = next((float(x) for x, d in zip(q, decisions) if d.megno_overlap), None)
@@ -383,7 +388,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     scan = OverlapScan(rtol=float(rtol), name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
                        elongation_ro=float(analytic.elongation_from_omega0(w_ro)),
-                       orbits=float(ran[-1]), seconds=time.perf_counter() - t0,
+                       orbits=float(ran[-1]), seconds=t0.seconds(),
                        sections=first_sec, max_drift=first_sec.max_drift,
                        n_inaccurate=int(n_inaccurate),
                        include_inaccurate=bool(include_inaccurate), lengths=ran,

@@ -130,6 +130,7 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
             os.environ[CACHE_ENV] = saved
     _STATE["arch"] = name
     _STATE["generation"] = _STATE.get("generation", 0) + 1
+    _STATE["disk_cache"] = bool(kwargs["offline_cache"])
     return name
 
 
@@ -196,6 +197,12 @@ def ensure_init():
 def current_arch():
     """The arch Taichi was initialised with, or None."""
     return _STATE["arch"]
+
+
+def disk_cache():
+    """True when compiled kernels are kept in the offline cache on disk (so a variant compiled
+    by an earlier process is only loaded; ``ti_spinorbit.compiling``)."""
+    return bool(_STATE.get("disk_cache"))
 
 
 def generation():

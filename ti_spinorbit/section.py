@@ -19,7 +19,8 @@ import numpy as np
 
 from . import accuracy
 from . import coordinates as _coords
-from ._validate import (_as_floats, require_callable, require_count, require_finite,
+from . import progress as _progress
+from ._validate import (_as_floats, require_count, require_finite,
                         require_order, require_real, require_spin, show)
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
@@ -50,7 +51,7 @@ def _check_run_inputs(rtol, atol, order, progress, window_orbits):
     check_tolerances(rtol, atol)
     require_order(order)
     require_count("window_orbits", window_orbits, 1, 10**6)      # as Ensemble.run
-    require_callable("progress", progress)
+    _progress.check(progress)
 
 
 def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None,
@@ -229,8 +230,10 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
     indicators : bool
         Also integrate a shadow trajectory per member (same steps, about 2x the cost) for
         MEGNO and the maximal Lyapunov exponent; the main trajectory is unchanged.
-    progress : callable, optional
-        ``progress(fraction)`` after every window.
+    progress : bool or callable, optional
+        None (default): a progress bar in a terminal or Jupyter when the run lasts over 2 s,
+        nothing elsewhere; True: always; False: never; a callable: ``progress(fraction)``
+        after every window (:mod:`ti_spinorbit.progress`).
     model : {"auto", "planar", "3d"}
         Equations of motion. "auto" integrates the reduced planar model when every member
         starts planar with bodies symmetric about their equators (every catalogued system),
@@ -271,9 +274,10 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
                                              coordinates, order)
     _warn_near_circular(members)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
-    out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
-                  progress=progress, checkpoint=checkpoint, resume=resume,
-                  overwrite_checkpoint=overwrite_checkpoint)
+    with _progress.reporting(progress, "surface_of_section") as report:
+        out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
+                      progress=report, checkpoint=checkpoint, resume=resume,
+                      overwrite_checkpoint=overwrite_checkpoint)
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"),
                             apsidal=coordinates == "apsidal", order=order)
     thetadot, rate = cols["thetadot"], None
@@ -437,10 +441,11 @@ def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orb
     members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
                                              coordinates, order)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
-    out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
-                  sample_dt=2.0 * np.pi / samples_per_orbit, progress=progress,
-                  checkpoint=checkpoint, resume=resume,
-                  overwrite_checkpoint=overwrite_checkpoint)
+    with _progress.reporting(progress, "time_series") as report:
+        out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
+                      sample_dt=2.0 * np.pi / samples_per_orbit, progress=report,
+                      checkpoint=checkpoint, resume=resume,
+                      overwrite_checkpoint=overwrite_checkpoint)
     apsidal = coordinates == "apsidal"
     cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r", "e"),
                             ensemble=ens, apsidal=apsidal, order=order)

@@ -1,0 +1,369 @@
+"""Kernel compile time: done before the clock starts, announced, measured, and ahead of time.
+
+Taichi compiles a kernel variant (model × indicators × sampling × potential order × odd
+terms × method: template arguments) on its first launch in a process, and keeps it in its
+offline cache on disk (``runtime.cache_folder()``), so a later process only loads it. A cold
+compile takes seconds (planar) to a minute (3-D) on 2 cores; a load well under a second.
+
+What happens at the first use of a variant in a process (:class:`FirstUse`, wrapped
+around ``advance`` and the run's first right-hand-side and diagnostics calls by
+``Ensemble.run``):
+
+1. The variant is compiled by a **compile-only launch**: the same kernel with one-member
+   copies of every per-member array and that member's status "done", so nothing is
+   integrated and nothing of the run is touched; the results are bit-identical with or
+   without it (the real first window then runs on the compiled kernel).
+2. If the disk cache does not hold it (see below), the active progress reporter
+   (:mod:`ti_spinorbit.progress`) announces ``compiling kernels for <variant> (first use
+   only, about N s)`` before it starts. N is the last cold compile of this variant measured on
+   this machine (stored in ``compile_seconds.json`` in the cache folder), else
+   ``DEFAULT_COMPILE_SECONDS`` (documented 2-core figures).
+3. The whole first use (the other kernels' compile included) is kept out of ``RunOutput.seconds`` (so out of every result's ``seconds``
+   and member-orbits/s), out of the window-length adaptation, and out of the bar's elapsed
+   time and ETA (``Progress.compiled`` shifts the bar's clock).
+
+Whether the disk cache holds a variant: ``compile_seconds.json`` records, per variant, a
+fingerprint (the kernel sources, Taichi version, arch) of the last compile made with the disk
+cache on. Same fingerprint: it is a load, not announced (Taichi may still evict old entries:
+then a compile happens unannounced, and is measured and recorded as usual).
+
+:func:`warmup` (CLI ``ti-spinorbit warmup``) compiles chosen variants ahead of time by
+running each on one member for a hundredth of an orbit.
+"""
+
+import contextlib
+import hashlib
+import json
+import logging
+import os
+import time
+
+import numpy as np
+
+_LOG = logging.getLogger("ti_spinorbit")
+
+#: Seconds a cold compile of a variant takes when nothing was measured on this machine yet
+#: (2-core CPU, Taichi 1.7.4, issue 13: planar ≈ 8 s, 3-D ≈ 50 s quiet, 110-136 s loaded);
+#: the shadow trajectory (indicators) and dense sampling add code, about +50 % and +20 %.
+DEFAULT_COMPILE_SECONDS = {"planar": 10.0, "3d": 60.0}
+INDICATORS_FACTOR = 1.5
+SAMPLING_FACTOR = 1.2
+#: Announce only compiles expected to take at least this long (seconds).
+ANNOUNCE_MIN_S = 1.0
+#: The measurements, in the kernel cache folder (runtime.cache_folder()).
+RECORD_FILE = "compile_seconds.json"
+#: Methods warmup() accepts (the one place to extend when the kernels get more).
+METHODS = ("cash-karp",)
+MODELS = ("planar", "3d")
+
+_SEEN = set()              # (runtime generation, arch, variant) compiled in this process
+_TOTAL = [0.0]             # compile seconds spent in this process
+_HOW = {}                  # variant -> how its last first use went ("compiled", "loaded")
+
+
+def variant_name(model, indicators, sampling, order=4, odd=False, method="cash-karp"):
+    """A variant as text (the key of the measurements): ``planar/indicators/order4/cash-karp``."""
+    parts = [model, "indicators" if indicators else "plain", "sampling" if sampling else
+             "sections", f"order{int(order)}"]
+    if odd:
+        parts.append("odd")
+    return "/".join(parts + [method])
+
+
+def describe(variant):
+    """``planar/indicators/sections/order4/cash-karp`` -> "the planar model with indicators"."""
+    model, ind, samp = variant.split("/")[:3]
+    what = [f"the {'3-D' if model == '3d' else model} model"]
+    if ind == "indicators":
+        what.append("with chaos indicators")
+    if samp == "sampling":
+        what.append("with dense sampling")
+    method = variant.split("/")[-1]
+    if method != "cash-karp":
+        what.append(f"({method})")
+    return " ".join(what)
+
+
+def default_seconds(variant):
+    """``DEFAULT_COMPILE_SECONDS`` of the variant's model, scaled for indicators/sampling."""
+    model, ind, samp = variant.split("/")[:3]
+    seconds = DEFAULT_COMPILE_SECONDS.get(model, max(DEFAULT_COMPILE_SECONDS.values()))
+    if ind == "indicators":
+        seconds *= INDICATORS_FACTOR
+    if samp == "sampling":
+        seconds *= SAMPLING_FACTOR
+    return seconds
+
+
+def record_path():
+    """The measurements file in the kernel cache folder."""
+    from . import runtime
+
+    return os.path.join(runtime.cache_folder(), RECORD_FILE)
+
+
+def read_records():
+    """{variant: {"seconds": last cold compile, "fingerprint": ..., "loaded_seconds": ...}};
+    empty when missing or unreadable (a damaged file is only a lost estimate)."""
+    try:
+        with open(record_path()) as f:
+            data = json.load(f)
+        return data if isinstance(data, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def _write_records(records):
+    """Atomic replace; failures are ignored (a read-only cache only loses the estimate)."""
+    path = record_path()
+    tmp = f"{path}.tmp-{os.getpid()}"
+    try:
+        with open(tmp, "w") as f:
+            json.dump(records, f, indent=1, sort_keys=True)
+        os.replace(tmp, path)
+    except OSError:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+
+
+def fingerprint(variant):
+    """Digest of what Taichi's cache key depends on for us: the kernel sources, the Taichi
+    version, the arch and the variant."""
+    from . import kernels, runtime
+
+    h = hashlib.sha256(variant.encode())
+    folder = list(kernels.__path__)[0]
+    for name in sorted(os.listdir(folder)):
+        if name.endswith(".py"):
+            with open(os.path.join(folder, name), "rb") as f:
+                h.update(name.encode() + f.read())
+    try:
+        import taichi
+
+        h.update(str(taichi.__version__).encode())
+    except ImportError:  # pragma: no cover - taichi is a dependency
+        pass
+    h.update(str(runtime.current_arch()).encode())
+    return h.hexdigest()
+
+
+def compiled_seconds():
+    """Compile seconds spent in this process so far (for callers that time whole studies)."""
+    return _TOTAL[0]
+
+
+class Stopwatch:
+    """Wall time since creation minus the compile time spent meanwhile (seconds of a study
+    that runs several integrations: chaos maps, scans, the libration search)."""
+
+    def __init__(self, already=0.0):
+        self.start = time.perf_counter() - float(already)
+        self._compiled = _TOTAL[0]
+
+    def seconds(self):
+        return time.perf_counter() - self.start - (_TOTAL[0] - self._compiled)
+
+
+def _clock():
+    return time.perf_counter()
+
+
+def _launch(kernel, args):
+    """The compile-only launch (a function of its own so that tests can stand in for it)."""
+    kernel(*args)
+
+
+def _one_member(args, n, status):
+    """Arguments of a compile-only launch: one-member copies of every per-member array (first
+    dimension ``n``), the status "done" (the kernel skips the member); the rest as given."""
+    from .kernels.ensemble import DONE
+
+    out = []
+    for a in args:
+        if a is status:
+            out.append(np.full(1, DONE, dtype=status.dtype))
+        elif isinstance(a, np.ndarray) and a.ndim >= 1 and a.shape[0] == n:
+            out.append(np.ascontiguousarray(a[:1]).copy())
+        else:
+            out.append(a)
+    return out
+
+
+class FirstUse:
+    """``kernel`` (the integrator kernel, ``advance``) wrapped so that the first use of
+    ``variant`` in this process is announced, compiled by a compile-only launch before the
+    real one, and timed. ``other_kernels()`` wraps the run's first calls of the other kernels
+    (right-hand side, diagnostics), whose first use also compiles (or loads) them: their time
+    counts as compile time too. ``status`` is the members' status array, or a function
+    returning it (the array the launch will be given). ``take_seconds()`` returns (and resets) the integrator
+    kernel's compile time, which the caller keeps out of its own clock."""
+
+    def __init__(self, kernel, variant, status):
+        from . import runtime
+
+        self.kernel = kernel
+        self.variant = variant
+        self.status = status
+        self.key = (runtime.generation(), runtime.current_arch(), variant)
+        self.first = self.key not in _SEEN
+        self.seconds = 0.0          # integrator kernel compile, not yet taken
+        self.how = "ready"          # "compiled", "loaded" (disk cache) or "ready" (in process)
+        self._other = 0.0           # the other kernels' first use
+        self._begun = False
+        self._cached = False
+        self._report = None
+
+    def _begin(self):
+        """Announce the compile (once) unless the disk cache holds the variant."""
+        from . import progress, runtime
+
+        if self._begun:
+            return
+        self._begun = True
+        rec = read_records().get(self.variant) or {}
+        self._fp = fingerprint(self.variant)
+        self._cached = runtime.disk_cache() and rec.get("fingerprint") == self._fp
+        self._report = progress.active()
+        if self._cached:
+            return
+        estimate = rec.get("seconds") or default_seconds(self.variant)
+        if estimate >= ANNOUNCE_MIN_S:
+            text = (f"compiling kernels for {describe(self.variant)} (first use only, about "
+                    f"{estimate:.0f} s)")
+            _LOG.info(text)
+            if self._report is not None:
+                self._report.compiling(text)
+
+    @contextlib.contextmanager
+    def other_kernels(self):
+        if not self.first or self.key in _SEEN:
+            yield
+            return
+        self._begin()
+        started = _clock()
+        try:
+            yield
+        finally:
+            seconds = _clock() - started
+            self._other += seconds
+            _TOTAL[0] += seconds
+
+    def __call__(self, *args):
+        status = self.status() if callable(self.status) else self.status
+        if self.first and self.key not in _SEEN and len(status):
+            self._begin()
+            started = _clock()
+            _launch(self.kernel, _one_member(args, len(status), status))
+            seconds = _clock() - started
+            _SEEN.add(self.key)
+            _TOTAL[0] += seconds
+            self.seconds += seconds
+            self.how = "loaded" if self._cached else "compiled"
+            _HOW[self.variant] = self.how
+            total = seconds + self._other
+            self._record(total)
+            _LOG.info("kernels for %s %s in %.2f s", describe(self.variant), self.how, total)
+            if self._report is not None:
+                self._report.compiled(total)
+        return self.kernel(*args)
+
+    def _record(self, total):
+        """Store the measurement (the whole first use: what a user waits for)."""
+        from . import runtime
+
+        records = read_records()
+        rec = dict(records.get(self.variant) or {})
+        rec["loaded_seconds" if self._cached else "seconds"] = round(total, 3)
+        if runtime.disk_cache():
+            rec["fingerprint"] = self._fp
+        else:
+            rec.pop("fingerprint", None)
+        if rec != records.get(self.variant):
+            records[self.variant] = rec
+            _write_records(records)
+
+    def take_seconds(self):
+        seconds, self.seconds = self.seconds, 0.0
+        return seconds
+
+
+# ---- ahead of time ----------------------------------------------------------------------
+def _choices(name, values, allowed):
+    values = [values] if isinstance(values, (str, bool)) else list(values)
+    bad = [v for v in values if v not in allowed]
+    if bad or not values:
+        raise ValueError(f"{name} must be a non-empty selection of {', '.join(map(repr, allowed))} "
+                         f"(got {values!r})")
+    return list(dict.fromkeys(values))
+
+
+def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), methods=METHODS,
+           order=4, verbose=True, stream=None):
+    """Compile kernel variants ahead of time, so that later runs (in this process, and in
+    later processes through the disk cache) start without waiting.
+
+    Each variant is run once on one member of 1991 VH for 0.01 orbit (which also compiles
+    the right-hand side and diagnostics kernels it uses).
+
+    Parameters
+    ----------
+    models : sequence of {"planar", "3d"}
+        Equations of motion (default both).
+    indicators : sequence of bool
+        Without and/or with the chaos-indicator shadow (``chaos_map``, ``overlap_threshold``).
+    sampling : sequence of bool
+        Without (sections) and/or with dense sampling (``time_series``, libration).
+    methods : sequence of str
+        Integration methods; currently only "cash-karp" (``METHODS``).
+    order : {0, 2, 3, 4}
+        Potential order of the variants (default 4, every entry point's default).
+    verbose : bool
+        Print one line per variant (what, how, seconds) on ``stream`` (default stdout).
+
+    Returns
+    -------
+    list of dict
+        One per variant: ``variant``, ``how`` ("compiled", "loaded" from the disk cache, or
+        "ready" already in this process), ``kernel_seconds`` (the compile or load of the
+        kernels this variant uses first: integrator, and right-hand side and diagnostics when
+        not used before) and ``seconds`` (the whole first run).
+    """
+    import itertools
+    import sys
+
+    from . import catalog, runtime
+    from ._validate import require_order
+    from .ensemble import Ensemble
+    from .section import build_members
+
+    models = _choices("models", models, MODELS)
+    indicators = _choices("indicators", indicators, (False, True))
+    sampling = _choices("sampling", sampling, (False, True))
+    methods = _choices("methods", methods, METHODS)
+    order = require_order(order)
+    out = sys.stdout if stream is None else stream
+    runtime.ensure_init()
+    system = catalog.system("1991 VH")
+    _, par, y0, _, _ = build_members(system, 0.0, 1.0, order=order)
+    done = []
+    for method, model, ind, samp in itertools.product(methods, models, indicators, sampling):
+        started = time.perf_counter()
+        kw = {} if method == "cash-karp" else {"method": method}
+        ens = Ensemble(par, y0, order=order, model=model, **kw)
+        before = len(_SEEN), _TOTAL[0]
+        ens.run(2.0 * np.pi * 0.01, sample_dt=2.0 * np.pi / 64 if samp else None,
+                indicators=ind)
+        variant = variant_name(model, ind, samp, order, ens.odd, method)
+        seconds = time.perf_counter() - started
+        kernel = _TOTAL[0] - before[1]
+        how = "ready" if len(_SEEN) == before[0] else _HOW.get(variant, "compiled")
+        done.append({"variant": variant, "how": how, "kernel_seconds": kernel,
+                     "seconds": seconds})
+        if verbose:
+            word = {"compiled": "compiled", "loaded": "loaded from the disk cache",
+                    "ready": "already compiled in this process"}[how]
+            print(f"{variant}: {word} in {kernel:.2f} s (first run {seconds:.2f} s in all)",
+                  file=out)
+    return done
