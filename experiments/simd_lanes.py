@@ -1,0 +1,347 @@
+"""SIMD lanes (issue 13 §4): several ensemble members per CPU thread as vector lanes, against
+today's one member per thread, on the planar right-hand side of 1991 VH (a/b = 1.5).
+
+Benchmark-only prototype: the package kernels are not changed. Three layouts of the same work
+(every member evaluates the planar RHS ``repeats`` times in a dependent chain):
+
+scalar
+    today's layout: one member per loop iteration (per thread task), state and parameters
+    of member i from (N, 10) and (N, 37) arrays, ``kernels/planar.rhs_member``.
+unrolled L
+    structure of arrays, (10, N) and (37, N), so that L consecutive members are contiguous;
+    one loop iteration takes L members and runs the package's scalar ``rhs_member`` on each,
+    interleaved in one loop body (``ti.static`` unrolled), leaving it to LLVM's SLP
+    vectoriser to pack the L independent copies into vector instructions.
+lanes L
+    the same layout, with an RHS written here over ``ti.types.vector(L, f64)``: every scalar
+    of the planar equations is an L-vector (one lane per member), the state an (10, L)
+    matrix: explicit vector lanes.
+
+Two workloads: ``rhs`` (z ← y0 + 1e-12 f(z), R dependent evaluations, as the split section
+of bench_throughput.py) and ``rk4`` (R fixed steps of the classical 4th-order Runge-Kutta
+method, h = 2π/256: a whole integrator loop, stage combination included). Checks: the
+unrolled layout must equal the scalar one bit for bit (same operations per member); the
+explicit lanes, whose RHS is written again here, must agree to round-off.
+
+The machine may be shared: the variants are timed interleaved (variant A, B, C, A, B, C, ...),
+``--repeat`` rounds, and each timing records wall and process CPU time; ns per RHS are given
+per core (CPU time / evaluations, the figure to compare under load) and per wall second;
+the speed-up is the scalar layout's median CPU time over the variant's.
+
+    python experiments/simd_lanes.py                 # N = 4096, lanes 2, 4, 8
+    python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 4, a fraction of a s
+"""
+
+import os
+import sys
+import time
+
+import numpy as np
+
+from _common import parse, save
+
+EPS = 1e-12                 # rhs workload: next argument y0 + EPS f(previous)
+RK4_STEP = 2.0 * np.pi / 256
+FULL = dict(members=4096, lanes=(2, 4, 8), seconds=0.5, repeat=5)
+QUICK = dict(members=256, lanes=(4,), seconds=0.02, repeat=2)
+ORDER, ODD = 4, False       # 1991 VH: ellipsoids, no order-3 terms
+#: Largest relative difference of the explicit-lane results from the scalar ones: round-off
+#: of a differently ordered RHS; the rk4 runs (several orbits, chaotic members among them)
+#: amplify it, measured 5e-11 after 912 steps.
+AGREE = {"rhs": 1e-13, "rk4": 1e-8}
+
+
+def build_kernels(lanes_list):
+    """Taichi kernels {(workload, variant, L): kernel(par, y, out, repeats)}."""
+    import taichi as ti
+
+    from ti_spinorbit.kernels import planar as P
+
+    nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
+    NS, NP = P.NSTATE, P.NPAR
+
+    # ---- scalar: one member per iteration (AoS, the package's layout) ----
+    @ti.kernel
+    def scalar_rhs(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+        for i in range(y.shape[0]):
+            pv = P.member(par, i)
+            y0 = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
+            z = y0
+            for _ in range(repeats):
+                z = y0 + EPS * P.rhs_member(pv, z, ORDER, ODD)
+            for k in ti.static(range(NS)):
+                out[i, k] = z[k]
+
+    @ti.kernel
+    def scalar_rk4(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+        for i in range(y.shape[0]):
+            pv = P.member(par, i)
+            z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
+            h = RK4_STEP
+            for _ in range(repeats):
+                k1 = P.rhs_member(pv, z, ORDER, ODD)
+                k2 = P.rhs_member(pv, z + 0.5 * h * k1, ORDER, ODD)
+                k3 = P.rhs_member(pv, z + 0.5 * h * k2, ORDER, ODD)
+                k4 = P.rhs_member(pv, z + h * k3, ORDER, ODD)
+                z = z + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+            for k in ti.static(range(NS)):
+                out[i, k] = z[k]
+
+    kernels = {("rhs", "scalar", 1): scalar_rhs, ("rk4", "scalar", 1): scalar_rk4}
+
+    # ---- unrolled: L members per iteration, scalar code per member (SoA) ----
+    def unrolled(L, workload):
+        @ti.func
+        def column(M, l: ti.template(), n: ti.template()):
+            return ti.Vector([M[k, l] for k in ti.static(range(n))], ti.f64)
+
+        @ti.kernel
+        def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+            for g in range(y.shape[1] // L):
+                base = g * L
+                PV = ti.Matrix([[par[k, base + l] for l in ti.static(range(L))]
+                                for k in ti.static(range(NP))], ti.f64)
+                Y0 = ti.Matrix([[y[k, base + l] for l in ti.static(range(L))]
+                                for k in ti.static(range(NS))], ti.f64)
+                Z = Y0
+                h = RK4_STEP
+                for _ in range(repeats):
+                    for l in ti.static(range(L)):
+                        pv = column(PV, l, NP)
+                        z = column(Z, l, NS)
+                        if ti.static(workload == "rhs"):
+                            z = column(Y0, l, NS) + EPS * P.rhs_member(pv, z, ORDER, ODD)
+                        else:
+                            k1 = P.rhs_member(pv, z, ORDER, ODD)
+                            k2 = P.rhs_member(pv, z + 0.5 * h * k1, ORDER, ODD)
+                            k3 = P.rhs_member(pv, z + 0.5 * h * k2, ORDER, ODD)
+                            k4 = P.rhs_member(pv, z + h * k3, ORDER, ODD)
+                            z = z + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+                        for k in ti.static(range(NS)):
+                            Z[k, l] = z[k]
+                for k in ti.static(range(NS)):
+                    for l in ti.static(range(L)):
+                        out[k, base + l] = Z[k, l]
+        return kernel
+
+    # ---- lanes: the RHS over L-vectors, one lane per member (SoA) ----
+    def lanes(L, workload):
+        @ti.func
+        def row(M, k: ti.template()):
+            return ti.Vector([M[k, l] for l in ti.static(range(L))], ti.f64)
+
+        @ti.func
+        def rhs_lanes(PV, Y):
+            """kernels/planar.py's equations (order 4, no odd terms), every scalar an
+            L-vector of members."""
+            r, vr, ell = row(Y, P.Y_R), row(Y, P.Y_VR), row(Y, P.Y_L)
+            ca, sa, cb, sb = row(Y, P.Y_CA), row(Y, P.Y_SA), row(Y, P.Y_CB), row(Y, P.Y_SB)
+            c2a = ca * ca - sa * sa
+            s2a = 2.0 * ca * sa
+            c4a = c2a * c2a - s2a * s2a
+            s4a = 2.0 * c2a * s2a
+            c2b = cb * cb - sb * sb
+            s2b = 2.0 * cb * sb
+            c4b = c2b * c2b - s2b * s2b
+            s4b = 2.0 * c2b * s2b
+            f2 = (row(PV, P.P_P2) + row(PV, P.P_P2 + 1) * c2a + row(PV, P.P_P2 + 2) * s2a
+                  + row(PV, P.P_Q2) + row(PV, P.P_Q2 + 1) * c2b + row(PV, P.P_Q2 + 2) * s2b)
+            d2a = 2.0 * (row(PV, P.P_P2 + 2) * c2a - row(PV, P.P_P2 + 1) * s2a)
+            d2b = 2.0 * (row(PV, P.P_Q2 + 2) * c2b - row(PV, P.P_Q2 + 1) * s2b)
+            f4 = (row(PV, P.P_P4) + row(PV, P.P_P4 + 1) * c2a + row(PV, P.P_P4 + 2) * s2a
+                  + row(PV, P.P_P4 + 3) * c4a + row(PV, P.P_P4 + 4) * s4a
+                  + row(PV, P.P_Q4) + row(PV, P.P_Q4 + 1) * c2b + row(PV, P.P_Q4 + 2) * s2b
+                  + row(PV, P.P_Q4 + 3) * c4b + row(PV, P.P_Q4 + 4) * s4b)
+            d4a = (2.0 * (row(PV, P.P_P4 + 2) * c2a - row(PV, P.P_P4 + 1) * s2a)
+                   + 4.0 * (row(PV, P.P_P4 + 4) * c4a - row(PV, P.P_P4 + 3) * s4a))
+            d4b = (2.0 * (row(PV, P.P_Q4 + 2) * c2b - row(PV, P.P_Q4 + 1) * s2b)
+                   + 4.0 * (row(PV, P.P_Q4 + 4) * c4b - row(PV, P.P_Q4 + 3) * s4b))
+            xa, xb, xab, xm = (row(PV, P.P_X + 1), row(PV, P.P_X + 2), row(PV, P.P_X + 3),
+                               row(PV, P.P_X + 4))
+            cm = c2a * c2b + s2a * s2b
+            sm = s2a * c2b - c2a * s2b
+            f4 += row(PV, P.P_X) + xa * c2a + xb * c2b + xab * c2a * c2b + xm * cm
+            d4a += -2.0 * (s2a * (xa + xab * c2b) + xm * sm)
+            d4b += -2.0 * (s2b * (xb + xab * c2a) - xm * sm)
+            u = 1.0 / r
+            u2 = u * u
+            u3 = u2 * u
+            u5 = u3 * u2
+            v_r = -row(PV, P.P_MM) * u2 - 3.0 * f2 * u3 * u - 5.0 * f4 * u5 * u
+            v_a = d2a * u3 + d4a * u5
+            v_b = d2b * u3 + d4b * u5
+            lam_dot = ell * u2
+            inv_m = row(PV, P.P_INV_M)
+            rate_a = lam_dot - row(PV, P.P_F1) * row(Y, P.Y_W1)
+            rate_b = lam_dot - row(PV, P.P_F2) * row(Y, P.Y_W2)
+            return ti.Matrix.rows([vr, ell * lam_dot * u + inv_m * v_r, inv_m * (v_a + v_b),
+                                   lam_dot, -sa * rate_a, ca * rate_a,
+                                   -v_a * row(PV, P.P_K1), -sb * rate_b, cb * rate_b,
+                                   -v_b * row(PV, P.P_K2)])
+
+        @ti.kernel
+        def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+            for g in range(y.shape[1] // L):
+                base = g * L
+                PV = ti.Matrix([[par[k, base + l] for l in ti.static(range(L))]
+                                for k in ti.static(range(NP))], ti.f64)
+                Y0 = ti.Matrix([[y[k, base + l] for l in ti.static(range(L))]
+                                for k in ti.static(range(NS))], ti.f64)
+                Z = Y0
+                h = RK4_STEP
+                for _ in range(repeats):
+                    if ti.static(workload == "rhs"):
+                        Z = Y0 + EPS * rhs_lanes(PV, Z)
+                    else:
+                        K1 = rhs_lanes(PV, Z)
+                        K2 = rhs_lanes(PV, Z + 0.5 * h * K1)
+                        K3 = rhs_lanes(PV, Z + 0.5 * h * K2)
+                        K4 = rhs_lanes(PV, Z + h * K3)
+                        Z = Z + h / 6.0 * (K1 + 2.0 * K2 + 2.0 * K3 + K4)
+                for k in ti.static(range(NS)):
+                    for l in ti.static(range(L)):
+                        out[k, base + l] = Z[k, l]
+        return kernel
+
+    for L in lanes_list:
+        for workload in ("rhs", "rk4"):
+            kernels[(workload, "unrolled", L)] = unrolled(L, workload)
+            kernels[(workload, "lanes", L)] = lanes(L, workload)
+    return kernels
+
+
+def member_inputs(n):
+    """Planar parameter rows and states of the first n benchmark members (bench_throughput's
+    R2 sequence of starts, 1991 VH at a/b = 1.5)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import bench_throughput as bt
+
+    from ti_spinorbit import planar
+
+    par, y0 = bt.member_table(n)
+    return planar.parameter_rows(par), planar.to_planar(y0)
+
+
+def timed(kernel, par, y, out, repeats):
+    import taichi as ti
+
+    wall, cpu = time.perf_counter(), time.process_time()
+    kernel(par, y, out, repeats)
+    ti.sync()
+    return time.perf_counter() - wall, time.process_time() - cpu
+
+
+def measure(kernels, kpar, q, seconds, rounds):
+    """Interleaved timings of every kernel; one row per (workload, variant, L)."""
+    n = len(q)
+    aos = (np.ascontiguousarray(kpar), np.ascontiguousarray(q))
+    soa = (np.ascontiguousarray(kpar.T), np.ascontiguousarray(q.T))
+    outputs, repeats, compile_s = {}, {}, {}
+    for key, kernel in kernels.items():
+        par, y = aos if key[1] == "scalar" else soa
+        out = np.zeros_like(y)
+        wall, _ = timed(kernel, par, y, out, 1)          # compile or load
+        compile_s[key] = wall
+        wall, _ = timed(kernel, par, y, out, 8)
+        repeats[key] = max(8, int(8 * seconds / max(wall, 1e-6)))
+        outputs[key] = out
+    # the scalar variant's repeats for every variant of a workload: the same work
+    for key in kernels:
+        repeats[key] = repeats[(key[0], "scalar", 1)]
+    times = {key: [] for key in kernels}
+    for _ in range(rounds):
+        for key, kernel in kernels.items():
+            par, y = aos if key[1] == "scalar" else soa
+            times[key].append(timed(kernel, par, y, outputs[key], repeats[key]))
+    rows = []
+    for key in kernels:
+        workload, variant, L = key
+        rhs_calls = n * repeats[key] * (4 if workload == "rk4" else 1)
+        walls = np.array([t[0] for t in times[key]])
+        cpus = np.array([t[1] for t in times[key]])
+        out = outputs[key] if variant == "scalar" else outputs[key].T
+        rows.append({"workload": workload, "variant": variant, "lanes": L, "members": n,
+                     "repeats": repeats[key], "rhs_calls": rhs_calls,
+                     "compile_s": compile_s[key], "wall_s": walls.tolist(),
+                     "cpu_s": cpus.tolist(),
+                     "ns_per_rhs_cpu_median": 1e9 * float(np.median(cpus)) / rhs_calls,
+                     "ns_per_rhs_cpu_best": 1e9 * float(cpus.min()) / rhs_calls,
+                     "ns_per_rhs_wall_median": 1e9 * float(np.median(walls)) / rhs_calls,
+                     "out": out})
+    for r in rows:
+        ref = next(s for s in rows if (s["workload"], s["variant"]) == (r["workload"], "scalar"))
+        diff = np.abs(r["out"] - ref["out"]) / np.maximum(np.abs(ref["out"]).max(axis=0), 1e-300)
+        r["max_rel_diff_vs_scalar"] = float(diff.max())
+        r["bit_identical"] = bool(np.array_equal(r["out"], ref["out"]))
+        r["speedup_cpu"] = ref["ns_per_rhs_cpu_median"] / r["ns_per_rhs_cpu_median"]
+        r["speedup_wall"] = ref["ns_per_rhs_wall_median"] / r["ns_per_rhs_wall_median"]
+    for r in rows:
+        del r["out"]
+    return rows
+
+
+def figure(rows):
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for ax, workload in zip(axes, ("rhs", "rk4")):
+        group = [r for r in rows if r["workload"] == workload]
+        labels = [r["variant"] if r["variant"] == "scalar" else f"{r['variant']} {r['lanes']}"
+                  for r in group]
+        x = np.arange(len(group))
+        ax.bar(x - 0.2, [r["ns_per_rhs_cpu_median"] for r in group], 0.4, label="per core (CPU time)")
+        ax.bar(x + 0.2, [r["ns_per_rhs_wall_median"] for r in group], 0.4, label="wall")
+        ax.set_xticks(x, labels, rotation=30, fontsize=8)
+        ax.set_ylabel("ns per RHS evaluation (median)")
+        ax.set_title(f"planar RHS, 1991 VH a/b = 1.5: workload {workload}", fontsize=9)
+        ax.legend(fontsize=7)
+    return fig
+
+
+def main():
+    args, started = parse(__doc__.splitlines()[0], lambda p: p.add_argument(
+        "--repeat", type=int, default=None, help="interleaved rounds (default 5; quick 2)"))
+    s = dict(QUICK if args.quick else FULL)
+    rounds = args.repeat or s["repeat"]
+    kpar, q = member_inputs(s["members"])
+    t0 = time.perf_counter()
+    kernels = build_kernels(s["lanes"])
+    rows = measure(kernels, kpar, q, s["seconds"], rounds)
+    load = os.getloadavg()[0]
+    import bench_throughput as bt                           # on the path after member_inputs
+    cpu_model, ghz, flags = bt.cpu_info()
+    simd = sorted(f for f in flags if f in ("avx2", "fma", "avx512f"))
+    print(f"[simd_lanes] CPU {cpu_model} ({', '.join(simd) or 'no AVX2'}), "
+          f"{os.cpu_count()} CPUs")
+    print(f"[simd_lanes] N = {s['members']}, {rounds} interleaved rounds, load average "
+          f"{load:.2f}; ns per RHS (median), per core = process CPU time / evaluations")
+    print(f"{'workload':>8} {'variant':>9} {'L':>2} {'CPU ns':>7} {'best':>7} {'wall ns':>8} "
+          f"{'speed-up':>8} {'(wall)':>7} {'max rel diff':>12} {'compile s':>9}")
+    for r in rows:
+        print(f"{r['workload']:>8} {r['variant']:>9} {r['lanes']:>2} "
+              f"{r['ns_per_rhs_cpu_median']:7.2f} {r['ns_per_rhs_cpu_best']:7.2f} "
+              f"{r['ns_per_rhs_wall_median']:8.2f} {r['speedup_cpu']:7.2f}x "
+              f"{r['speedup_wall']:6.2f}x {r['max_rel_diff_vs_scalar']:12.1e} "
+              f"{r['compile_s']:9.2f}")
+    bad = [(r["workload"], r["variant"], r["lanes"]) for r in rows
+           if (r["variant"] == "unrolled" and not r["bit_identical"])
+           or r["max_rel_diff_vs_scalar"] > AGREE[r["workload"]]]
+    if bad:
+        raise SystemExit(f"[simd_lanes] results differ from the scalar layout: {bad}")
+    best = {w: max((r for r in rows if r["workload"] == w), key=lambda r: r["speedup_cpu"])
+            for w in ("rhs", "rk4")}
+    numbers = {f"{w} speed-up per core, best ({b['variant']} {b['lanes']})": b["speedup_cpu"]
+               for w, b in best.items()}
+    numbers.update({f"{w} scalar ns per RHS per core": next(
+        r["ns_per_rhs_cpu_median"] for r in rows if (r["workload"], r["variant"]) == (w, "scalar"))
+        for w in ("rhs", "rk4")})
+    keys = ("workload", "variant", "lanes", "ns_per_rhs_cpu_median", "ns_per_rhs_wall_median",
+            "speedup_cpu", "max_rel_diff_vs_scalar")
+    save(args, "simd_lanes", figure(rows), {k: [r[k] for r in rows] for k in keys},
+         {**s, "rounds": rounds, "rows": rows, "load_average": load, "cpu": cpu_model,
+          "simd": simd,
+          "build_and_time_s": time.perf_counter() - t0}, numbers, started)
+
+
+if __name__ == "__main__":
+    main()
