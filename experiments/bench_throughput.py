@@ -1,6 +1,7 @@
 """Benchmark: where the ensemble integrator's time goes on 1991 VH (a/b = 1.5), and how it scales.
 
-Issue 5, item 1 ("measure first"). Every run is deterministic: member k starts at
+Issue 5, item 1 ("measure first"); issue 13 §1 (methods as an axis, a compiled DOP853
+baseline in the same run, accuracy at equal rtol, the issue-13 targets with their ratios). Every run is deterministic: member k starts at
 θ_p = 180° frac(½ + k/g), θ̇_p/n = 0.5 + 2 frac(½ + k/g²) with g the plastic number (an
 R2 low-discrepancy sequence over θ_p ∈ [0, 180), θ̇_p/n ∈ [0.5, 2.5]), so the first N
 members of a larger table are the N-member table and every N samples the same mix of regular
@@ -8,8 +9,8 @@ and chaotic starts. Integration uses ``Ensemble`` directly (order 4, atol = rtol
 distance 1000 a so no member stops early). Sections (``--sections``, default all):
 
 throughput
-    member-orbits per second for N × rtol × model (``--members``, ``--rtols``,
-    ``--models``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10, 1e-12, 1e-15, models
+    member-orbits per second for N × rtol × model × method (``--members``, ``--rtols``,
+    ``--models``, ``--methods``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10, 1e-12, 1e-15, models
     planar and 3d) on the arch of ``--arch`` (cpu by default; ``--arch cuda --members ...
     65536`` for a GPU). The orbits of each point are chosen so that it takes about
     ``--seconds`` (default 2 s): a short pilot run measures the rate, then the timed run
@@ -63,6 +64,22 @@ baseline
     again in the baseline's favour. One-off costs (importing scipy.integrate, the
     reference's cached multipole bases) are paid before timing. The speed-up printed is the
     kernel rate at the split N over the baseline rate, per model and rtol.
+numba
+    a compiled single-trajectory DOP853 integrator of the planar model written for this
+    benchmark with numba (experiments/_numba_dop853.py: its own RHS, Hairer's error norm and
+    controller; the ``bench`` extra), at rtol 1e-12 and 1e-15 (those of ``--rtols``),
+    atol = rtol, on the first 64 members (quick: 4) one after the other on ONE core: orbits
+    per CPU-second is its rate per core. Checked in the same run: its RHS against the
+    package's planar RHS on 256 random states (relative difference, round-off), and its
+    final states against the kernels at rtol 1e-14 over ``accuracy_orbits``.
+accuracy
+    final-state error at equal rtol: each (model, method, rtol) of the run and the numba
+    baseline on the first 32 members (quick: 4) over 4 orbits (quick: 0.5), against a tight
+    reference, numba DOP853 at rtol 1e-16 (the kernels' Cash-Karp at 1e-16 without numba);
+    error = max |Δy| over the scaled 3-D state (planar states through ``to_spatial``, so
+    both models meet the same reference), median and max over members. One line per model
+    and rtol gives every method's median error and its ratio to Cash-Karp's, so that a
+    faster method is not bought with accuracy.
 latency
     first result from a fresh process: ``sys.executable -c`` imports ti_spinorbit and
     computes a 1-member, 1-orbit section; with a new, empty offline kernel cache (cold:
@@ -74,6 +91,19 @@ over 0.5 orbit, no cold-cache run: every section in about 12 s (CI, not figures)
 ``--repeat k`` times every run k times and keeps the best (do that on a shared machine; the
 load average at start and end is recorded, and other processes' load lowers every
 wall-clock figure).
+
+Methods: ``--methods cash-karp dop853 ...`` (``Ensemble(method=...)``; the default
+"cash-karp" is never passed by keyword, so the script runs on a package without the keyword;
+a method ``Ensemble`` does not accept yet is skipped with a one-line note). The split, flops,
+threads and window sections use Cash-Karp.
+
+Issue-13 targets (planar unless said, 1991 VH a/b = 1.5, N = the split N, "fastest" = the
+fastest method measured): >= 60 000 member-orbits/s on 2 cores at rtol 1e-12; >= 2x per core
+the numba DOP853 baseline (ensemble member-orbits per CPU-second over the baseline's orbits
+per CPU-second; on a GPU the wall rate against one CPU core); at 1e-15 >= 4x the Cash-Karp
+rate of the same run; 3-D >= 15 000 at 1e-12; and the accuracy at equal rtol of each method
+no worse than Cash-Karp's (median error ratio <= 1). Each prints MET/MISS, its value and
+value/target.
 
 Targets (2-core machine): issue 5, >= 20 000 member-orbits/s for the planar model and
 >= 2 000 for the 3-D model at N = 4096, rtol 1e-12 (issue 2 asked >= 1 000); >= 300x the
