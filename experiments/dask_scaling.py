@@ -160,6 +160,8 @@ def main():
     w = [r["workers"] for r in scaling]
     ax.plot(w, [r["member_orbits_per_s"] for r in scaling], "o-", label="chaos_map, client=")
     ax.plot(w, [one * k for k in w], "k:", lw=1, label="ideal (k x 1 worker)")
+    ax.plot(w, [r["workers"] * r["member_orbits_per_worker_cpu_s"] for r in scaling], "s--",
+            label="k x per worker CPU-s (k unshared cores)")
     ax.axhline(mo / local, color="C2", ls="--", lw=1, label="one process, no Dask, all cores")
     ax.set_xlabel("worker processes (1 thread each)")
     ax.set_ylabel("member-orbits per second")
