@@ -29,7 +29,8 @@ per core (CPU time / evaluations, the figure to compare under load) and per wall
 the speed-up is the scalar layout's median CPU time over the variant's.
 
     python experiments/simd_lanes.py                 # N = 4096, lanes 2, 4, 8
-    python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 4, a fraction of a s
+    python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 4, ~10 s
+    python experiments/simd_lanes.py --llvm-ir       # and count vector instructions in the IR
 """
 
 import os
@@ -280,6 +281,46 @@ def measure(kernels, kpar, q, seconds, rounds):
     return rows
 
 
+def llvm_ir_counts(lanes_list, kpar, q):
+    """Floating-point instructions in each kernel's optimised LLVM IR, scalar and vector
+    (``<k x double>``), by vector width: whether LLVM packed the lanes. Re-initialises Taichi
+    (the package's settings, no kernel cache, IR written to a temporary folder)."""
+    import glob
+    import re
+    import tempfile
+
+    import taichi as ti
+
+    here = os.getcwd()
+    counts = {}
+    with tempfile.TemporaryDirectory(prefix="simd_lanes_ir_") as folder:
+        os.chdir(folder)
+        try:
+            ti.reset()
+            ti.init(arch=ti.cpu, default_fp=ti.f64, default_ip=ti.i32, fast_math=False,
+                    offline_cache=False, log_level=ti.WARN, make_cpu_multithreading_loop=False,
+                    cpu_block_dim_adaptive=False, default_cpu_block_dim=1,
+                    print_kernel_llvm_ir_optimized=True)
+            seen = set()
+            for key, kernel in build_kernels(lanes_list).items():
+                par, y = (kpar, q) if key[1] == "scalar" else (np.ascontiguousarray(kpar.T),
+                                                               np.ascontiguousarray(q.T))
+                kernel(par, y, np.zeros_like(y), 1)
+                new = sorted(set(glob.glob("*.ll")) - seen)
+                seen.update(new)
+                text = "".join(open(f).read() for f in new)
+                op = r"(?:fadd|fsub|fmul|fdiv)"
+                counts[key] = {
+                    "scalar_ops": len(re.findall(op + r" (?:\w+ )*double ", text)),
+                    "vector_ops": len(re.findall(op + r" (?:\w+ )*<\d+ x double>", text)),
+                    "widths": {int(w): text.count(f"<{w} x double>")
+                               for w in sorted(set(re.findall(r"<(\d+) x double>", text)),
+                                               key=int)}}
+        finally:
+            os.chdir(here)
+    return counts
+
+
 def figure(rows):
     import matplotlib.pyplot as plt
 
@@ -299,8 +340,14 @@ def figure(rows):
 
 
 def main():
-    args, started = parse(__doc__.splitlines()[0], lambda p: p.add_argument(
-        "--repeat", type=int, default=None, help="interleaved rounds (default 5; quick 2)"))
+    def extra(p):
+        p.add_argument("--repeat", type=int, default=None,
+                       help="interleaved rounds (default 5; quick 2)")
+        p.add_argument("--llvm-ir", action="store_true",
+                       help="also count scalar and vector floating-point instructions in each "
+                            "kernel's optimised LLVM IR (recompiles every kernel)")
+
+    args, started = parse(__doc__.splitlines()[0], extra)
     s = dict(QUICK if args.quick else FULL)
     rounds = args.repeat or s["repeat"]
     kpar, q = member_inputs(s["members"])
@@ -328,6 +375,14 @@ def main():
            or r["max_rel_diff_vs_scalar"] > AGREE[r["workload"]]]
     if bad:
         raise SystemExit(f"[simd_lanes] results differ from the scalar layout: {bad}")
+    ir = {}
+    if args.llvm_ir:
+        ir = llvm_ir_counts(s["lanes"], kpar[:64], q[:64])
+        print("[simd_lanes] optimised LLVM IR, f64 fadd/fsub/fmul/fdiv: scalar, vector "
+              "(<k x double>), occurrences of each vector width")
+        for (workload, variant, L), c in ir.items():
+            print(f"  {workload:>4} {variant:>9} {L:2d}: scalar {c['scalar_ops']:5d}  vector "
+                  f"{c['vector_ops']:5d}  widths {c['widths']}")
     best = {w: max((r for r in rows if r["workload"] == w), key=lambda r: r["speedup_cpu"])
             for w in ("rhs", "rk4")}
     numbers = {f"{w} speed-up per core, best ({b['variant']} {b['lanes']})": b["speedup_cpu"]
@@ -338,7 +393,8 @@ def main():
     keys = ("workload", "variant", "lanes", "ns_per_rhs_cpu_median", "ns_per_rhs_wall_median",
             "speedup_cpu", "max_rel_diff_vs_scalar")
     save(args, "simd_lanes", figure(rows), {k: [r[k] for r in rows] for k in keys},
-         {**s, "rounds": rounds, "rows": rows, "load_average": load, "cpu": cpu_model,
+         {**s, "rounds": rounds, "rows": rows,
+          "llvm_ir": {" ".join(map(str, k)): v for k, v in ir.items()}, "load_average": load, "cpu": cpu_model,
           "simd": simd,
           "build_and_time_s": time.perf_counter() - t0}, numbers, started)
 
