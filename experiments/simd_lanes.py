@@ -17,7 +17,7 @@ lanes L
     of the planar equations is an L-vector (one lane per member), the state an (10, L)
     matrix: explicit vector lanes.
 
-Two workloads: ``rhs`` (z ← y0 + 1e-12 f(z), R dependent evaluations, as the split section
+Workloads: ``rhs`` (z ← y0 + 1e-12 f(z), R dependent evaluations, as the split section
 of bench_throughput.py) and ``rk4`` (R fixed steps of the classical 4th-order Runge-Kutta
 method, h = 2π/256: a whole integrator loop, stage combination included). Checks: the
 unrolled layout must equal the scalar one bit for bit (same operations per member); the
@@ -28,8 +28,14 @@ The machine may be shared: the variants are timed interleaved (variant A, B, C, 
 per core (CPU time / evaluations, the figure to compare under load) and per wall second;
 the speed-up is the scalar layout's median CPU time over the variant's.
 
+A third workload, ``ck45``, is the kernels' adaptive scheme without events: Cash-Karp 4(5)
+(``kernels/tableau.py``), max-norm error control at rtol = atol = 1e-12, the same
+controller, each member to its own end time (cost per member-orbit). Its lane variant keeps
+the L members of a group in lock-step (every lane computes a step each round, a finished
+lane's is discarded, as SIMD lanes would) and must equal the scalar results bit for bit.
+
     python experiments/simd_lanes.py                 # N = 4096, lanes 2, 4, 8
-    python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 4, ~10 s
+    python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 2, ~10 s
     python experiments/simd_lanes.py --llvm-ir       # and count vector instructions in the IR
 """
 
@@ -37,22 +43,36 @@ import os
 import sys
 import time
 
+import warnings
+
 import numpy as np
 
 from _common import parse, save
 
+# the stage list of the ck45 step is built with list.append at compile time (on purpose)
+warnings.filterwarnings("ignore", message='.*non-taichi function "ks.append"',
+                        category=SyntaxWarning)
+
 EPS = 1e-12                 # rhs workload: next argument y0 + EPS f(previous)
 RK4_STEP = 2.0 * np.pi / 256
-FULL = dict(members=4096, lanes=(2, 4, 8), seconds=0.5, repeat=5)
-QUICK = dict(members=256, lanes=(4,), seconds=0.02, repeat=2)
+# ck_lanes: lane counts of the adaptive workload (its L = 8 kernel took 195 s to compile and
+# ran 1.08x the scalar one: measured once, left out)
+FULL = dict(members=4096, lanes=(2, 4, 8), ck_lanes=(2, 4), seconds=0.5, repeat=5)
+QUICK = dict(members=256, lanes=(2,), ck_lanes=(2,), seconds=0.02, repeat=2)
 ORDER, ODD = 4, False       # 1991 VH: ellipsoids, no order-3 terms
 #: Largest relative difference of the explicit-lane results from the scalar ones: round-off
 #: of a differently ordered RHS; the rk4 runs (several orbits, chaotic members among them)
 #: amplify it, measured 5e-11 after 912 steps.
-AGREE = {"rhs": 1e-13, "rk4": 1e-8}
+AGREE = {"rhs": 1e-13, "rk4": 1e-8, "ck45": 0.0}
+#: ck45 workload: adaptive Cash-Karp at rtol = atol = CK_TOL to repeats x CK_UNIT (scaled
+#: time), first step CK_H0; its cost is given per member-orbit, not per RHS
+CK_TOL = 1e-12
+CK_UNIT = 2.0 * np.pi / 64
+CK_H0 = 0.01
+WORKLOADS = ("rhs", "rk4", "ck45")
 
 
-def build_kernels(lanes_list):
+def build_kernels(lanes_list, ck_lanes=()):
     """Taichi kernels {(workload, variant, L): kernel(par, y, out, repeats)}."""
     import taichi as ti
 
@@ -204,10 +224,111 @@ def build_kernels(lanes_list):
                         out[k, base + l] = Z[k, l]
         return kernel
 
+    # ---- adaptive Cash-Karp 4(5), max-norm error control (the kernels' scheme, no events) ----
+    from ti_spinorbit.kernels.tableau import CASH_KARP as CK, DEFAULT_CONTROLLER as CTRL
+
+    @ti.func
+    def ck_step(pv, z, h):
+        """One Cash-Karp step: (propagated solution, max-norm error in tolerance units)."""
+        ks = [P.rhs_member(pv, z, ORDER, ODD)]
+        for st in ti.static(range(1, CK.stages)):
+            zs = z
+            for j in ti.static(range(st)):
+                if ti.static(CK.a[st][j] != 0.0):
+                    zs = zs + (CK.a[st][j] * h) * ks[j]
+            ks.append(P.rhs_member(pv, zs, ORDER, ODD))
+        dy = ti.Vector([0.0] * NS, ti.f64)
+        er = ti.Vector([0.0] * NS, ti.f64)
+        for st in ti.static(range(CK.stages)):
+            if ti.static(CK.b[st] != 0.0):
+                dy += CK.b[st] * ks[st]
+            if ti.static(CK.e[st] != 0.0):
+                er += CK.e[st] * ks[st]
+        z_new = z + h * dy
+        worst = 0.0
+        for k in ti.static(range(NS)):
+            scale = CK_TOL + CK_TOL * ti.max(ti.abs(z[k]), ti.abs(z_new[k]))
+            worst = ti.max(worst, ti.abs(h * er[k]) / scale)
+        return z_new, worst
+
+    @ti.func
+    def controlled(t, h, h_try, z, z_new, err, rejected, t_end):
+        """Accept or reject a step (the scipy/NR controller of kernels/tableau.py)."""
+        if err <= 1.0:
+            fac = CTRL.MAX_FACTOR
+            if err > 0.0:
+                fac = ti.min(CTRL.MAX_FACTOR, CTRL.SAFETY * ti.pow(err, -1.0 / CK.order))
+            if rejected:
+                fac = ti.min(1.0, fac)
+            t += h_try
+            z = z_new
+            h = h_try * fac
+            rejected = 0
+        else:
+            h = h_try * ti.max(CTRL.MIN_FACTOR, CTRL.SAFETY * ti.pow(err, -1.0 / CK.order))
+            rejected = 1
+        return t, h, z, rejected
+
+    @ti.kernel
+    def scalar_ck(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+        for i in range(y.shape[0]):
+            pv = P.member(par, i)
+            z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
+            t_end = repeats * CK_UNIT
+            t, h, rejected = 0.0, CK_H0, 0
+            while t < t_end:
+                h_try = ti.min(h, t_end - t)
+                z_new, err = ck_step(pv, z, h_try)
+                t, h, z, rejected = controlled(t, h, h_try, z, z_new, err, rejected, t_end)
+            for k in ti.static(range(NS)):
+                out[i, k] = z[k]
+
+    def unrolled_ck(L):
+        @ti.func
+        def column(M, l: ti.template(), n: ti.template()):
+            return ti.Vector([M[k, l] for k in ti.static(range(n))], ti.f64)
+
+        @ti.kernel
+        def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+            for g in range(y.shape[1] // L):
+                base = g * L
+                PV = ti.Matrix([[par[k, base + l] for l in ti.static(range(L))]
+                                for k in ti.static(range(NP))], ti.f64)
+                Z = ti.Matrix([[y[k, base + l] for l in ti.static(range(L))]
+                               for k in ti.static(range(NS))], ti.f64)
+                t_end = repeats * CK_UNIT
+                T = ti.Vector([0.0] * L, ti.f64)
+                H = ti.Vector([CK_H0] * L, ti.f64)
+                REJ = ti.Vector([0] * L, ti.i32)
+                running = 1
+                while running:
+                    running = 0
+                    # every lane computes a step (a finished lane's is discarded): the lanes
+                    # stay in lock-step, as SIMD lanes would
+                    for l in ti.static(range(L)):
+                        z = column(Z, l, NS)
+                        h_try = ti.min(H[l], t_end - T[l])
+                        z_new, err = ck_step(column(PV, l, NP), z, h_try)
+                        if T[l] < t_end:
+                            t, h, z, rej = controlled(T[l], H[l], h_try, z, z_new, err, REJ[l],
+                                                      t_end)
+                            T[l], H[l], REJ[l] = t, h, rej
+                            for k in ti.static(range(NS)):
+                                Z[k, l] = z[k]
+                        if T[l] < t_end:
+                            running = 1
+                for k in ti.static(range(NS)):
+                    for l in ti.static(range(L)):
+                        out[k, base + l] = Z[k, l]
+        return kernel
+
+    kernels[("ck45", "scalar", 1)] = scalar_ck
     for L in lanes_list:
         for workload in ("rhs", "rk4"):
             kernels[(workload, "unrolled", L)] = unrolled(L, workload)
             kernels[(workload, "lanes", L)] = lanes(L, workload)
+    for L in ck_lanes:
+        kernels[("ck45", "unrolled", L)] = unrolled_ck(L)
     return kernels
 
 
@@ -257,7 +378,9 @@ def measure(kernels, kpar, q, seconds, rounds):
     rows = []
     for key in kernels:
         workload, variant, L = key
-        rhs_calls = n * repeats[key] * (4 if workload == "rk4" else 1)
+        # work units: RHS evaluations (rhs, rk4), member-orbits (ck45)
+        rhs_calls = (n * repeats[key] / 64 if workload == "ck45"
+                     else n * repeats[key] * (4 if workload == "rk4" else 1))
         walls = np.array([t[0] for t in times[key]])
         cpus = np.array([t[1] for t in times[key]])
         out = outputs[key] if variant == "scalar" else outputs[key].T
@@ -281,7 +404,7 @@ def measure(kernels, kpar, q, seconds, rounds):
     return rows
 
 
-def llvm_ir_counts(lanes_list, kpar, q):
+def llvm_ir_counts(lanes_list, ck_lanes, kpar, q):
     """Floating-point instructions in each kernel's optimised LLVM IR, scalar and vector
     (``<k x double>``), by vector width: whether LLVM packed the lanes. Re-initialises Taichi
     (the package's settings, no kernel cache, IR written to a temporary folder)."""
@@ -302,7 +425,7 @@ def llvm_ir_counts(lanes_list, kpar, q):
                     cpu_block_dim_adaptive=False, default_cpu_block_dim=1,
                     print_kernel_llvm_ir_optimized=True)
             seen = set()
-            for key, kernel in build_kernels(lanes_list).items():
+            for key, kernel in build_kernels(lanes_list, ck_lanes).items():
                 par, y = (kpar, q) if key[1] == "scalar" else (np.ascontiguousarray(kpar.T),
                                                                np.ascontiguousarray(q.T))
                 kernel(par, y, np.zeros_like(y), 1)
@@ -324,16 +447,19 @@ def llvm_ir_counts(lanes_list, kpar, q):
 def figure(rows):
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
-    for ax, workload in zip(axes, ("rhs", "rk4")):
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    for ax, workload in zip(axes, WORKLOADS):
         group = [r for r in rows if r["workload"] == workload]
         labels = [r["variant"] if r["variant"] == "scalar" else f"{r['variant']} {r['lanes']}"
                   for r in group]
         x = np.arange(len(group))
-        ax.bar(x - 0.2, [r["ns_per_rhs_cpu_median"] for r in group], 0.4, label="per core (CPU time)")
-        ax.bar(x + 0.2, [r["ns_per_rhs_wall_median"] for r in group], 0.4, label="wall")
+        unit = 1e-3 if workload == "ck45" else 1.0          # ck45: microseconds per orbit
+        ax.bar(x - 0.2, [unit * r["ns_per_rhs_cpu_median"] for r in group], 0.4,
+               label="per core (CPU time)")
+        ax.bar(x + 0.2, [unit * r["ns_per_rhs_wall_median"] for r in group], 0.4, label="wall")
         ax.set_xticks(x, labels, rotation=30, fontsize=8)
-        ax.set_ylabel("ns per RHS evaluation (median)")
+        ax.set_ylabel("us per member-orbit (median)" if workload == "ck45"
+                      else "ns per RHS evaluation (median)")
         ax.set_title(f"planar RHS, 1991 VH a/b = 1.5: workload {workload}", fontsize=9)
         ax.legend(fontsize=7)
     return fig
@@ -352,7 +478,7 @@ def main():
     rounds = args.repeat or s["repeat"]
     kpar, q = member_inputs(s["members"])
     t0 = time.perf_counter()
-    kernels = build_kernels(s["lanes"])
+    kernels = build_kernels(s["lanes"], s["ck_lanes"])
     rows = measure(kernels, kpar, q, s["seconds"], rounds)
     load = os.getloadavg()[0]
     import bench_throughput as bt                           # on the path after member_inputs
@@ -361,7 +487,8 @@ def main():
     print(f"[simd_lanes] CPU {cpu_model} ({', '.join(simd) or 'no AVX2'}), "
           f"{os.cpu_count()} CPUs")
     print(f"[simd_lanes] N = {s['members']}, {rounds} interleaved rounds, load average "
-          f"{load:.2f}; ns per RHS (median), per core = process CPU time / evaluations")
+          f"{load:.2f}; ns per RHS (ck45: per member-orbit), median, per core = process "
+          "CPU time / work")
     print(f"{'workload':>8} {'variant':>9} {'L':>2} {'CPU ns':>7} {'best':>7} {'wall ns':>8} "
           f"{'speed-up':>8} {'(wall)':>7} {'max rel diff':>12} {'compile s':>9}")
     for r in rows:
@@ -377,19 +504,19 @@ def main():
         raise SystemExit(f"[simd_lanes] results differ from the scalar layout: {bad}")
     ir = {}
     if args.llvm_ir:
-        ir = llvm_ir_counts(s["lanes"], kpar[:64], q[:64])
+        ir = llvm_ir_counts(s["lanes"], s["ck_lanes"], kpar[:64], q[:64])
         print("[simd_lanes] optimised LLVM IR, f64 fadd/fsub/fmul/fdiv: scalar, vector "
               "(<k x double>), occurrences of each vector width")
         for (workload, variant, L), c in ir.items():
             print(f"  {workload:>4} {variant:>9} {L:2d}: scalar {c['scalar_ops']:5d}  vector "
                   f"{c['vector_ops']:5d}  widths {c['widths']}")
     best = {w: max((r for r in rows if r["workload"] == w), key=lambda r: r["speedup_cpu"])
-            for w in ("rhs", "rk4")}
+            for w in WORKLOADS}
     numbers = {f"{w} speed-up per core, best ({b['variant']} {b['lanes']})": b["speedup_cpu"]
                for w, b in best.items()}
-    numbers.update({f"{w} scalar ns per RHS per core": next(
+    numbers.update({f"{w} scalar ns per {'member-orbit' if w == 'ck45' else 'RHS'} per core": next(
         r["ns_per_rhs_cpu_median"] for r in rows if (r["workload"], r["variant"]) == (w, "scalar"))
-        for w in ("rhs", "rk4")})
+        for w in WORKLOADS})
     keys = ("workload", "variant", "lanes", "ns_per_rhs_cpu_median", "ns_per_rhs_wall_median",
             "speedup_cpu", "max_rel_diff_vs_scalar")
     save(args, "simd_lanes", figure(rows), {k: [r[k] for r in rows] for k in keys},
