@@ -68,3 +68,21 @@ def test_benchmark_skips_a_method_the_package_refuses(members):
     why = bt.method_unavailable("no-such-method")
     assert isinstance(why, str) and "\n" not in why
     assert "no method= keyword" in why or "no-such-method" in why
+
+
+@pytest.mark.parametrize("method,passed", [("cash-karp", {}), ("dop853", {"method": "dop853"})])
+def test_benchmark_passes_method_only_when_not_the_default(monkeypatch, members, method, passed):
+    """``method=`` reaches Ensemble only for a non-default method, so the benchmark runs on a
+    package with and without the keyword."""
+    import ti_spinorbit.ensemble as E
+
+    seen = []
+
+    class Recorder:
+        def __init__(self, par, y0, **kwargs):
+            seen.append(kwargs)
+
+    monkeypatch.setattr(E, "Ensemble", Recorder)
+    par, y0 = members
+    bt.make_ensemble(par, y0, "planar", 1e-12, method)
+    assert seen == [dict(rtol=1e-12, model="planar", **passed)]
