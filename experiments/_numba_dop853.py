@@ -152,8 +152,6 @@ def integrate(p, y0, t_end, rtol, atol):
     y = y0.copy()
     y_new = np.empty(n)
     work = np.empty(n)
-    err5 = np.empty(n)
-    err3 = np.empty(n)
     rhs(p, y, K[0])
     nfev = 1
     h = _initial_step(p, y, K[0], rtol, atol, work, K[1])

@@ -1,7 +1,8 @@
 """Benchmark: where the ensemble integrator's time goes on 1991 VH (a/b = 1.5), and how it scales.
 
 Issue 5, item 1 ("measure first"); issue 13 §1 (methods as an axis, a compiled DOP853
-baseline in the same run, accuracy at equal rtol, the issue-13 targets with their ratios). Every run is deterministic: member k starts at
+baseline in the same run, accuracy at equal rtol, the issue-13 targets with their ratios).
+Every run is deterministic: member k starts at
 θ_p = 180° frac(½ + k/g), θ̇_p/n = 0.5 + 2 frac(½ + k/g²) with g the plastic number (an
 R2 low-discrepancy sequence over θ_p ∈ [0, 180), θ̇_p/n ∈ [0.5, 2.5]), so the first N
 members of a larger table are the N-member table and every N samples the same mix of regular
@@ -10,9 +11,9 @@ distance 1000 a so no member stops early). Sections (``--sections``, default all
 
 throughput
     member-orbits per second for N × rtol × model × method (``--members``, ``--rtols``,
-    ``--models``, ``--methods``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10, 1e-12, 1e-15, models
-    planar and 3d) on the arch of ``--arch`` (cpu by default; ``--arch cuda --members ...
-    65536`` for a GPU). The orbits of each point are chosen so that it takes about
+    ``--models``, ``--methods``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10,
+    1e-12, 1e-15, models planar and 3d, methods cash-karp and dop853) on the arch of
+    ``--arch`` (cpu by default; ``--arch cuda --members ... 65536`` for a GPU). The orbits of each point are chosen so that it takes about
     ``--seconds`` (default 2 s): a short pilot run measures the rate, then the timed run
     integrates ``seconds × rate / N`` orbits (rounded up to two significant figures, at
     least one orbit). The time is ``RunOutput.seconds`` (the window loop: kernel launches
@@ -338,7 +339,8 @@ def run_point(par, y0, model, rtol, orbits, window=16, method=DEFAULT_METHOD):
     accepted, rejected, calls = out.counters.sum(axis=0)
     calls -= n                                   # the first-stage evaluation before the loop
     return {"model": model, "method": method, "rtol": rtol, "members": n, "orbits": orbits,
-            "window_orbits": window, "seconds": out.seconds, "loop_wall_s": loop_wall, "loop_cpu_s": loop_cpu,
+            "window_orbits": window, "seconds": out.seconds, "loop_wall_s": loop_wall,
+            "loop_cpu_s": loop_cpu,
             "kernel_wall_s": timer.kernel_wall, "kernel_cpu_s": timer.kernel_cpu,
             "launches": timer.launches, "member_orbits": member_orbits,
             "member_orbits_per_s": member_orbits / out.seconds,

@@ -521,8 +521,8 @@ def main():
             "speedup_cpu", "max_rel_diff_vs_scalar")
     save(args, "simd_lanes", figure(rows), {k: [r[k] for r in rows] for k in keys},
          {**s, "rounds": rounds, "rows": rows,
-          "llvm_ir": {" ".join(map(str, k)): v for k, v in ir.items()}, "load_average": load, "cpu": cpu_model,
-          "simd": simd,
+          "llvm_ir": {" ".join(map(str, k)): v for k, v in ir.items()}, "load_average": load,
+          "cpu": cpu_model, "simd": simd,
           "build_and_time_s": time.perf_counter() - t0}, numbers, started)
 
 
