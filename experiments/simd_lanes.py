@@ -29,8 +29,8 @@ per core (CPU time / evaluations, the figure to compare under load) and per wall
 the speed-up is the scalar layout's median CPU time over the variant's.
 
 A third workload, ``ck45``, is the kernels' adaptive scheme without events: Cash-Karp 4(5)
-(``kernels/tableau.py``), max-norm error control at rtol = atol = 1e-12, the same
-controller, each member to its own end time (cost per member-orbit). Its lane variant keeps
+(``kernels/tableau.py``), max-norm error control at rtol = atol = 1e-12, the kernels'
+controller constants, each member to its own end time (cost per member-orbit). Its lane variant keeps
 the L members of a group in lock-step (every lane computes a step each round, a finished
 lane's is discarded, as SIMD lanes would) and must equal the scalar results bit for bit.
 
@@ -69,6 +69,9 @@ AGREE = {"rhs": 1e-13, "rk4": 1e-8, "ck45": 0.0}
 CK_TOL = 1e-12
 CK_UNIT = 2.0 * np.pi / 64
 CK_H0 = 0.01
+#: step-size controller of the ensemble kernels (scipy naming, NR §16.2): factor
+#: clip(SAFETY err^(-1/5), MIN_FACTOR, MAX_FACTOR), no growth right after a rejection
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 5.0
 WORKLOADS = ("rhs", "rk4", "ck45")
 
 
@@ -225,7 +228,7 @@ def build_kernels(lanes_list, ck_lanes=()):
         return kernel
 
     # ---- adaptive Cash-Karp 4(5), max-norm error control (the kernels' scheme, no events) ----
-    from ti_spinorbit.kernels.tableau import CASH_KARP as CK, DEFAULT_CONTROLLER as CTRL
+    from ti_spinorbit.kernels.tableau import CASH_KARP as CK
 
     @ti.func
     def ck_step(pv, z, h):
@@ -253,11 +256,11 @@ def build_kernels(lanes_list, ck_lanes=()):
 
     @ti.func
     def controlled(t, h, h_try, z, z_new, err, rejected, t_end):
-        """Accept or reject a step (the scipy/NR controller of kernels/tableau.py)."""
+        """Accept or reject a step (the kernels' controller constants, above)."""
         if err <= 1.0:
-            fac = CTRL.MAX_FACTOR
+            fac = MAX_FACTOR
             if err > 0.0:
-                fac = ti.min(CTRL.MAX_FACTOR, CTRL.SAFETY * ti.pow(err, -1.0 / CK.order))
+                fac = ti.min(MAX_FACTOR, SAFETY * ti.pow(err, -1.0 / CK.order))
             if rejected:
                 fac = ti.min(1.0, fac)
             t += h_try
@@ -265,7 +268,7 @@ def build_kernels(lanes_list, ck_lanes=()):
             h = h_try * fac
             rejected = 0
         else:
-            h = h_try * ti.max(CTRL.MIN_FACTOR, CTRL.SAFETY * ti.pow(err, -1.0 / CK.order))
+            h = h_try * ti.max(MIN_FACTOR, SAFETY * ti.pow(err, -1.0 / CK.order))
             rejected = 1
         return t, h, z, rejected
 
