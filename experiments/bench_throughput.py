@@ -13,11 +13,11 @@ throughput
     member-orbits per second for N × rtol × model × method (``--members``, ``--rtols``,
     ``--models``, ``--methods``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10,
     1e-12, 1e-15, models planar and 3d, methods cash-karp and dop853) on the arch of
-    ``--arch`` (cpu by default; ``--arch cuda --members ... 65536`` for a GPU). The orbits of each point are chosen so that it takes about
-    ``--seconds`` (default 2 s): a short pilot run measures the rate, then the timed run
-    integrates ``seconds × rate / N`` orbits (rounded up to two significant figures, at
-    least one orbit). The time is ``RunOutput.seconds`` (the window loop: kernel launches
-    and draining); accepted and rejected steps and RHS calls are per member-orbit.
+    ``--arch`` (cpu by default; ``--arch cuda --members ... 65536`` for a GPU). The
+    orbits of each point are chosen so that it takes about ``--seconds`` (default 2 s): a
+    short pilot run measures the rate, then the timed run integrates ``seconds × rate / N``
+    orbits (rounded up to two significant figures, at least one orbit). The time is
+    ``RunOutput.seconds`` (the window loop: kernel launches and draining); accepted and rejected steps and RHS calls are per member-orbit.
     Per-core CPU-time throughput (member-orbits per process CPU-second) is printed beside
     the wall-clock rate: it is what to compare on a loaded machine.
 split

@@ -30,9 +30,10 @@ the speed-up is the scalar layout's median CPU time over the variant's.
 
 A third workload, ``ck45``, is the kernels' adaptive scheme without events: Cash-Karp 4(5)
 (``kernels/tableau.py``), max-norm error control at rtol = atol = 1e-12, the kernels'
-controller constants, each member to its own end time (cost per member-orbit). Its lane variant keeps
-the L members of a group in lock-step (every lane computes a step each round, a finished
-lane's is discarded, as SIMD lanes would) and must equal the scalar results bit for bit.
+controller constants, each member to its own end time (cost per member-orbit). Its lane
+variant keeps the L members of a group in lock-step (every lane computes a step each round, a
+finished lane's is discarded, as SIMD lanes would) and must equal the scalar results bit for
+bit.
 
     python experiments/simd_lanes.py                 # N = 4096, lanes 2, 4, 8
     python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 2, ~10 s
