@@ -17,7 +17,8 @@ throughput
     orbits of each point are chosen so that it takes about ``--seconds`` (default 2 s): a
     short pilot run measures the rate, then the timed run integrates ``seconds × rate / N``
     orbits (rounded up to two significant figures, at least one orbit). The time is
-    ``RunOutput.seconds`` (the window loop: kernel launches and draining); accepted and rejected steps and RHS calls are per member-orbit.
+    ``RunOutput.seconds`` (the window loop: kernel launches and draining); accepted and
+    rejected steps and RHS calls are per member-orbit.
     Per-core CPU-time throughput (member-orbits per process CPU-second) is printed beside
     the wall-clock rate: it is what to compare on a loaded machine.
 split
