@@ -73,7 +73,9 @@ numba
     atol = rtol, on the first 64 members (quick: 4) one after the other on ONE core: orbits
     per CPU-second is its rate per core. Checked in the same run: its RHS against the
     package's planar RHS on 256 random states (relative difference, round-off), and its
-    final states against the kernels at rtol 1e-14 over ``accuracy_orbits``.
+    final states against the kernels at rtol 1e-14 over ``accuracy_orbits``. With the
+    accuracy section it is also timed at 1e-11, 1e-13 and 1e-14 (quick: 1e-13): its rate
+    against its error, for the equal-accuracy comparison.
 accuracy
     final-state error at equal rtol: each (model, method, rtol) of the run and the numba
     baseline on the first 32 members (quick: 4) over 4 orbits (quick: 0.5), against a tight
@@ -81,7 +83,11 @@ accuracy
     error = max |Δy| over the scaled 3-D state (planar states through ``to_spatial``, so
     both models meet the same reference), median and max over members. One line per model
     and rtol gives every method's median error and its ratio to Cash-Karp's, so that a
-    faster method is not bought with accuracy.
+    faster method is not bought with accuracy. Then, informational (not an issue-13
+    target), "equal accuracy": each planar method's per-core rate over the numba baseline's
+    rate at the SAME median error (log-log interpolation between the baseline's measured
+    tolerances): the kernels' max-norm error control is more accurate at a given rtol than
+    the baseline's RMS norm, so equal rtol is not equal work.
 latency
     first result from a fresh process: ``sys.executable -c`` imports ti_spinorbit and
     computes a 1-member, 1-orbit section; with a new, empty offline kernel cache (cold:
@@ -200,11 +206,12 @@ FLOPS_PER_RHS = {"planar": 141, "3d": 835}
 FULL = dict(sizes=(1, 16, 256, 1024, 4096, 16384), seconds=2.0, min_orbits=1.0,
             split_members=4096, rhs_seconds=1.0, window_orbits=2.0 * max(WINDOWS),
             baseline_members=2, baseline_orbits=2.0, cold_latency=True,
-            numba_members=64, accuracy_members=32, accuracy_orbits=4.0)
+            numba_members=64, accuracy_members=32, accuracy_orbits=4.0,
+            numba_curve=(1e-11, 1e-13, 1e-14))
 QUICK = dict(sizes=(1, 16), seconds=0.05, min_orbits=0.1,
              split_members=16, rhs_seconds=0.05, window_orbits=2.0 * max(WINDOWS),
              baseline_members=1, baseline_orbits=0.5, cold_latency=False,
-             numba_members=4, accuracy_members=4, accuracy_orbits=0.5)
+             numba_members=4, accuracy_members=4, accuracy_orbits=0.5, numba_curve=(1e-13,))
 FIRST_RATE_GUESS = 1000.0         # member-orbits/s, for sizing the very first pilot run
 PILOT_FRACTION = 0.125            # pilot run length, fraction of --seconds
 MIN_PILOT_ORBITS = 0.05
@@ -709,8 +716,10 @@ def numba_run(nb, kpar, q0, orbits, rtol):
     return y, counters, time.perf_counter() - wall, time.thread_time() - cpu
 
 
-def bench_numba(points, rtols, members, seconds, repeat, check_orbits):
-    """numba DOP853, planar, one member at a time on one core; orbits per CPU-second."""
+def bench_numba(points, rtols, members, seconds, repeat, check_orbits, curve=()):
+    """numba DOP853, planar, one member at a time on one core; orbits per CPU-second at
+    ``rtols`` and, marked ``curve``, at the extra tolerances ``curve`` (the rate-against-
+    error curve of the equal-accuracy comparison)."""
     from ti_spinorbit import planar
 
     nb = numba_baseline()
@@ -732,7 +741,7 @@ def bench_numba(points, rtols, members, seconds, repeat, check_orbits):
           f"{rhs_mismatch:.1e}; final states vs kernels (rtol {tight:g}, {check_orbits:g} "
           f"orbits) max |dy| {trajectory_mismatch:.1e}", flush=True)
     rows = []
-    for rtol in rtols:
+    for rtol in sorted(set(rtols) | set(curve), reverse=True):
         _, c, _, cpu = numba_run(nb, kpar, q0, 1.0, rtol)    # pilot: one orbit each
         rate = members / max(cpu, 1e-6)
         orbits = max(points.settings["min_orbits"], nice_ceil(seconds * rate / members))
@@ -741,6 +750,7 @@ def bench_numba(points, rtols, members, seconds, repeat, check_orbits):
         mo = members * orbits
         accepted, rejected, calls = counters.sum(axis=0)
         rows.append({"method": "numba DOP853", "model": "planar", "rtol": rtol,
+                     "curve": rtol not in rtols,
                      "members": members, "orbits": orbits, "threads": 1, "wall_s": wall,
                      "cpu_s": cpu, "orbits_per_s": mo / wall, "orbits_per_cpu_s": mo / cpu,
                      "accepted_per_orbit": accepted / mo, "rejected_per_orbit": rejected / mo,
@@ -754,7 +764,7 @@ def bench_numba(points, rtols, members, seconds, repeat, check_orbits):
     return rows
 
 
-def bench_accuracy(models, methods, rtols, members, orbits):
+def bench_accuracy(models, methods, rtols, members, orbits, numba_rtols=()):
     """Final-state error of every (model, method, rtol) and of the numba baseline against a
     tight reference: numba DOP853 at ACCURACY_REFERENCE_RTOL (else the kernels' Cash-Karp at
     that rtol). Error of a member: max over the 30 scaled 3-D state components (the planar
@@ -784,7 +794,8 @@ def bench_accuracy(models, methods, rtols, members, orbits):
         for model in models:
             for method in methods:
                 add(model, method, rtol, make_ensemble(par, y0, model, rtol, method).run(t_end).y)
-        if nb is not None:
+    if nb is not None:
+        for rtol in sorted(set(rtols) | set(numba_rtols), reverse=True):
             add("planar", "numba DOP853", rtol, planar.to_spatial(numba_run(nb, kpar, q0, orbits,
                                                                           rtol)[0]))
     print(f"  accuracy: {len(rows)} runs against {reference_name}", flush=True)
@@ -827,7 +838,7 @@ def targets13(points, numba_rows, accuracy_rows, models, methods, n, cores, cpu)
             add(f">= {TARGET13_PLANAR:.0f} member-orbits/s on {cores} cores, planar, fastest "
                 f"method ({method}), N = {n}, rtol 1e-12", row["member_orbits_per_s"],
                 TARGET13_PLANAR)
-        for b in numba_rows:
+        for b in (b for b in numba_rows if not b.get("curve")):
             key = "member_orbits_per_cpu_s" if cpu else "member_orbits_per_s"
             method, row = fastest(points, "planar", b["rtol"], n, methods, key)
             if row:
@@ -860,6 +871,41 @@ def targets13(points, numba_rows, accuracy_rows, models, methods, n, cores, cpu)
                                   f"Cash-Karp's, {a['model']}, rtol {a['rtol']:.0e} (median "
                                   f"{a['median_error']:.2e} vs {ck[0]['median_error']:.2e})",
                         "value": ratio, "met": ratio <= 1.0})
+    return out
+
+
+def equal_accuracy(points, numba_rows, accuracy_rows, methods, n, cpu):
+    """Informational (not an issue-13 target): each planar method at each baseline rtol
+    against the numba baseline at the SAME median final-state error, its rate read off the
+    baseline's rate-against-error curve (log-log interpolation between the measured
+    tolerances; None outside the curve)."""
+    def error(method, rtol):
+        rows = [a for a in accuracy_rows
+                if (a["model"], a["method"], a["rtol"]) == ("planar", method, rtol)]
+        return rows[0]["median_error"] if rows else None
+
+    curve = sorted((error(b["method"], b["rtol"]), b["orbits_per_cpu_s"], b["rtol"])
+                   for b in numba_rows if error(b["method"], b["rtol"]))
+    out = []
+    if len(curve) < 2:
+        return out
+    log_err = np.log([c[0] for c in curve])
+    key = "member_orbits_per_cpu_s" if cpu else "member_orbits_per_s"
+    for b in (b for b in numba_rows if not b.get("curve")):
+        for method in methods:
+            row, err = points.measured("planar", b["rtol"], n, method), error(method, b["rtol"])
+            if not row or not err:
+                continue
+            inside = log_err[0] <= np.log(err) <= log_err[-1]
+            rate = float(np.exp(np.interp(np.log(err), log_err, np.log([c[1] for c in curve])))) \
+                if inside else None
+            numba_rtol = float(np.exp(np.interp(np.log(err), log_err,
+                                                np.log([c[2] for c in curve])))) \
+                if inside else None
+            out.append({"method": method, "rtol": b["rtol"], "members": n, "median_error": err,
+                        "rate": row[key], "numba_rate_at_equal_error": rate,
+                        "numba_rtol_at_equal_error": numba_rtol,
+                        "ratio": row[key] / rate if rate else None})
     return out
 
 
@@ -1036,6 +1082,22 @@ def print_report(result):
             where = "new cache folder" if f["new_cache_folder"] else "default cache folder"
             print(f"  {f['run']:<10} ({where}): wall {f['wall_s']:6.2f} s  (import "
                   f"{f['import_s']:.2f} s, in process {f['in_process_s']:.2f} s)")
+    if s.get("equal_accuracy"):
+        print("\n[equal accuracy] informational: each method against the numba baseline at the "
+              "same median final-state error (its rate interpolated between the measured "
+              "tolerances); " + ("per core" if s["equal_accuracy"][0]["rate"] is not None
+                                 and result["machine"]["arch"] in ("cpu", "x64", "arm64")
+                                 else "wall rate against one core"))
+        for e in s["equal_accuracy"]:
+            if e["ratio"] is None:
+                print(f"  planar {e['method']}, rtol {e['rtol']:.0e}: error "
+                      f"{e['median_error']:.2e} outside the baseline's measured curve")
+            else:
+                print(f"  planar {e['method']}, rtol {e['rtol']:.0e}: error "
+                      f"{e['median_error']:.2e}, {e['rate']:.0f} member-orbits/CPU-s; numba "
+                      f"DOP853 at that error (rtol ~{e['numba_rtol_at_equal_error']:.1e}) "
+                      f"{e['numba_rate_at_equal_error']:.0f} orbits/CPU-s: ratio "
+                      f"{e['ratio']:.2f}")
     if result.get("skipped_methods"):
         print()
         for method, why in result["skipped_methods"].items():
@@ -1054,6 +1116,8 @@ def print_accuracy_lines(rows):
         for rtol in dict.fromkeys(r["rtol"] for r in rows):
             group = [r for r in rows if (r["model"], r["rtol"]) == (model, rtol)]
             ck = [r["median_error"] for r in group if r["method"] == DEFAULT_METHOD]
+            if not ck:
+                continue                       # a tolerance of the baseline's curve only
             parts = []
             for r in group:
                 ratio = f" ({r['median_error'] / ck[0]:.2g}x Cash-Karp)" if ck and ck[0] > 0 \
@@ -1173,12 +1237,16 @@ def main():
         s["baseline"] = bench_baseline(settings["baseline_members"], settings["baseline_orbits"],
                                        args.rtols)
     if "numba" in sections:
+        curve = settings["numba_curve"] if "accuracy" in sections else ()
         s["numba"] = bench_numba(points, [r for r in args.rtols if r in NUMBA_RTOLS] or args.rtols,
                                  settings["numba_members"], settings["seconds"], args.repeat,
-                                 settings["accuracy_orbits"])
+                                 settings["accuracy_orbits"], curve)
     if "accuracy" in sections:
         s["accuracy"] = bench_accuracy(args.models, methods, args.rtols,
-                                       settings["accuracy_members"], settings["accuracy_orbits"])
+                                       settings["accuracy_members"], settings["accuracy_orbits"],
+                                       [b["rtol"] for b in s.get("numba", [])])
+        s["equal_accuracy"] = equal_accuracy(points, s.get("numba", []), s["accuracy"], methods,
+                                             n_split, cpu)
     if "latency" in sections:
         s["latency"] = bench_first_result(args.arch, args.repeat, settings["cold_latency"])
     parameters = {"system": SYSTEM, "elongation": ELONGATION, "theta_p_range": THETA_P_RANGE,
