@@ -1,6 +1,8 @@
 """Benchmark: where the ensemble integrator's time goes on 1991 VH (a/b = 1.5), and how it scales.
 
-Issue 5, item 1 ("measure first"). Every run is deterministic: member k starts at
+Issue 5, item 1 ("measure first"); issue 13 §1 (methods as an axis, a compiled DOP853
+baseline in the same run, accuracy at equal rtol, the issue-13 targets with their ratios).
+Every run is deterministic: member k starts at
 θ_p = 180° frac(½ + k/g), θ̇_p/n = 0.5 + 2 frac(½ + k/g²) with g the plastic number (an
 R2 low-discrepancy sequence over θ_p ∈ [0, 180), θ̇_p/n ∈ [0.5, 2.5]), so the first N
 members of a larger table are the N-member table and every N samples the same mix of regular
@@ -8,14 +10,15 @@ and chaotic starts. Integration uses ``Ensemble`` directly (order 4, atol = rtol
 distance 1000 a so no member stops early). Sections (``--sections``, default all):
 
 throughput
-    member-orbits per second for N × rtol × model (``--members``, ``--rtols``,
-    ``--models``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10, 1e-12, 1e-15, models
-    planar and 3d) on the arch of ``--arch`` (cpu by default; ``--arch cuda --members ...
-    65536`` for a GPU). The orbits of each point are chosen so that it takes about
-    ``--seconds`` (default 2 s): a short pilot run measures the rate, then the timed run
-    integrates ``seconds × rate / N`` orbits (rounded up to two significant figures, at
-    least one orbit). The time is ``RunOutput.seconds`` (the window loop: kernel launches
-    and draining); accepted and rejected steps and RHS calls are per member-orbit.
+    member-orbits per second for N × rtol × model × method (``--members``, ``--rtols``,
+    ``--models``, ``--methods``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10,
+    1e-12, 1e-15, models planar and 3d, methods cash-karp and dop853) on the arch of
+    ``--arch`` (cpu by default; ``--arch cuda --members ... 65536`` for a GPU). The
+    orbits of each point are chosen so that it takes about ``--seconds`` (default 2 s): a
+    short pilot run measures the rate, then the timed run integrates ``seconds × rate / N``
+    orbits (rounded up to two significant figures, at least one orbit). The time is
+    ``RunOutput.seconds`` (the window loop: kernel launches and draining); accepted and
+    rejected steps and RHS calls are per member-orbit.
     Per-core CPU-time throughput (member-orbits per process CPU-second) is printed beside
     the wall-clock rate: it is what to compare on a loaded machine.
 split
@@ -63,6 +66,28 @@ baseline
     again in the baseline's favour. One-off costs (importing scipy.integrate, the
     reference's cached multipole bases) are paid before timing. The speed-up printed is the
     kernel rate at the split N over the baseline rate, per model and rtol.
+numba
+    a compiled single-trajectory DOP853 integrator of the planar model written for this
+    benchmark with numba (experiments/_numba_dop853.py: its own RHS, Hairer's error norm and
+    controller; the ``bench`` extra), at rtol 1e-12 and 1e-15 (those of ``--rtols``),
+    atol = rtol, on the first 64 members (quick: 4) one after the other on ONE core: orbits
+    per CPU-second is its rate per core. Checked in the same run: its RHS against the
+    package's planar RHS on 256 random states (relative difference, round-off), and its
+    final states against the kernels at rtol 1e-14 over ``accuracy_orbits``. With the
+    accuracy section it is also timed at 1e-11, 1e-13 and 1e-14 (quick: 1e-13): its rate
+    against its error, for the equal-accuracy comparison.
+accuracy
+    final-state error at equal rtol: each (model, method, rtol) of the run and the numba
+    baseline on the first 32 members (quick: 4) over 4 orbits (quick: 0.5), against a tight
+    reference, numba DOP853 at rtol 1e-16 (the kernels' Cash-Karp at 1e-16 without numba);
+    error = max |Δy| over the scaled 3-D state (planar states through ``to_spatial``, so
+    both models meet the same reference), median and max over members. One line per model
+    and rtol gives every method's median error and its ratio to Cash-Karp's, so that a
+    faster method is not bought with accuracy. Then, informational (not an issue-13
+    target), "equal accuracy": each planar method's per-core rate over the numba baseline's
+    rate at the SAME median error (log-log interpolation between the baseline's measured
+    tolerances): the kernels' max-norm error control is more accurate at a given rtol than
+    the baseline's RMS norm, so equal rtol is not equal work.
 latency
     first result from a fresh process: ``sys.executable -c`` imports ti_spinorbit and
     computes a 1-member, 1-orbit section; with a new, empty offline kernel cache (cold:
@@ -74,6 +99,19 @@ over 0.5 orbit, no cold-cache run: every section in about 12 s (CI, not figures)
 ``--repeat k`` times every run k times and keeps the best (do that on a shared machine; the
 load average at start and end is recorded, and other processes' load lowers every
 wall-clock figure).
+
+Methods: ``--methods cash-karp dop853 ...`` (``Ensemble(method=...)``; the default
+"cash-karp" is never passed by keyword, so the script runs on a package without the keyword;
+a method ``Ensemble`` does not accept yet is skipped with a one-line note). The split, flops,
+threads and window sections use Cash-Karp.
+
+Issue-13 targets (planar unless said, 1991 VH a/b = 1.5, N = the split N, "fastest" = the
+fastest method measured): >= 60 000 member-orbits/s on 2 cores at rtol 1e-12; >= 2x per core
+the numba DOP853 baseline (ensemble member-orbits per CPU-second over the baseline's orbits
+per CPU-second; on a GPU the wall rate against one CPU core); at 1e-15 >= 4x the Cash-Karp
+rate of the same run; 3-D >= 15 000 at 1e-12; and the accuracy at equal rtol of each method
+no worse than Cash-Karp's (median error ratio <= 1). Each prints MET/MISS, its value and
+value/target.
 
 Targets (2-core machine): issue 5, >= 20 000 member-orbits/s for the planar model and
 >= 2 000 for the 3-D model at N = 4096, rtol 1e-12 (issue 2 asked >= 1 000); >= 300x the
@@ -92,6 +130,7 @@ the settings), ``bench_throughput.png`` (throughput against N; time split) and
 
 import datetime
 import importlib
+import inspect
 import json
 import math
 import os
@@ -115,8 +154,19 @@ PLASTIC = 1.32471795724474602596  # g of the R2 sequence (g³ = g + 1)
 RTOLS = (1e-10, 1e-12, 1e-15)
 MODELS = ("planar", "3d")
 WINDOWS = (4, 16, 64)
-SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "latency")
+SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "numba",
+            "accuracy", "latency")
+#: Integration methods (``Ensemble(method=...)``); the default one is never passed by keyword.
+DEFAULT_METHOD = "cash-karp"
+METHODS = ("cash-karp", "dop853")
 TARGET_RATE = {"planar": 20000.0, "3d": 2000.0}   # member-orbits/s, N = 4096, rtol 1e-12
+# issue 13 §1 (planar, 1991 VH a/b = 1.5, N >= 1024; "fastest" = the fastest method measured)
+TARGET13_PLANAR = 60000.0         # member-orbits/s on 2 cores, rtol 1e-12
+TARGET13_3D = 15000.0             # member-orbits/s, 3-D, rtol 1e-12
+TARGET13_PER_CORE = 2.0           # x the numba DOP853 baseline, per core, same run
+TARGET13_TIGHT = 4.0              # x today's Cash-Karp rate at rtol 1e-15
+NUMBA_RTOLS = (1e-12, 1e-15)      # the baseline's tolerances (issue 13 §1)
+ACCURACY_REFERENCE_RTOL = 1e-16   # numba DOP853, the tight reference of the accuracy section
 TARGET_SPEEDUP = 300.0            # over the scipy baseline
 TARGET_FIRST_RESULT_S = 3.0       # fresh process, warm offline cache
 SCIPY_MIN_RTOL = 100 * np.finfo(float).eps   # scipy's RK solvers raise smaller rtol to this
@@ -155,10 +205,13 @@ FLOPS_PER_RHS = {"planar": 141, "3d": 835}
 
 FULL = dict(sizes=(1, 16, 256, 1024, 4096, 16384), seconds=2.0, min_orbits=1.0,
             split_members=4096, rhs_seconds=1.0, window_orbits=2.0 * max(WINDOWS),
-            baseline_members=2, baseline_orbits=2.0, cold_latency=True)
+            baseline_members=2, baseline_orbits=2.0, cold_latency=True,
+            numba_members=64, accuracy_members=32, accuracy_orbits=4.0,
+            numba_curve=(1e-11, 1e-13, 1e-14))
 QUICK = dict(sizes=(1, 16), seconds=0.05, min_orbits=0.1,
              split_members=16, rhs_seconds=0.05, window_orbits=2.0 * max(WINDOWS),
-             baseline_members=1, baseline_orbits=0.5, cold_latency=False)
+             baseline_members=1, baseline_orbits=0.5, cold_latency=False,
+             numba_members=4, accuracy_members=4, accuracy_orbits=0.5, numba_curve=(1e-13,))
 FIRST_RATE_GUESS = 1000.0         # member-orbits/s, for sizing the very first pilot run
 PILOT_FRACTION = 0.125            # pilot run length, fraction of --seconds
 MIN_PILOT_ORBITS = 0.05
@@ -252,12 +305,38 @@ class AdvanceTimer:
         self.last = (time.perf_counter(), time.process_time())
 
 
-def run_point(par, y0, model, rtol, orbits, window=16):
-    """Integrate the members (par, y0) for ``orbits`` with ``model``; one result row."""
+def make_ensemble(par, y0, model, rtol, method=DEFAULT_METHOD):
+    """``Ensemble`` of the members with ``model`` and ``method``; ``method=`` is passed only
+    when it is not the default, so the script runs on a package without the keyword."""
     from ti_spinorbit.ensemble import Ensemble
+
+    extra = {} if method == DEFAULT_METHOD else {"method": method}
+    return Ensemble(par, y0, rtol=rtol, model=model, **extra)
+
+
+def method_unavailable(method):
+    """None if ``Ensemble`` runs ``method``, else a one-line reason (the keyword or the
+    value not accepted yet): such a method is skipped, not an error."""
+    from ti_spinorbit.ensemble import Ensemble
+
+    if method == DEFAULT_METHOD:
+        return None
+    if "method" not in inspect.signature(Ensemble).parameters:
+        return "Ensemble() has no method= keyword yet"
+    par, y0 = member_table(1)
+    try:
+        make_ensemble(par, y0, "planar", 1e-12, method)
+    except (TypeError, ValueError) as exc:
+        return f"Ensemble(method={method!r}) refused: {str(exc).splitlines()[0]}"
+    return None
+
+
+def run_point(par, y0, model, rtol, orbits, window=16, method=DEFAULT_METHOD):
+    """Integrate the members (par, y0) for ``orbits`` with ``model`` and ``method``; one
+    result row."""
     from ti_spinorbit.kernels.ensemble import DONE
 
-    ens = Ensemble(par, y0, rtol=rtol, model=model)
+    ens = make_ensemble(par, y0, model, rtol, method)
     n = len(par)
     t_stop = 2.0 * np.pi * orbits
     with AdvanceTimer(ens.kernels) as timer:
@@ -267,8 +346,9 @@ def run_point(par, y0, model, rtol, orbits, window=16):
     member_orbits = float(np.sum(np.minimum(out.t, t_stop)) / (2.0 * np.pi))
     accepted, rejected, calls = out.counters.sum(axis=0)
     calls -= n                                   # the first-stage evaluation before the loop
-    return {"model": model, "rtol": rtol, "members": n, "orbits": orbits, "window_orbits": window,
-            "seconds": out.seconds, "loop_wall_s": loop_wall, "loop_cpu_s": loop_cpu,
+    return {"model": model, "method": method, "rtol": rtol, "members": n, "orbits": orbits,
+            "window_orbits": window, "seconds": out.seconds, "loop_wall_s": loop_wall,
+            "loop_cpu_s": loop_cpu,
             "kernel_wall_s": timer.kernel_wall, "kernel_cpu_s": timer.kernel_cpu,
             "launches": timer.launches, "member_orbits": member_orbits,
             "member_orbits_per_s": member_orbits / out.seconds,
@@ -282,8 +362,9 @@ def run_point(par, y0, model, rtol, orbits, window=16):
 
 
 class Points:
-    """Throughput points measured so far, keyed by (model, rtol, N, window, orbits); a point
-    asked for without orbits is sized by pilot runs so that it lasts about ``seconds``."""
+    """Throughput points measured so far, keyed by (model, rtol, N, window, orbits, method);
+    a point asked for without orbits is sized by pilot runs so that it lasts about
+    ``seconds``."""
 
     def __init__(self, settings, repeat):
         self.settings, self.repeat = settings, repeat
@@ -297,48 +378,54 @@ class Points:
             self.par, self.y0 = member_table(max(n, *self.settings["sizes"]))
         return self.par[:n], self.y0[:n]
 
-    def warm_up(self, model):
-        """Compile or load the model's kernels (timed once, not part of any point)."""
-        if model not in self.warmup_s:
+    def warm_up(self, model, method=DEFAULT_METHOD):
+        """Compile or load the kernels of (model, method) (timed once, not part of any
+        point)."""
+        name = model if method == DEFAULT_METHOD else f"{model} {method}"
+        if name not in self.warmup_s:
             par, y0 = self.table(1)
             t0 = time.perf_counter()
-            run_point(par, y0, model, RTOLS[0], MIN_PILOT_ORBITS)
-            self.warmup_s[model] = time.perf_counter() - t0
-        return self.warmup_s[model]
+            run_point(par, y0, model, RTOLS[0], MIN_PILOT_ORBITS, method=method)
+            self.warmup_s[name] = time.perf_counter() - t0
+        return self.warmup_s[name]
 
-    def get(self, model, rtol, n, window=16, orbits=None):
-        """The row of (model, rtol, N, window) over ``orbits`` (None: sized by pilot runs)."""
-        key = (model, rtol, n, window, orbits)
+    def get(self, model, rtol, n, window=16, orbits=None, method=DEFAULT_METHOD):
+        """The row of (model, rtol, N, window, method) over ``orbits`` (None: sized by pilot
+        runs)."""
+        key = (model, rtol, n, window, orbits, method)
         if key in self.rows:
             return self.rows[key]
-        self.warm_up(model)
+        self.warm_up(model, method)
         par, y0 = self.table(n)
         if orbits is None:
-            orbits = self._orbits(par, y0, model, rtol, window)
-        runs = [run_point(par, y0, model, rtol, orbits, window) for _ in range(self.repeat)]
+            orbits = self._orbits(par, y0, model, rtol, window, method)
+        runs = [run_point(par, y0, model, rtol, orbits, window, method)
+                for _ in range(self.repeat)]
         row = dict(min(runs, key=lambda r: r["seconds"]),
                    all_seconds=[r["seconds"] for r in runs])
-        self._rate[(model, rtol)] = row["member_orbits_per_s"]
+        self._rate[(model, rtol, method)] = row["member_orbits_per_s"]
         self.rows[key] = row
-        print(f"  {model:6} rtol {rtol:.0e} N {n:6d} window {window:3d}: {orbits:9.4g} orbits "
-              f"{row['seconds']:7.2f} s  {row['member_orbits_per_s']:10.1f} member-orbits/s",
-              flush=True)
+        print(f"  {model:6} {method:9} rtol {rtol:.0e} N {n:6d} window {window:3d}: "
+              f"{orbits:9.4g} orbits {row['seconds']:7.2f} s  "
+              f"{row['member_orbits_per_s']:10.1f} member-orbits/s", flush=True)
         return row
 
-    def measured(self, model, rtol, n):
-        """The sized, default-window row of (model, rtol, N), or None if not measured."""
-        return self.rows.get((model, rtol, n, 16, None))
+    def measured(self, model, rtol, n, method=DEFAULT_METHOD):
+        """The sized, default-window row of (model, rtol, N, method), or None if not
+        measured."""
+        return self.rows.get((model, rtol, n, 16, None, method))
 
-    def _orbits(self, par, y0, model, rtol, window):
+    def _orbits(self, par, y0, model, rtol, window, method):
         """Orbits for a run of about ``seconds``: a pilot run of PILOT_FRACTION of that,
         sized by the last rate of this model and rtol, measures the rate (a pilot shorter than
         half its plan is repeated with the rate it measured, at most twice)."""
         n, s = len(par), self.settings
         plan = PILOT_FRACTION * s["seconds"]
-        rate = self._rate.get((model, rtol), FIRST_RATE_GUESS)
+        rate = self._rate.get((model, rtol, method),
+                              self._rate.get((model, rtol, DEFAULT_METHOD), FIRST_RATE_GUESS))
         for _ in range(3):
             pilot = run_point(par, y0, model, rtol, max(MIN_PILOT_ORBITS, plan * rate / n),
-                              window)
+                              window, method)
             rate = pilot["member_orbits_per_s"]
             if pilot["seconds"] >= 0.5 * plan:
                 break
@@ -347,9 +434,9 @@ class Points:
 
 # ---- sections ----------------------------------------------------------------------------
 
-def bench_throughput(points, models, rtols, sizes):
-    return [points.get(model, rtol, n) for model in models for rtol in rtols
-            for n in sorted(sizes)]
+def bench_throughput(points, models, rtols, sizes, methods=(DEFAULT_METHOD,)):
+    return [points.get(model, rtol, n, method=method) for model in models for rtol in rtols
+            for method in methods for n in sorted(sizes)]
 
 
 _RHS_LOOPS = {}
@@ -584,6 +671,137 @@ def bench_baseline(members, orbits, rtols):
     return rows
 
 
+def numba_baseline():
+    """The numba DOP853 module (experiments/_numba_dop853.py), or None when numba is not
+    installed (``pip install ti-spinorbit[bench]``)."""
+    try:
+        return importlib.import_module("_numba_dop853")
+    except ImportError as exc:
+        print(f"  numba baseline skipped: {exc} (pip install 'ti-spinorbit[bench]')", flush=True)
+        return None
+
+
+def random_planar_states(n, seed=1):
+    """n random planar states (r 0.8-1.3, any angles and spins): RHS comparisons only."""
+    rng = np.random.default_rng(seed)
+    q = np.zeros((n, 10))
+    q[:, 0] = rng.uniform(0.8, 1.3, n)
+    q[:, 1] = 0.1 * rng.normal(size=n)
+    q[:, 2] = rng.uniform(0.8, 1.2, n)
+    q[:, 3] = rng.uniform(0.0, 2.0 * np.pi, n)
+    for c, angle in ((4, rng.uniform(0, 2 * np.pi, n)), (7, rng.uniform(0, 2 * np.pi, n))):
+        q[:, c], q[:, c + 1] = np.cos(angle), np.sin(angle)
+    q[:, 6], q[:, 9] = rng.normal(size=n), rng.normal(size=n)
+    return q
+
+
+def numba_rhs_mismatch(nb, kpar, q):
+    """max over states and components of |f_numba − f_package| / max |f_package| of that
+    component: the baseline's RHS against the planar kernels' (round-off: ~1e-16)."""
+    from ti_spinorbit.kernels import ensemble as K
+
+    f_pkg, f_nb = np.zeros_like(q), np.zeros_like(q)
+    K.PLANAR.evaluate_rhs(kpar, q, f_pkg, 4, False)
+    nb.rhs_many(kpar, q, f_nb)
+    scale = np.maximum(np.abs(f_pkg).max(axis=0), np.finfo(float).tiny)
+    return float(np.max(np.abs(f_nb - f_pkg) / scale))
+
+
+def numba_run(nb, kpar, q0, orbits, rtol):
+    """The members one after the other on this thread: (final planar states, counters, wall
+    s, this thread's CPU s)."""
+    y, counters = np.zeros_like(q0), np.zeros((len(q0), 3), dtype=np.int64)
+    wall, cpu = time.perf_counter(), time.thread_time()
+    nb.integrate_many(kpar, q0, 2.0 * np.pi * orbits, rtol, rtol, y, counters)
+    return y, counters, time.perf_counter() - wall, time.thread_time() - cpu
+
+
+def bench_numba(points, rtols, members, seconds, repeat, check_orbits, curve=()):
+    """numba DOP853, planar, one member at a time on one core; orbits per CPU-second at
+    ``rtols`` and, marked ``curve``, at the extra tolerances ``curve`` (the rate-against-
+    error curve of the equal-accuracy comparison)."""
+    from ti_spinorbit import planar
+
+    nb = numba_baseline()
+    if nb is None:
+        return []
+    par, y0 = points.table(members)
+    kpar, q0 = planar.parameter_rows(par), planar.to_planar(y0)
+    nb.check_even(kpar)
+    t0 = time.perf_counter()
+    numba_run(nb, kpar[:1], q0[:1], 0.01, 1e-10)             # compile (or load numba's cache)
+    compile_s = time.perf_counter() - t0
+    rhs_mismatch = numba_rhs_mismatch(nb, kpar[:1].repeat(256, axis=0), random_planar_states(256))
+    # whole trajectories against the kernels at a tight tolerance
+    tight = 1e-14
+    y_nb = numba_run(nb, kpar, q0, check_orbits, tight)[0]
+    kernel = make_ensemble(par, y0, "planar", tight).run(2.0 * np.pi * check_orbits)
+    trajectory_mismatch = float(np.max(np.abs(planar.to_spatial(y_nb) - kernel.y)))
+    print(f"  numba DOP853: compile/load {compile_s:.2f} s; RHS vs package max rel diff "
+          f"{rhs_mismatch:.1e}; final states vs kernels (rtol {tight:g}, {check_orbits:g} "
+          f"orbits) max |dy| {trajectory_mismatch:.1e}", flush=True)
+    rows = []
+    for rtol in sorted(set(rtols) | set(curve), reverse=True):
+        _, c, _, cpu = numba_run(nb, kpar, q0, 1.0, rtol)    # pilot: one orbit each
+        rate = members / max(cpu, 1e-6)
+        orbits = max(points.settings["min_orbits"], nice_ceil(seconds * rate / members))
+        runs = [numba_run(nb, kpar, q0, orbits, rtol) for _ in range(repeat)]
+        _, counters, wall, cpu = min(runs, key=lambda r: r[3])
+        mo = members * orbits
+        accepted, rejected, calls = counters.sum(axis=0)
+        rows.append({"method": "numba DOP853", "model": "planar", "rtol": rtol,
+                     "curve": rtol not in rtols,
+                     "members": members, "orbits": orbits, "threads": 1, "wall_s": wall,
+                     "cpu_s": cpu, "orbits_per_s": mo / wall, "orbits_per_cpu_s": mo / cpu,
+                     "accepted_per_orbit": accepted / mo, "rejected_per_orbit": rejected / mo,
+                     "rhs_per_orbit": calls / mo, "ns_per_rhs": 1e9 * cpu / calls,
+                     "all_cpu_s": [r[3] for r in runs], "compile_s": compile_s,
+                     "rhs_max_rel_diff_vs_package": rhs_mismatch,
+                     "final_state_max_diff_vs_kernels": trajectory_mismatch,
+                     "check_rtol": tight, "check_orbits": check_orbits})
+        print(f"  numba DOP853 rtol {rtol:.0e}: {mo:g} member-orbits {cpu:7.2f} CPU-s "
+              f"{mo / cpu:10.1f} orbits/CPU-s", flush=True)
+    return rows
+
+
+def bench_accuracy(models, methods, rtols, members, orbits, numba_rtols=()):
+    """Final-state error of every (model, method, rtol) and of the numba baseline against a
+    tight reference: numba DOP853 at ACCURACY_REFERENCE_RTOL (else the kernels' Cash-Karp at
+    that rtol). Error of a member: max over the 30 scaled 3-D state components (the planar
+    states are compared after ``to_spatial``, so both models meet the same reference)."""
+    from ti_spinorbit import planar
+
+    par, y0 = member_table(members)
+    t_end = 2.0 * np.pi * orbits
+    nb = numba_baseline()
+    tight = ACCURACY_REFERENCE_RTOL
+    if nb is not None:
+        kpar, q0 = planar.parameter_rows(par), planar.to_planar(y0)
+        reference = planar.to_spatial(numba_run(nb, kpar, q0, orbits, tight)[0])
+        reference_name = f"numba DOP853, rtol {tight:g}"
+    else:
+        reference = make_ensemble(par, y0, "planar", tight).run(t_end).y
+        reference_name = f"kernels, Cash-Karp, planar, rtol {tight:g}"
+    rows = []
+
+    def add(model, method, rtol, y):
+        err = np.max(np.abs(y - reference), axis=1)
+        rows.append({"model": model, "method": method, "rtol": rtol, "members": members,
+                     "orbits": orbits, "reference": reference_name,
+                     "median_error": float(np.median(err)), "max_error": float(err.max())})
+
+    for rtol in rtols:
+        for model in models:
+            for method in methods:
+                add(model, method, rtol, make_ensemble(par, y0, model, rtol, method).run(t_end).y)
+    if nb is not None:
+        for rtol in sorted(set(rtols) | set(numba_rtols), reverse=True):
+            add("planar", "numba DOP853", rtol, planar.to_spatial(numba_run(nb, kpar, q0, orbits,
+                                                                          rtol)[0]))
+    print(f"  accuracy: {len(rows)} runs against {reference_name}", flush=True)
+    return rows
+
+
 def bench_first_result(arch, repeat, cold):
     """Fresh processes: with ``cold``, a run with a new empty kernel cache and then
     ``repeat`` runs with it warm; else ``repeat`` runs with the default cache folder."""
@@ -597,6 +815,98 @@ def bench_first_result(arch, repeat, cold):
             runs.append({"run": label, "new_cache_folder": cold, "wall_s": wall, **inside})
             print(f"  fresh process, {label}: {wall:8.3f} s", flush=True)
     return runs
+
+
+def fastest(points, model, rtol, n, methods, key="member_orbits_per_s"):
+    """(method, row) of the measured method with the highest ``key`` at (model, rtol, N)."""
+    rows = [(m, points.measured(model, rtol, n, m)) for m in methods]
+    rows = [(m, r) for m, r in rows if r]
+    return max(rows, key=lambda mr: mr[1][key]) if rows else (None, None)
+
+
+def targets13(points, numba_rows, accuracy_rows, models, methods, n, cores, cpu):
+    """Issue 13 §1 targets with their values and ratios to the target."""
+    out = []
+
+    def add(text, value, goal):
+        out.append({"target": "issue 13: " + text, "value": value, "ratio": value / goal,
+                    "met": value >= goal})
+
+    if "planar" in models:
+        method, row = fastest(points, "planar", 1e-12, n, methods)
+        if row:
+            add(f">= {TARGET13_PLANAR:.0f} member-orbits/s on {cores} cores, planar, fastest "
+                f"method ({method}), N = {n}, rtol 1e-12", row["member_orbits_per_s"],
+                TARGET13_PLANAR)
+        for b in (b for b in numba_rows if not b.get("curve")):
+            key = "member_orbits_per_cpu_s" if cpu else "member_orbits_per_s"
+            method, row = fastest(points, "planar", b["rtol"], n, methods, key)
+            if row:
+                add(f">= {TARGET13_PER_CORE:g}x the numba DOP853 baseline "
+                    f"({b['orbits_per_cpu_s']:.0f} orbits/CPU-s, one core) "
+                    + ("per core" if cpu else "(device wall rate against one CPU core)")
+                    + f", planar, fastest method ({method}, {row[key]:.0f}), N = {n}, "
+                    f"rtol {b['rtol']:.0e}", row[key] / b["orbits_per_cpu_s"],
+                    TARGET13_PER_CORE)
+        today = points.measured("planar", 1e-15, n, DEFAULT_METHOD)
+        method, row = fastest(points, "planar", 1e-15, n, methods)
+        if today and row:
+            add(f">= {TARGET13_TIGHT:g}x today's Cash-Karp rate ({today['member_orbits_per_s']:.0f}"
+                f"), planar, fastest method ({method}), N = {n}, rtol 1e-15",
+                row["member_orbits_per_s"] / today["member_orbits_per_s"], TARGET13_TIGHT)
+    if "3d" in models:
+        method, row = fastest(points, "3d", 1e-12, n, methods)
+        if row:
+            add(f">= {TARGET13_3D:.0f} member-orbits/s, 3-D, fastest method ({method}), N = {n}, "
+                "rtol 1e-12", row["member_orbits_per_s"], TARGET13_3D)
+    # accuracy at equal rtol: each method's median final-state error over Cash-Karp's
+    for a in accuracy_rows:
+        if a["method"] == DEFAULT_METHOD or a["method"] not in methods:
+            continue
+        ck = [c for c in accuracy_rows if (c["model"], c["rtol"], c["method"])
+              == (a["model"], a["rtol"], DEFAULT_METHOD)]
+        if ck:
+            ratio = a["median_error"] / max(ck[0]["median_error"], 1e-300)
+            out.append({"target": f"issue 13: accuracy at equal rtol, {a['method']} error <= "
+                                  f"Cash-Karp's, {a['model']}, rtol {a['rtol']:.0e} (median "
+                                  f"{a['median_error']:.2e} vs {ck[0]['median_error']:.2e})",
+                        "value": ratio, "met": ratio <= 1.0})
+    return out
+
+
+def equal_accuracy(points, numba_rows, accuracy_rows, methods, n, cpu):
+    """Informational (not an issue-13 target): each planar method at each baseline rtol
+    against the numba baseline at the SAME median final-state error, its rate read off the
+    baseline's rate-against-error curve (log-log interpolation between the measured
+    tolerances; None outside the curve)."""
+    def error(method, rtol):
+        rows = [a for a in accuracy_rows
+                if (a["model"], a["method"], a["rtol"]) == ("planar", method, rtol)]
+        return rows[0]["median_error"] if rows else None
+
+    curve = sorted((error(b["method"], b["rtol"]), b["orbits_per_cpu_s"], b["rtol"])
+                   for b in numba_rows if error(b["method"], b["rtol"]))
+    out = []
+    if len(curve) < 2:
+        return out
+    log_err = np.log([c[0] for c in curve])
+    key = "member_orbits_per_cpu_s" if cpu else "member_orbits_per_s"
+    for b in (b for b in numba_rows if not b.get("curve")):
+        for method in methods:
+            row, err = points.measured("planar", b["rtol"], n, method), error(method, b["rtol"])
+            if not row or not err:
+                continue
+            inside = log_err[0] <= np.log(err) <= log_err[-1]
+            rate = float(np.exp(np.interp(np.log(err), log_err, np.log([c[1] for c in curve])))) \
+                if inside else None
+            numba_rtol = float(np.exp(np.interp(np.log(err), log_err,
+                                                np.log([c[2] for c in curve])))) \
+                if inside else None
+            out.append({"method": method, "rtol": b["rtol"], "members": n, "median_error": err,
+                        "rate": row[key], "numba_rate_at_equal_error": rate,
+                        "numba_rtol_at_equal_error": numba_rtol,
+                        "ratio": row[key] / rate if rate else None})
+    return out
 
 
 def targets(points, baseline_rows, first_runs, models, n):
@@ -647,9 +957,16 @@ def machine_info():
             "simd": sorted(f for f in flags if f in ("avx2", "fma", "avx512f")),
             "machine": platform.machine(), "platform": platform.platform(),
             "python": platform.python_version(), "taichi": ".".join(map(str, ti.__version__)),
-            "numpy": np.__version__, "scipy": scipy.__version__,
+            "numpy": np.__version__, "scipy": scipy.__version__, "numba": _version("numba"),
             "ti_spinorbit": tso.__version__, "arch": tso.runtime.current_arch(), "git": commit,
             "load_average_1min_start": os.getloadavg()[0]}
+
+
+def _version(module):
+    try:
+        return importlib.import_module(module).__version__
+    except ImportError:
+        return None
 
 
 def _opt(x, fmt):
@@ -670,12 +987,13 @@ def _table(rows, columns):
 
 
 MODEL, RTOL, N = ("model", "model", "s"), ("rtol", "rtol", ".0e"), ("N", "members", "d")
+METHOD = ("method", "method", "s")
 RATE = ("mo/s", "member_orbits_per_s", ".1f")
 CPU_RATE = ("mo/CPU-s", "member_orbits_per_cpu_s", ".1f")
 ORBITS, SECONDS = ("orbits", "orbits", ".4g"), ("seconds", "seconds", ".2f")
 LAUNCHES, DRAIN = ("launches", "launches", "d"), ("drain", "drain_fraction", "%")
 TABLES = {
-    "throughput": [MODEL, RTOL, N, ORBITS, SECONDS, RATE, CPU_RATE,
+    "throughput": [MODEL, METHOD, RTOL, N, ORBITS, SECONDS, RATE, CPU_RATE,
                    ("acc/orb", "accepted_per_orbit", ".1f"),
                    ("rej/orb", "rejected_per_orbit", ".2f"), ("RHS/orb", "rhs_per_orbit", ".1f"),
                    LAUNCHES, DRAIN, ("not done", "not_done", "d")],
@@ -694,6 +1012,12 @@ TABLES = {
                  ORBITS, ("seconds", "seconds", ".3f"), ("mo/s", "member_orbits_per_s", ".3f"),
                  ("steps/orb", "steps_per_orbit", ".1f"), ("RHS/orb", "rhs_per_orbit", ".1f"),
                  ("max|dy| vs kernel", "kernel_reference_max_diff_scaled", ".2e")],
+    "numba": [RTOL, ("members", "members", "d"), ORBITS, ("CPU s", "cpu_s", ".2f"),
+              ("orbits/CPU-s", "orbits_per_cpu_s", ".1f"), ("orbits/s", "orbits_per_s", ".1f"),
+              ("acc/orb", "accepted_per_orbit", ".1f"), ("rej/orb", "rejected_per_orbit", ".2f"),
+              ("RHS/orb", "rhs_per_orbit", ".1f"), ("ns/RHS", "ns_per_rhs", ".1f")],
+    "accuracy": [MODEL, METHOD, RTOL, ("members", "members", "d"), ORBITS,
+                 ("median err", "median_error", ".2e"), ("max err", "max_error", ".2e")],
 }
 
 
@@ -725,7 +1049,12 @@ def print_report(result):
         "threads": "fresh processes, cpu_max_num_threads = k; speed-up over 1 thread (wall), "
                    "efficiency = speed-up / k",
         "window": "planar, rtol 1e-12: orbits per launch",
-        "baseline": "scipy DOP853 + NumPy reference RHS, atol = rtol * to_physical(ones)"}
+        "baseline": "scipy DOP853 + NumPy reference RHS, atol = rtol * to_physical(ones)",
+        "numba": "compiled single-trajectory DOP853 (numba, experiments/_numba_dop853.py), "
+                 "planar, members one after the other on ONE core, atol = rtol, Hairer's "
+                 "RMS error norm; orbits per CPU-second = per core",
+        "accuracy": "final-state error at equal rtol: max |dy| over the scaled 3-D state "
+                    "against a tight reference, median and max over members"}
     for name, columns in TABLES.items():
         if s.get(name):
             print(f"\n[{name}] {captions[name]}")
@@ -734,17 +1063,68 @@ def print_report(result):
                     f"{k} {v['ns_per_rhs_cpu']:.1f} ns CPU time, {v['ns_per_rhs_wall']:.1f} ns "
                     f"wall (N = {v['members']}, {v['repeats']} repeats)"
                     for k, v in s["rhs_only"].items()))
+            if name == "numba":
+                b = s[name][0]
+                print(f"checks: RHS vs the package's planar RHS, max relative difference "
+                      f"{b['rhs_max_rel_diff_vs_package']:.1e} (256 random states); final "
+                      f"states vs the kernels at rtol {b['check_rtol']:g} over "
+                      f"{b['check_orbits']:g} orbits, max |dy| "
+                      f"{b['final_state_max_diff_vs_kernels']:.1e}; compile/load "
+                      f"{b['compile_s']:.2f} s")
+            if name == "accuracy":
+                print(f"reference: {s[name][0]['reference']}")
             _table(s[name], columns)
+            if name == "accuracy":
+                print_accuracy_lines(s[name])
     if "latency" in s:
         print("\n[latency] first result from a fresh process (1 member, 1 orbit)")
         for f in s["latency"]:
             where = "new cache folder" if f["new_cache_folder"] else "default cache folder"
             print(f"  {f['run']:<10} ({where}): wall {f['wall_s']:6.2f} s  (import "
                   f"{f['import_s']:.2f} s, in process {f['in_process_s']:.2f} s)")
+    if s.get("equal_accuracy"):
+        print("\n[equal accuracy] informational: each method against the numba baseline at the "
+              "same median final-state error (its rate interpolated between the measured "
+              "tolerances); " + ("per core" if s["equal_accuracy"][0]["rate"] is not None
+                                 and result["machine"]["arch"] in ("cpu", "x64", "arm64")
+                                 else "wall rate against one core"))
+        for e in s["equal_accuracy"]:
+            if e["ratio"] is None:
+                print(f"  planar {e['method']}, rtol {e['rtol']:.0e}: error "
+                      f"{e['median_error']:.2e} outside the baseline's measured curve")
+            else:
+                print(f"  planar {e['method']}, rtol {e['rtol']:.0e}: error "
+                      f"{e['median_error']:.2e}, {e['rate']:.0f} member-orbits/CPU-s; numba "
+                      f"DOP853 at that error (rtol ~{e['numba_rtol_at_equal_error']:.1e}) "
+                      f"{e['numba_rate_at_equal_error']:.0f} orbits/CPU-s: ratio "
+                      f"{e['ratio']:.2f}")
+    if result.get("skipped_methods"):
+        print()
+        for method, why in result["skipped_methods"].items():
+            print(f"method {method} skipped: {why}")
     if result["targets"]:
         print("\n[targets]")
         for t in result["targets"]:
-            print(f"  {'MET ' if t['met'] else 'MISS'}  {t['target']}: {t['value']:.4g}")
+            ratio = f"  ({t['ratio']:.2f}x the target)" if "ratio" in t else ""
+            print(f"  {'MET ' if t['met'] else 'MISS'}  {t['target']}: {t['value']:.4g}{ratio}")
+
+
+def print_accuracy_lines(rows):
+    """One "accuracy at equal rtol" line per (model, rtol): every method's median error and
+    its ratio to Cash-Karp's."""
+    for model in dict.fromkeys(r["model"] for r in rows):
+        for rtol in dict.fromkeys(r["rtol"] for r in rows):
+            group = [r for r in rows if (r["model"], r["rtol"]) == (model, rtol)]
+            ck = [r["median_error"] for r in group if r["method"] == DEFAULT_METHOD]
+            if not ck:
+                continue                       # a tolerance of the baseline's curve only
+            parts = []
+            for r in group:
+                ratio = f" ({r['median_error'] / ck[0]:.2g}x Cash-Karp)" if ck and ck[0] > 0 \
+                    and r["method"] != DEFAULT_METHOD else ""
+                parts.append(f"{r['method']} {r['median_error']:.2e}{ratio}")
+            print(f"accuracy at equal rtol, {model}, rtol {rtol:.0e} (median final-state error): "
+                  + "; ".join(parts))
 
 
 def figure(result):
@@ -756,10 +1136,18 @@ def figure(result):
     for k, rtol in enumerate(result["parameters"]["rtols"]):
         color = f"C{k}"
         for model in result["parameters"]["models"]:
-            rows = [r for r in s.get("throughput", []) if r["rtol"] == rtol and r["model"] == model]
-            if rows:
-                ax.loglog([r["members"] for r in rows], [r["member_orbits_per_s"] for r in rows],
-                          "o" + styles[model], color=color, label=f"{model}, rtol {rtol:.0e}")
+            for j, method in enumerate(result["parameters"]["methods"]):
+                rows = [r for r in s.get("throughput", []) if r["rtol"] == rtol
+                        and r["model"] == model and r["method"] == method]
+                if rows:
+                    ax.loglog([r["members"] for r in rows],
+                              [r["member_orbits_per_s"] for r in rows], "os^v"[j % 4]
+                              + styles[model], color=color,
+                              label=f"{model}, {method}, rtol {rtol:.0e}")
+        for b in s.get("numba", []):
+            if b["rtol"] == rtol:
+                ax.axhline(b["orbits_per_cpu_s"], color=color, ls=(0, (5, 2, 1, 2)), lw=1,
+                           label=f"numba DOP853, 1 core, rtol {rtol:.0e}")
         for b in s.get("baseline", []):
             if b["rtol"] == rtol:
                 ax.axhline(b["member_orbits_per_s"], color=color, ls=":", lw=1,
@@ -801,6 +1189,10 @@ def _extra(p):
                    help="tolerances (default 1e-10 1e-12 1e-15)")
     p.add_argument("--models", nargs="+", choices=MODELS, default=list(MODELS),
                    help="equations of motion (default: planar 3d)")
+    p.add_argument("--methods", nargs="+", default=list(METHODS),
+                   help="integration methods, Ensemble(method=...) (default: cash-karp dop853; "
+                        "a method the installed package does not accept is skipped with a "
+                        "note)")
     p.add_argument("--seconds", type=float, default=None,
                    help="target duration of each throughput point (default 2; --quick 0.05)")
     p.add_argument("--flops-per-cycle", type=float, default=FLOPS_PER_CYCLE,
@@ -821,9 +1213,14 @@ def main():
     print(f"bench_throughput ({'quick' if args.quick else 'full'}; "
           f"{', '.join(sections)}): running ...", flush=True)
     points = Points(settings, args.repeat)
+    skipped = {m: why for m in dict.fromkeys(args.methods) if (why := method_unavailable(m))}
+    for method, why in skipped.items():
+        print(f"  method {method} skipped: {why}", flush=True)
+    methods = [m for m in dict.fromkeys(args.methods) if m not in skipped]
     s = {}
     if "throughput" in sections:
-        s["throughput"] = bench_throughput(points, args.models, args.rtols, settings["sizes"])
+        s["throughput"] = bench_throughput(points, args.models, args.rtols, settings["sizes"],
+                                           methods)
     if "split" in sections or "flops" in sections:
         s["rhs_only"] = {m: bench_rhs(points, m, n_split, settings["rhs_seconds"], args.repeat)
                          for m in args.models}
@@ -839,19 +1236,34 @@ def main():
     if "baseline" in sections:
         s["baseline"] = bench_baseline(settings["baseline_members"], settings["baseline_orbits"],
                                        args.rtols)
+    if "numba" in sections:
+        curve = settings["numba_curve"] if "accuracy" in sections else ()
+        s["numba"] = bench_numba(points, [r for r in args.rtols if r in NUMBA_RTOLS] or args.rtols,
+                                 settings["numba_members"], settings["seconds"], args.repeat,
+                                 settings["accuracy_orbits"], curve)
+    if "accuracy" in sections:
+        s["accuracy"] = bench_accuracy(args.models, methods, args.rtols,
+                                       settings["accuracy_members"], settings["accuracy_orbits"],
+                                       [b["rtol"] for b in s.get("numba", [])])
+        s["equal_accuracy"] = equal_accuracy(points, s.get("numba", []), s["accuracy"], methods,
+                                             n_split, cpu)
     if "latency" in sections:
         s["latency"] = bench_first_result(args.arch, args.repeat, settings["cold_latency"])
     parameters = {"system": SYSTEM, "elongation": ELONGATION, "theta_p_range": THETA_P_RANGE,
                   "thetadot_range": THETADOT_RANGE, "escape_distance": ESCAPE_DISTANCE,
                   "starts": "R2 sequence, plastic number", "rtols": args.rtols,
-                  "models": args.models, "sections": sections, "repeat": args.repeat,
+                  "models": args.models, "methods": methods, "sections": sections,
+                  "repeat": args.repeat,
                   "flops_per_cycle": args.flops_per_cycle, "flops_per_rhs": FLOPS_PER_RHS,
                   "windows": WINDOWS, **settings}
     result = {"benchmark": "bench_throughput", "quick": bool(args.quick),
               "machine": {**machine, "load_average_1min_end": os.getloadavg()[0]},
               "parameters": parameters, "warmup_s": points.warmup_s, "sections": s,
+              "skipped_methods": skipped,
               "targets": targets(points, s.get("baseline", []), s.get("latency", []),
-                                 args.models, n_split),
+                                 args.models, n_split)
+              + targets13(points, s.get("numba", []), s.get("accuracy", []), args.models,
+                          methods, n_split, machine["cpus_usable"], cpu),
               "total_seconds": time.perf_counter() - started}
     print_report(result)
     path = os.path.join(args.out, "bench_throughput.json")
@@ -860,7 +1272,7 @@ def main():
     print(f"[bench_throughput] wrote {path}")
     rows = s.get("throughput", [])
     save(args, "bench_throughput", figure(result),
-         {key: [r[key] for r in rows] for key in ("model", "rtol", "members",
+         {key: [r[key] for r in rows] for key in ("model", "method", "rtol", "members",
                                                   "member_orbits_per_s",
                                                   "member_orbits_per_cpu_s")},
          {"machine": result["machine"], **parameters},
