@@ -158,7 +158,7 @@ def main():
 
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 3.8))
     w = [r["workers"] for r in scaling]
-    ax.plot(w, [r["member_orbits_per_s"] for r in scaling], "o-", label="chaos_map, client=")
+    ax.plot(w, [r["member_orbits_per_s"] for r in scaling], "o-", label="chaos map on a Dask cluster")
     ax.plot(w, [one * k for k in w], "k:", lw=1, label="ideal (k x 1 worker)")
     ax.plot(w, [r["workers"] * r["member_orbits_per_worker_cpu_s"] for r in scaling], "s--",
             label="k x per worker CPU-s (k unshared cores)")
@@ -173,7 +173,7 @@ def main():
               label=f"{s['sweep_grid']}x{s['sweep_grid']} map, {s['sweep_orbits']:g} orbits")
     bx.axhline(tiny, color="C3", ls="--", lw=1,
                label=f"one-member 0.01-orbit chunk: {1e3 * tiny:.0f} ms")
-    bx.set_xlabel("members per chunk (chunk_size)")
+    bx.set_xlabel("members per chunk")
     bx.set_ylabel("seconds per chunk, 1 worker")
     bx.set_title(f"per-chunk cost; fit: {1e3 * per_chunk:.0f} ms fixed per chunk", fontsize=9)
     bx.legend(fontsize=7)
