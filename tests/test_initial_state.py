@@ -206,3 +206,18 @@ def test_kick_changes_only_the_velocity_along_the_orbit_frame(vh):
     mu = tso.G * circ.total_mass
     a_new = 1.0 / (2.0 / np.linalg.norm(kv.R) - kv.V @ kv.V / mu)
     assert (a_new / circ.a) ** 1.5 - 1.0 == pytest.approx(3 * dv / v, rel=3e-3)
+
+
+def test_rows_round_trip_and_vectorised_rows_match_from_scaled(spun_vh):
+    rng = np.random.default_rng(6)
+    states = [random_state(spun_vh, rng) for _ in range(3)]
+    for s in states:
+        back = InitialState.from_row(s.to_row())
+        np.testing.assert_array_equal(back.to_row(), s.to_row())
+    y = np.stack([s.to_scaled(spun_vh) for s in states])
+    rows = I.physical_rows(spun_vh, y.reshape(3, 1, 30))          # any leading shape
+    for k, s in enumerate(states):
+        expect = InitialState.from_scaled(spun_vh, y[k]).to_row()
+        scale = np.abs(expect).max()
+        np.testing.assert_allclose(rows[k, 0], expect, rtol=1e-13, atol=1e-14 * scale)
+        np.testing.assert_allclose(rows[k, 0], s.to_row(), rtol=1e-12, atol=1e-13 * scale)

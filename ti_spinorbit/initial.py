@@ -38,6 +38,16 @@ ORTHONORMAL_TOLERANCE = 1e-9
 
 _FIELDS = ("R", "V", "primary_attitude", "primary_omega", "secondary_attitude",
            "secondary_omega")
+#: Columns of a state row (:meth:`InitialState.to_row`, results' ``initial_states`` and
+#: ``states``): R (3, m), V (3, m/s), primary attitude (9, row-major, body -> inertial),
+#: primary ω (3, rad/s, its body frame), secondary attitude (9), secondary ω (3).
+ROW_SLICES = {"R": slice(0, 3), "V": slice(3, 6), "primary_attitude": slice(6, 15),
+              "primary_omega": slice(15, 18), "secondary_attitude": slice(18, 27),
+              "secondary_omega": slice(27, 30)}
+#: Unit text of a state row, for saved files.
+ROW_UNIT = ("state row (docs/physics.md §6.8): R m (3), V m/s (3), primary attitude body->inertial "
+            "(9, row-major), primary omega rad/s body frame (3), secondary attitude (9), "
+            "secondary omega rad/s (3)")
 _UNITS = {"R": "m", "V": "m/s", "primary_attitude": "1 (body -> inertial)",
           "primary_omega": "rad/s (primary body frame)",
           "secondary_attitude": "1 (body -> inertial)",
@@ -209,6 +219,17 @@ class InitialState:
                             secondary_attitude=self.secondary_attitude,
                             secondary_omega=self.secondary_omega)
 
+    def to_row(self):
+        """The 30 numbers of this state in the row layout :data:`ROW_SLICES` (SI)."""
+        return np.concatenate([getattr(self, name).ravel() for name in _FIELDS])
+
+    @classmethod
+    def from_row(cls, row):
+        """Inverse of :meth:`to_row`."""
+        row = _finite("row", row, (30,))
+        return cls(**{name: row[sl].reshape(3, 3) if name.endswith("attitude") else row[sl]
+                      for name, sl in ROW_SLICES.items()})
+
     def angular_momentum(self, system):
         """Total angular momentum about the centre of mass, inertial frame (kg m²/s):
         m R × V + A1 I1 ω1 + A2 I2 ω2 (docs/physics.md §4.2)."""
@@ -317,3 +338,21 @@ def as_scaled_states(system, states):
     if not out:
         raise ValueError("initial_states must hold at least one InitialState")
     return np.stack(out)
+
+
+def physical_rows(system, y):
+    """State rows (:data:`ROW_SLICES`, SI, inertial) of scaled 3-D states ``y`` (..., 30) of
+    ``system``, vectorised (no re-orthonormalisation: the attitudes are the integrator's,
+    orthonormal to its tolerance). NaN rows stay NaN."""
+    y = np.asarray(y, dtype=np.float64)
+    x = system.to_physical(y)
+    S = x[..., 12:21].reshape(y.shape[:-1] + (3, 3))
+    A1 = x[..., 21:30].reshape(y.shape[:-1] + (3, 3))
+    m_red = system.primary.mass * system.secondary.mass / system.total_mass
+    R = np.einsum("...ij,...j->...i", A1, x[..., 0:3])
+    V = np.einsum("...ij,...j->...i", A1, x[..., 3:6]) / m_red
+    A2 = A1 @ S
+    w1 = x[..., 6:9] / system.primary.moments
+    w2 = np.einsum("...ji,...j->...i", S, x[..., 9:12]) / system.secondary.moments
+    flat = y.shape[:-1] + (9,)
+    return np.concatenate([R, V, A1.reshape(flat), w1, A2.reshape(flat), w2], axis=-1)
