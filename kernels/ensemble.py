@@ -1,4 +1,8 @@
-"""Ensemble kernels: every member advances with its own adaptive Cash-Karp loop in one launch.
+"""Ensemble kernels: every member advances with its own adaptive Runge-Kutta loop in one launch.
+
+The method (a ``tableau.Tableau``: Cash-Karp 4(5), the default, or DOP853) and the step-size
+policy (a ``controller.Controller``) are arguments of the kernel factory :func:`make_kernels`;
+:func:`kernels_for` builds and caches one kernel set per (model, method).
 
 One launch of :func:`advance` takes each running member from its current time until its
 first accepted step that reaches ``t_end[i]`` (a soft window end: steps are never shortened
@@ -7,7 +11,7 @@ end: the last step lands on it exactly). On the way it records
 
 * pericentre crossings (osculating true anomaly through 0, i.e. g = R·V changing sign from
   − to +): time and full state at the crossing. The crossing is located inside the accepted
-  step by Newton iteration on g(τ), where the state at τ comes from a Cash-Karp step of
+  step by Newton iteration on g(τ), where the state at τ comes from a step of the same method of
   length τ from the step start, so event states carry the integrator's own local accuracy
   (near the tolerance), not an interpolant's;
 * optionally (``sampling``), time and state on a regular time grid (steps are shortened to
@@ -34,10 +38,10 @@ import taichi as ti
 
 from . import eom, planar
 from .eom import NSTATE
-from .integrator import (NONFINITE_ERROR, error_norm, make_primitives, stage_matrix_type,
-                         step_factor)
+from .controller import DEFAULT_CONTROLLER, NONFINITE_ERROR
+from .integrator import make_error_norm, make_primitives, stage_matrix_type
 from .potential import mutual, vec3
-from .tableau import CASH_KARP
+from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 
 RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE = range(6)
 #: Set on the host only, after a run, by the accuracy check (ti_spinorbit.accuracy): a
@@ -56,9 +60,7 @@ DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
 # Counter columns.
 C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2
 
-NEWTON_MAX_ITER = 8
-_STAGES = CASH_KARP.stages
-_EXPONENT = 1.0 / CASH_KARP.order  # controller exponent: the error estimate is O(h^5)
+NEWTON_MAX_ITER = DEFAULT_CONTROLLER.event_max_iter
 _STEP, _LOCATE = 0, 1
 
 nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
@@ -68,8 +70,9 @@ nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd2l = ti.types.ndarray(dtype=ti.i64, ndim=2)
 
 
-def make_kernels(model):
-    """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion.
+def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER):
+    """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion,
+    integrating with ``tableau`` under the step-size policy ``controller``.
 
     ``model`` is a module (``eom`` for the 3-D model, ``planar`` for the planar one) that
     provides NSTATE, state, rhs, pericentre_function, pericentre_rate, osculating_elements,
@@ -77,8 +80,12 @@ def make_kernels(model):
     """
     NSTATE = model.NSTATE
     state = model.state
-    stage_point, combine, put_stage = make_primitives(CASH_KARP, NSTATE)
-    kmat = stage_matrix_type(CASH_KARP, NSTATE)
+    stage_point, combine, put_stage = make_primitives(tableau, NSTATE)
+    kmat = stage_matrix_type(tableau, NSTATE)
+    error_norm = make_error_norm(tableau)
+    ctl = controller.funcs()
+    _STAGES = tableau.stages
+    _EXPONENT = tableau.error_exponent   # 1/5 for Cash-Karp (error estimate O(h^5)), 1/8 DOP853
 
     @ti.func
     def _load(a: ti.template(), i):
@@ -205,19 +212,16 @@ def make_kernels(model):
                         put_stage(K, stage, fy)
                         stage += 1
                         if stage == _STAGES:
-                            dy, err = combine(K, hs)
+                            dy, err, err3 = combine(K, hs)
                             y_try = y + dy
                             if ti.static(indicators):
                                 if mode == _STEP:
-                                    dy_s, err_s = combine(K2, hs)
+                                    dy_s, err_s, err3_s = combine(K2, hs)
                                     ys_try = y_s + dy_s
-                            en = error_norm(y, y_try, err, rtol, atol, NSTATE)
+                            en = error_norm(y, y_try, err, err3, rtol, atol, NSTATE)
                             if mode == _STEP and en > 1.0:
                                 rej += 1
-                                if en >= NONFINITE_ERROR:
-                                    h = hs * 0.2
-                                else:
-                                    h = hs * step_factor(en, 1, _EXPONENT)
+                                h = ctl.rejected(hs, en, _EXPONENT)
                                 after_reject = 1
                                 new_attempt = 1
                                 if h < min_step:
@@ -242,7 +246,7 @@ def make_kernels(model):
                         gp = model.pericentre_rate(y_try, fy)
                         new_tau = ti.min(hs_acc, ti.max(0.0, tau - g / gp))
                         it += 1
-                        if ti.abs(new_tau - tau) <= 4e-16 * hs_acc or it >= NEWTON_MAX_ITER:
+                        if ctl.event_converged(new_tau, tau, hs_acc, it):
                             _record(events, i, nev, t - tc + tau, y_try)   # Kahan: true t = t - tc
                             nev += 1
                             mode = _STEP
@@ -286,9 +290,9 @@ def make_kernels(model):
                                 for c in ti.static(range(NSTATE)):
                                     K2[0, c] = fy[c] + (f_s1[c] - fy[c]) * scale
                         acc += 1
-                        fac = step_factor(en, after_reject, _EXPONENT)
-                        if not ((hit_end == 1 or hit_sample == 1) and hs < h and fac >= 1.0):
-                            h = hs * fac                        # (a shortened step that did well keeps h)
+                        # (a step shortened for a sample or the end that did well keeps h)
+                        h = ctl.accepted(h, hs, en, after_reject, hit_end == 1 or hit_sample == 1,
+                                         _EXPONENT)
                         after_reject = 0
                         new_attempt = 1
                         if ti.static(sampling):
@@ -334,12 +338,24 @@ def make_kernels(model):
             _store(out, i, model.rhs(par, i, _load(y_nd, i), order, odd))
 
     return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, load=_load,
-                           NSTATE=NSTATE, RECORD_WIDTH=1 + NSTATE, model=model)
+                           NSTATE=NSTATE, RECORD_WIDTH=1 + NSTATE, model=model,
+                           tableau=tableau, controller=controller)
 
 
-#: The 3-D model's kernels (30-number state) and the planar model's (10 numbers).
+#: The 3-D model's kernels (30-number state) and the planar model's (10 numbers), Cash-Karp.
 SPATIAL = make_kernels(eom)
 PLANAR = make_kernels(planar)
+_KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
+
+
+def kernels_for(model, method=DEFAULT_METHOD):
+    """The kernel set of ``model`` ("planar" or "3d") integrating with ``method`` (a name of
+    ``tableau.METHODS``), built once per process (Taichi compiles each on first launch)."""
+    key = (model, check_method(method))
+    if key not in _KERNEL_SETS:
+        _KERNEL_SETS[key] = make_kernels(planar if model == "planar" else eom, METHODS[method],
+                                         DEFAULT_CONTROLLER)
+    return _KERNEL_SETS[key]
 advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs
 
