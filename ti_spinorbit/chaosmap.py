@@ -123,6 +123,7 @@ class ChaosMap(accuracy.StatusSummary, _display.Readable):
     n_inaccurate: int = 0
     include_inaccurate: bool = False
     coordinates: str = "inertial"
+    method: str = "cash-karp"         # Runge-Kutta pair (section_kwargs method=...)
     # chaotic fraction against integration length (chaos_map(fraction_orbits=...)): the
     # lengths (orbits, ascending, the map's own last) and the fraction at each; whether it
     # never decreases (⟨Y⟩ of a chaotic orbit only grows) and a one-line verdict
@@ -310,6 +311,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
+        method=section.method,
         coordinates=coordinates, **evidence)
 
 
@@ -384,6 +386,7 @@ class ParameterMap(accuracy.StatusSummary, _display.Readable):
     inaccurate: np.ndarray = None
     include_inaccurate: bool = False
     coordinates: str = "inertial"
+    method: str = "cash-karp"         # Runge-Kutta pair (section_kwargs method=...)
     # chaotic fraction against integration length (parameter_map(fraction_orbits=...)):
     # fraction_by_length has shape (len(fraction_lengths), len(elongations),
     # len(eccentricities)); fraction_monotone per grid point; fraction_message one line
@@ -540,5 +543,5 @@ def parameter_map(factory_or_name: Union[str, Callable[[float, float], BinarySys
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
-        fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
+        method=section.method, fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
         fraction_message=message)

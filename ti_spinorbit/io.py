@@ -61,7 +61,8 @@ _COMMON_UNITS = {"status_names": "name", "system_index": "index into metadata sy
                  "coordinates": "name: 'inertial' (θ̇ = inertial spin rate) or 'apsidal' "
                                 "(θ̇ = spin rate − apsidal rate ϖ̇, θ from the osculating "
                                 "line of apsides)",
-                 "apsidal_rate": SPIN}
+                 "apsidal_rate": SPIN,
+                 "method": "name: Runge-Kutta pair ('cash-karp' or 'dop853')"}
 #: Units of every array and scalar field, per kind ("1": dimensionless).
 UNITS = {
     "section": {
@@ -343,7 +344,7 @@ def save(result, path, extra=None, include_sections=True):
     block = _encode(result, "", systems, arrays, units_out, bool(include_sections))
     fields = block["fields"]
     meta = {"kind": kind, "format_version": FORMAT_VERSION, **provenance(),
-            **{k: fields.get(k) for k in ("rtol", "atol", "order", "orbits")},
+            **{k: fields.get(k) for k in ("rtol", "atol", "order", "orbits", "method")},
             "systems": systems.descriptions, "units": units_out,
             "status_codes": {str(k): v for k, v in status_codes().items()}}
     status = getattr(result, "status", None)

@@ -94,7 +94,7 @@ def _amplitudes(ts, include_inaccurate=False):
 
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
                         rtol=1e-12, max_drift=None, include_inaccurate=False,
-                        coordinates="inertial"):
+                        coordinates="inertial", method="cash-karp"):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -118,6 +118,8 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
     coordinates : {"inertial", "apsidal"}
         Spin coordinate of ``thetadot_p`` (docs/physics.md §6.7); α, and so the amplitude,
         is the same in both.
+    method : {"cash-karp", "dop853"}
+        Runge-Kutta pair (:func:`~ti_spinorbit.section.time_series`).
 
     Returns
     -------
@@ -127,7 +129,7 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         failed the accuracy check (unless ``include_inaccurate``).
     """
     ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
-                     rtol=rtol, max_drift=max_drift, coordinates=coordinates)
+                     rtol=rtol, max_drift=max_drift, coordinates=coordinates, method=method)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
@@ -178,6 +180,7 @@ class RelaxedLibration(_display.Readable):
     angmom_drift: float = float("nan")
     max_drift: float = float("nan")
     coordinates: str = "inertial"
+    method: str = "cash-karp"         # Runge-Kutta pair (section_kwargs method=...)
     # convergence evidence (relaxed_libration(converge=True)): the centre and amplitude
     # found at each length of the doubling (orbits, 2·orbits, ...) and at rtol/10 at the
     # last length; the tolerances they were held to; the verdicts and a one-line message
@@ -436,6 +439,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     """The search of :func:`relaxed_libration` at one length and tolerance (inputs checked)."""
     limit = accuracy.drift_limit(rtol, orbits, max_drift)
     coordinates = section_kwargs.get("coordinates", "inertial")
+    method = section_kwargs.get("method", "cash-karp")
     x = DEFAULT_CANDIDATES.copy() if candidates is None else \
         np.asarray(candidates, dtype=np.float64).ravel()
     shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
@@ -470,7 +474,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     launched(1 + zooms_left(half_width, 0) + 2)
     librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol, max_drift=limit,
                                                samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT,
-                                               coordinates=coordinates))
+                                               coordinates=coordinates, method=method))
     launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
     tried, extents = [x], [extent]
@@ -518,7 +522,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
                       f"{max_extent:g} deg) after {iterations} launches", RuntimeWarning,
                       stacklevel=2)
     ts = time_series(system, 0.0, center, orbits, samples_per_orbit=samples_per_orbit, rtol=rtol,
-                     max_drift=limit, coordinates=coordinates)
+                     max_drift=limit, coordinates=coordinates, method=method)
     amplitude = float(_amplitudes(ts, include_inaccurate=True)[0])   # kept, flagged below
     launched(0)
     if not np.isfinite(amplitude):
@@ -538,4 +542,4 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
         seconds=time.perf_counter() - start, system=system, status=status,
         energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
-        max_drift=limit, coordinates=coordinates)
+        max_drift=limit, coordinates=coordinates, method=method)

@@ -113,6 +113,7 @@ class OverlapScan(_display.Readable):
     n_inaccurate: int = 0
     include_inaccurate: bool = False
     coordinates: str = "inertial"
+    method: str = "cash-karp"         # Runge-Kutta pair (section_kwargs method=...)
     # convergence in integration length (doubling; see overlap_threshold): the lengths run
     # (orbits), the geometric and MEGNO decisions at each (rows: lengths, columns:
     # elongations), the verdict, and the cost in member-orbits
@@ -380,7 +381,7 @@ def overlap_threshold(system_name_or_factory: Union[str, SystemFactory], elongat
                        converged_orbits=converged_at if converged else float("nan"),
                        max_orbits=float(lengths[-1]), message=message,
                        megno_first_overlap=megno_first, member_orbits=member_orbits,
-                       coordinates=coordinates)
+                       coordinates=coordinates, method=first_sec.method)
     scan._runs = runs
     return scan
 
