@@ -70,7 +70,7 @@ nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd2l = ti.types.ndarray(dtype=ti.i64, ndim=2)
 
 
-def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER):
+def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll_components=True):
     """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion,
     integrating with ``tableau`` under the step-size policy ``controller``.
 
@@ -80,7 +80,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER):
     """
     NSTATE = model.NSTATE
     state = model.state
-    stage_point, combine, put_stage = make_primitives(tableau, NSTATE)
+    stage_point, combine, put_stage = make_primitives(tableau, NSTATE, unroll_components)
     kmat = stage_matrix_type(tableau, NSTATE)
     error_norm = make_error_norm(tableau)
     ctl = controller.funcs()
@@ -343,7 +343,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER):
 
 
 #: The 3-D model's kernels (30-number state) and the planar model's (10 numbers), Cash-Karp.
-SPATIAL = make_kernels(eom)
+SPATIAL = make_kernels(eom, unroll_components=False)
 PLANAR = make_kernels(planar)
 _KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
 
@@ -354,7 +354,7 @@ def kernels_for(model, method=DEFAULT_METHOD):
     key = (model, check_method(method))
     if key not in _KERNEL_SETS:
         _KERNEL_SETS[key] = make_kernels(planar if model == "planar" else eom, METHODS[method],
-                                         DEFAULT_CONTROLLER)
+                                         DEFAULT_CONTROLLER, unroll_components=model == "planar")
     return _KERNEL_SETS[key]
 advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs

@@ -36,7 +36,7 @@ def stage_matrix_type(tableau, n):
     return ti.types.matrix(tableau.stages, n, ti.f64)
 
 
-def make_primitives(tableau, n):
+def make_primitives(tableau, n, unroll_components=True):
     """``(stage_point, combine, put_stage)`` funcs for ``tableau`` on n-component states.
 
     * ``stage_point(y, K, h, s)``: y + h Σ_{j<s} a_sj K[j]  (s is a runtime index >= 1)
@@ -54,6 +54,18 @@ def make_primitives(tableau, n):
     E3 = tableau.e3 if tableau.e3 is not None else (0.0,) * tableau.stages
     stages = tableau.stages
 
+    unroll = bool(unroll_components)
+
+    @ti.func
+    def axpy(ys: ti.template(), w, K: ti.template(), j: ti.template()):
+        """ys += w K[j] (components unrolled, or a runtime loop that keeps K in memory)."""
+        if ti.static(unroll):
+            for c in ti.static(range(n)):
+                ys[c] += w * K[j, c]
+        else:
+            for c in range(n):
+                ys[c] += w * K[j, c]
+
     @ti.func
     def stage_point(y, K, h, s):
         ys = y
@@ -61,17 +73,19 @@ def make_primitives(tableau, n):
             if s == st:
                 for j in ti.static(range(st)):
                     if ti.static(A[st][j] != 0.0):
-                        w = A[st][j] * h
-                        for c in ti.static(range(n)):
-                            ys[c] += w * K[j, c]
+                        axpy(ys, A[st][j] * h, K, j)
         return ys
 
     @ti.func
     def put_stage(K: ti.template(), s, v):
         for st in ti.static(range(stages)):
             if s == st:
-                for c in ti.static(range(n)):
-                    K[st, c] = v[c]
+                if ti.static(unroll):
+                    for c in ti.static(range(n)):
+                        K[st, c] = v[c]
+                else:
+                    for c in range(n):
+                        K[st, c] = v[c]
 
     @ti.func
     def combine(K, h):
@@ -79,13 +93,12 @@ def make_primitives(tableau, n):
         err = ti.Vector([0.0] * n, ti.f64)
         err3 = ti.Vector([0.0] * n, ti.f64)
         for s in ti.static(range(stages)):
-            for c in ti.static(range(n)):
-                if ti.static(B[s] != 0.0):
-                    dy[c] += B[s] * K[s, c]
-                if ti.static(E[s] != 0.0):
-                    err[c] += E[s] * K[s, c]
-                if ti.static(E3[s] != 0.0):
-                    err3[c] += E3[s] * K[s, c]
+            if ti.static(B[s] != 0.0):
+                axpy(dy, B[s], K, s)
+            if ti.static(E[s] != 0.0):
+                axpy(err, E[s], K, s)
+            if ti.static(E3[s] != 0.0):
+                axpy(err3, E3[s], K, s)
         return dy * h, err * h, err3 * h
 
     return stage_point, combine, put_stage
