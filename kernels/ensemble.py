@@ -61,6 +61,11 @@ DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
 C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2
 
 NEWTON_MAX_ITER = DEFAULT_CONTROLLER.event_max_iter
+#: Largest stage matrix (stages x state components) kept in registers with unrolled
+#: component loops: Cash-Karp planar (6 x 10). Larger ones (Cash-Karp 3-D 6 x 30, DOP853
+#: 12 x 10 and 12 x 30) spill anyway, and unrolled they took 3-6x longer to compile
+#: (docs/design.md, "Compile time").
+UNROLL_LIMIT = 60
 _STEP, _LOCATE = 0, 1
 
 nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
@@ -70,15 +75,22 @@ nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd2l = ti.types.ndarray(dtype=ti.i64, ndim=2)
 
 
-def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll_components=True):
+def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll_components=None):
     """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion,
     integrating with ``tableau`` under the step-size policy ``controller``.
 
     ``model`` is a module (``eom`` for the 3-D model, ``planar`` for the planar one) that
     provides NSTATE, state, rhs, pericentre_function, pericentre_rate, osculating_elements,
     distance, P_CONTACT and P_ESCAPE. Kernels compile on first call, per model and variant.
+
+    ``unroll_components`` (default: only when the stage matrix has at most
+    ``UNROLL_LIMIT`` entries, i.e. Cash-Karp on the planar model) unrolls the stage
+    combinations over the state components so the stage matrix lives in registers; otherwise
+    they are runtime loops (``integrator.make_primitives``; docs/design.md, "Compile time").
     """
     NSTATE = model.NSTATE
+    if unroll_components is None:
+        unroll_components = tableau.stages * NSTATE <= UNROLL_LIMIT
     state = model.state
     stage_point, combine, put_stage = make_primitives(tableau, NSTATE, unroll_components)
     kmat = stage_matrix_type(tableau, NSTATE)
@@ -343,7 +355,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
 
 
 #: The 3-D model's kernels (30-number state) and the planar model's (10 numbers), Cash-Karp.
-SPATIAL = make_kernels(eom, unroll_components=False)
+SPATIAL = make_kernels(eom)
 PLANAR = make_kernels(planar)
 _KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
 
@@ -354,7 +366,7 @@ def kernels_for(model, method=DEFAULT_METHOD):
     key = (model, check_method(method))
     if key not in _KERNEL_SETS:
         _KERNEL_SETS[key] = make_kernels(planar if model == "planar" else eom, METHODS[method],
-                                         DEFAULT_CONTROLLER, unroll_components=model == "planar")
+                                         DEFAULT_CONTROLLER)
     return _KERNEL_SETS[key]
 advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs

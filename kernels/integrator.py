@@ -44,10 +44,16 @@ def make_primitives(tableau, n, unroll_components=True):
       err3 is zero (and costs nothing) for a tableau with one error estimate
     * ``put_stage(K, s, v)``: K[s] = v for a runtime s
 
-    The runtime stage index is dispatched to compile-time branches, so every access to K has
-    a constant index: K then lives in registers and the a_sj are immediates (indexing a
-    local matrix with a runtime index forces it, and a copy of the tableau, into memory on
-    every call; this alone cost about a third of the planar model's time per stage).
+    The runtime stage index is dispatched to compile-time branches, so the a_sj are
+    immediates. With ``unroll_components`` (the planar model) every access to K also has a
+    constant index, so K lives in registers (indexing a local matrix with a runtime index
+    forces it, and a copy of the tableau, into memory on every call; this alone cost about a
+    third of the planar model's time per stage). Without it (the 3-D model, 30 components)
+    each stage is one runtime loop over the components, with the stage's terms unrolled
+    inside: K stays in memory, and the kernel compiles in a fraction of the time (a 6x30 or
+    12x30 matrix of SSA values carried through the state machine is what made LLVM slow; the
+    3-D step is dominated by its right-hand side, so nothing is lost at run time). Per
+    component the operations and their order are the same either way: bit-identical results.
     """
     A = _padded_a(tableau)
     B, E = tableau.b, tableau.e
@@ -57,48 +63,69 @@ def make_primitives(tableau, n, unroll_components=True):
     unroll = bool(unroll_components)
 
     @ti.func
-    def axpy(ys: ti.template(), w, K: ti.template(), j: ti.template()):
-        """ys += w K[j] (components unrolled, or a runtime loop that keeps K in memory)."""
-        if ti.static(unroll):
-            for c in ti.static(range(n)):
-                ys[c] += w * K[j, c]
-        else:
-            for c in range(n):
-                ys[c] += w * K[j, c]
-
-    @ti.func
     def stage_point(y, K, h, s):
         ys = y
         for st in ti.static(range(1, stages)):
             if s == st:
-                for j in ti.static(range(st)):
-                    if ti.static(A[st][j] != 0.0):
-                        axpy(ys, A[st][j] * h, K, j)
+                if ti.static(unroll):   # K in registers: constant indices only
+                    for j in ti.static(range(st)):
+                        if ti.static(A[st][j] != 0.0):
+                            w = A[st][j] * h
+                            for c in ti.static(range(n)):
+                                ys[c] += w * K[j, c]
+        if ti.static(not unroll):   # runtime loops; per component the same sum, same order
+            row = ti.Vector([0.0] * stages, ti.f64)
+            for st in ti.static(range(1, stages)):
+                if s == st:
+                    row = ti.Vector(A[st], ti.f64)
+            for j in range(s):
+                a = row[j]
+                if a != 0.0:
+                    w = a * h
+                    for c in range(n):
+                        ys[c] += w * K[j, c]
         return ys
 
     @ti.func
     def put_stage(K: ti.template(), s, v):
-        for st in ti.static(range(stages)):
-            if s == st:
-                if ti.static(unroll):
+        if ti.static(unroll):
+            for st in ti.static(range(stages)):
+                if s == st:
                     for c in ti.static(range(n)):
                         K[st, c] = v[c]
-                else:
-                    for c in range(n):
-                        K[st, c] = v[c]
+        else:
+            for c in range(n):
+                K[s, c] = v[c]
 
     @ti.func
     def combine(K, h):
         dy = ti.Vector([0.0] * n, ti.f64)
         err = ti.Vector([0.0] * n, ti.f64)
         err3 = ti.Vector([0.0] * n, ti.f64)
-        for s in ti.static(range(stages)):
-            if ti.static(B[s] != 0.0):
-                axpy(dy, B[s], K, s)
-            if ti.static(E[s] != 0.0):
-                axpy(err, E[s], K, s)
-            if ti.static(E3[s] != 0.0):
-                axpy(err3, E3[s], K, s)
+        if ti.static(unroll):
+            for s in ti.static(range(stages)):
+                for c in ti.static(range(n)):
+                    if ti.static(B[s] != 0.0):
+                        dy[c] += B[s] * K[s, c]
+                    if ti.static(E[s] != 0.0):
+                        err[c] += E[s] * K[s, c]
+                    if ti.static(E3[s] != 0.0):
+                        err3[c] += E3[s] * K[s, c]
+        else:
+            for c in range(n):
+                d = 0.0
+                e = 0.0
+                e3 = 0.0
+                for s in ti.static(range(stages)):
+                    if ti.static(B[s] != 0.0):
+                        d += B[s] * K[s, c]
+                    if ti.static(E[s] != 0.0):
+                        e += E[s] * K[s, c]
+                    if ti.static(E3[s] != 0.0):
+                        e3 += E3[s] * K[s, c]
+                dy[c] = d
+                err[c] = e
+                err3[c] = e3
         return dy * h, err * h, err3 * h
 
     return stage_point, combine, put_stage

@@ -41,6 +41,7 @@ import numpy as np
 from . import runtime, section
 from ._validate import require_count
 from .ensemble import check_tolerances
+from .kernels.tableau import check_method
 
 #: Default number of chunks per worker process: enough to balance members of unequal cost
 #: (chaotic members, early escapes) without paying Taichi's per-launch overhead too often.
@@ -117,6 +118,7 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
     section.check_orbits(orbits)
     section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits)
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
+    check_method(call.arguments["method"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
                          "would share one file); failed chunks are retried instead")
