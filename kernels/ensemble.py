@@ -94,7 +94,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     state = model.state
     stage_point, combine, put_stage = make_primitives(tableau, NSTATE, unroll_components)
     kmat = stage_matrix_type(tableau, NSTATE)
-    error_norm = make_error_norm(tableau)
+    error_norm = make_error_norm(tableau, unroll_components)
     ctl = controller.funcs()
     _STAGES = tableau.stages
     _EXPONENT = tableau.error_exponent   # 1/5 for Cash-Karp (error estimate O(h^5)), 1/8 DOP853

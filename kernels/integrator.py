@@ -189,15 +189,45 @@ def _combined_norm(y, y_new, err, err3, rtol, atol, n: ti.template()):
     return worst
 
 
-def make_error_norm(tableau):
+@ti.func
+def _norm_loop(y, y_new, err, err3, rtol, atol, n: ti.template(), combined: ti.template()):
+    """:func:`error_norm` (or :func:`_combined_norm`) as a runtime loop over components: the
+    same values in the same order (max is exact), for kernels that keep states in memory."""
+    worst = 0.0
+    bad = 0
+    for k in range(n):
+        scale = atol + rtol * ti.max(ti.abs(y[k]), ti.abs(y_new[k]))
+        v = 0.0
+        if ti.static(combined):
+            e5 = err[k] / scale
+            e3 = err3[k] / scale
+            e5sq = e5 * e5
+            den = e5sq + 0.01 * e3 * e3
+            if den != 0.0:
+                v = e5sq / ti.sqrt(den)
+            if not (v <= 1e300):
+                bad = 1
+        else:
+            v = ti.abs(err[k]) / scale
+        worst = ti.max(worst, v)
+    if bad == 1 or not (worst <= 1e300):
+        worst = NONFINITE_ERROR
+    return worst
+
+
+def make_error_norm(tableau, unroll_components=True):
     """``norm(y, y_new, err, err3, rtol, atol, n)`` for ``tableau``: :func:`error_norm` of
-    ``err`` for a single estimate, the DOP853 combination when the tableau has ``e3``."""
+    ``err`` for a single estimate, the DOP853 combination when the tableau has ``e3``;
+    a runtime loop over the components unless ``unroll_components``."""
     combined = tableau.e3 is not None
+    unroll = bool(unroll_components)
 
     @ti.func
     def norm(y, y_new, err, err3, rtol, atol, n: ti.template()):
         v = 0.0
-        if ti.static(combined):
+        if ti.static(not unroll):
+            v = _norm_loop(y, y_new, err, err3, rtol, atol, n, combined)
+        elif ti.static(combined):
             v = _combined_norm(y, y_new, err, err3, rtol, atol, n)
         else:
             v = error_norm(y, y_new, err, rtol, atol, n)
