@@ -41,7 +41,6 @@ import numpy as np
 from . import runtime, section
 from ._validate import require_count
 from .ensemble import check_tolerances
-from .kernels.tableau import check_method
 
 #: Default number of chunks per worker process: enough to balance members of unequal cost
 #: (chaotic members, early escapes) without paying Taichi's per-launch overhead too often.
@@ -118,6 +117,7 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
     section.check_orbits(orbits)
     section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits)
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
+    from .kernels.tableau import check_method
     check_method(call.arguments["method"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
@@ -128,8 +128,8 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
                                                      call.arguments["order"])
     if call.arguments.get("model") == "auto":
         # decided over the whole ensemble, as one launch would, not chunk by chunk
-        from .ensemble import _choose_model
-        kwargs["model"] = _choose_model("auto", par, y0)
+        from .models import choose
+        kwargs["model"] = choose("auto", par, y0).name
     n = len(members)
     if chunk_size is None:
         workers = max(len(client.nthreads()), 1)

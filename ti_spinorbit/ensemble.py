@@ -20,8 +20,7 @@ from typing import Callable, List, Optional
 
 import numpy as np
 
-from . import planar, runtime
-from .kernels.tableau import METHODS, check_method
+from . import models, runtime
 from ._validate import (require_count, require_memory, require_positive, require_range,
                         require_real)
 
@@ -40,13 +39,8 @@ SHADOW_SEPARATION = 1e-8
 
 
 def _shadow_direction():
-    """Fixed unit direction of the initial separation: R_x, R_y, V_x, V_y and the secondary's
-    spin w2_z, so a planar start stays planar (same for every member: slot-invariant)."""
-    from .kernels import eom
-
-    u = np.zeros(eom.NSTATE)
-    u[[eom.Y_R, eom.Y_R + 1, eom.Y_V, eom.Y_V + 1, eom.Y_W2 + 2]] = 1.0
-    return u / np.linalg.norm(u)
+    """Fixed unit direction of the 3-D model's initial separation (``models.SPATIAL``)."""
+    return models.SPATIAL.shadow_direction()
 
 
 @dataclass
@@ -107,6 +101,7 @@ class Ensemble:
                  min_step=MIN_STEP, model="auto", method="cash-karp"):
         from .bodies import ROW_LENGTH
         from .kernels import eom
+        from .kernels.tableau import METHODS, check_method
 
         runtime.ensure_init()
         self.par = np.ascontiguousarray(par, dtype=np.float64)
@@ -123,12 +118,11 @@ class Ensemble:
         self.odd = bool(odd)
         self.min_step = float(min_step)
         self.method = check_method(method)
-        self.model = _choose_model(model, self.par, self.y)
-        if self.model == "planar":
-            self.kpar = planar.parameter_rows(self.par)
-            self.y = planar.to_planar(self.y)
-        else:
-            self.kpar = self.par
+        #: the model object (``ti_spinorbit.models``); ``model`` is its name
+        self.equations = models.choose(model, self.par, self.y)
+        self.model = self.equations.name
+        self.kpar = self.equations.kernel_parameters(self.par)
+        self.y = self.equations.to_kernel_state(self.y)
         n = len(self.par)
         self.n = n
         self.t = np.zeros(n)
@@ -141,12 +135,11 @@ class Ensemble:
     @property
     def kernels(self):
         """The kernel set of this ensemble's model and method (``kernels_for``)."""
-        from .kernels import ensemble as K
-        return K.kernels_for(self.model, self.method)
+        return self.equations.kernels(self.method)
 
     def spatial(self, y):
         """Kernel states of this model -> 3-D scaled states (a copy)."""
-        return planar.to_spatial(y) if self.model == "planar" else np.array(y, dtype=np.float64)
+        return self.equations.to_spatial(y)
 
     def diagnostics(self, y=None, member=None) -> np.ndarray:
         """DIAG_FIELDS (energies, angular momenta, orthonormality) of 3-D states y (default:
@@ -302,7 +295,7 @@ class Ensemble:
         kern.evaluate_rhs(self.kpar, self.y, f, self.order, self.odd)
         self.counters[:, K.C_RHS] += 1
         if indicators:
-            direction = planar.shadow_direction() if self.model == "planar" else _shadow_direction()
+            direction = self.equations.shadow_direction()
             shadow = self.y + separation * direction
             shadow_f = np.zeros_like(shadow)
             kern.evaluate_rhs(self.kpar, shadow, shadow_f, self.order, self.odd)
@@ -336,9 +329,9 @@ class Ensemble:
         if not chunks:
             return np.zeros((0, K.RECORD_WIDTH))
         rec = np.concatenate(chunks)
-        if self.model != "planar":
+        if self.equations is models.SPATIAL:
             return rec
-        return np.concatenate([rec[:, :1], planar.to_spatial(rec[:, 1:])], axis=1)
+        return np.concatenate([rec[:, :1], self.equations.to_spatial(rec[:, 1:])], axis=1)
 
 
 def _next_span(span, seconds, window):
@@ -366,18 +359,8 @@ def _record_bytes(t_stop, sample_dt, width, cap):
 
 
 def _choose_model(model, par, y0):
-    """"planar" or "3d" for Ensemble(model=...)."""
-    if model not in ("auto", "planar", "3d"):
-        raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
-    if model == "3d":
-        return "3d"
-    ok = planar.qualifies(par, y0)
-    if model == "planar" and not np.all(ok):
-        bad = np.nonzero(~ok)[0]
-        raise ValueError(f"model='planar' needs planar starts and bodies symmetric about their "
-                         f"equators; members {bad[:10].tolist()} do not qualify (use "
-                         "model='3d' or 'auto')")
-    return "planar" if np.all(ok) else "3d"
+    """"planar" or "3d" for Ensemble(model=...) (the name of ``models.choose``)."""
+    return models.choose(model, par, y0).name
 
 
 def _odd_columns(row_length):
