@@ -15,7 +15,7 @@ Decisions:
   them in place.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 from typing import Callable, List, Optional
 
 import numpy as np
@@ -59,6 +59,50 @@ class RunOutput:
     seconds: float = 0.0
     megno: Optional[np.ndarray] = None      # (N,) MEGNO <Y> at the final time (indicators on)
     lyapunov: Optional[np.ndarray] = None   # (N,) finite-time max Lyapunov exponent, 1/orbit
+
+
+@dataclass
+class RunState:
+    """Everything a run carries between windows: the arrays a checkpoint holds
+    (``checkpoint._ARRAYS``: kernel-layout states, times with their Kahan compensations,
+    step proposals, status, counters, first-stage derivatives, sampling clock, shadow state
+    and indicator sums, diagnostics at t = 0), the records so far and the bookkeeping.
+    :meth:`launch` is the one place that hands them to the ``advance`` kernel, in its order."""
+
+    y: np.ndarray              # (N, nstate) kernel-layout state
+    t: np.ndarray              # (N,) scaled time
+    h: np.ndarray              # (N,) step proposal
+    status: np.ndarray         # (N,) int32, kernels.ensemble.STATUS_NAMES
+    counters: np.ndarray       # (N, 3) int64 accepted, rejected, RHS calls
+    yc: np.ndarray             # Kahan compensation of y
+    tc: np.ndarray             # Kahan compensation of t
+    f: np.ndarray              # dy/dt at (t, y): the next step's first stage
+    next_sample: np.ndarray    # (N,) next sample time (zeros without sampling)
+    shadow: np.ndarray         # (N, nstate) shadow state ((1, nstate) without indicators)
+    shadow_f: np.ndarray       # its derivative
+    ind: np.ndarray            # (N, 3) log-growth sums for the Lyapunov exponent and MEGNO
+    diag_start: np.ndarray     # (N, 14) DIAG_FIELDS at t = 0
+    events: list = field(default_factory=list)    # per member: list of record chunks
+    samples: list = field(default_factory=list)
+    launches: int = 0
+    seconds: float = 0.0
+    records_sha256: list = field(default_factory=list)   # digests (checkpoint.save)
+
+    def as_dict(self):
+        """The fields as a dict (the arrays themselves, not copies), for checkpoint.save."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
+
+    def launch(self, kern, par, t_end, t_stop, events_buf, n_events, samples_buf, n_samples,
+               rtol, atol, min_step, sample_dt, separation, order, odd, sampling, indicators):
+        """One ``advance`` launch on this state (updated in place)."""
+        kern.advance(par, self.y, self.yc, self.f, self.t, self.tc, self.h, t_end, t_stop,
+                     self.status, self.counters, events_buf, n_events, samples_buf, n_samples,
+                     self.next_sample, self.shadow, self.shadow_f, self.ind, rtol, atol,
+                     min_step, sample_dt, separation, order, odd, sampling, indicators)
 
 
 def check_tolerances(rtol, atol):
@@ -229,29 +273,27 @@ class Ensemble:
         if st is None:
             st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
         else:
-            for name in ("y", "t", "h", "status", "counters"):
-                setattr(self, name, st.pop(name))
-        st.setdefault("records_sha256", [])   # digests of the records files (checkpoint.save)
+            st = RunState.from_dict(st)
+            for name in ("y", "t", "h", "status", "counters"):   # the same arrays
+                setattr(self, name, getattr(st, name))
         scap = int(np.ceil(window / sample_dt)) + 4 if sampling else 1
         events_buf = np.zeros((n, cap, kern.RECORD_WIDTH))
         samples_buf = np.zeros((n, scap, kern.RECORD_WIDTH))
         n_events = np.zeros(n, dtype=np.int32)
         n_samples = np.zeros(n, dtype=np.int32)
-        events, samples = st["events"], st["samples"]
+        events, samples = st.events, st.samples
         # records not yet in the checkpoint (a fresh run's first sample is the initial state)
-        pending = {"events": {}, "samples": {} if st["launches"] else
+        pending = {"events": {}, "samples": {} if st.launches else
                    {i: list(s) for i, s in enumerate(samples) if s}}
-        t0 = time.perf_counter() - st["seconds"]
+        t0 = time.perf_counter() - st.seconds
         span = min(window, 2.0 * np.pi)  # first window: one orbit, then adapted to wall time
         while np.any(self.status == K.RUNNING):
             t_end = np.minimum(t_stop, self.t + span)
             launched = time.perf_counter()
-            kern.advance(self.kpar, self.y, st["yc"], st["f"], self.t, st["tc"], self.h, t_end,
-                         t_stop, self.status, self.counters, events_buf, n_events, samples_buf,
-                         n_samples, st["next_sample"], st["shadow"], st["shadow_f"], st["ind"],
-                         self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
-                         float(separation), self.order, self.odd, sampling, bool(indicators))
-            st["launches"] += 1
+            st.launch(kern, self.kpar, t_end, t_stop, events_buf, n_events, samples_buf,
+                      n_samples, self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
+                      float(separation), self.order, self.odd, sampling, bool(indicators))
+            st.launches += 1
             # the kernel's time only: draining and checkpointing do not shrink with the span
             span = _next_span(span, time.perf_counter() - launched, window)
             for name, store, buf, count in (("events", events, events_buf, n_events),
@@ -264,29 +306,28 @@ class Ensemble:
             n_samples[:] = 0
             finished = (self.status == K.RUNNING) & (self.t >= t_stop)
             self.status[finished] = K.DONE
-            st["seconds"] = time.perf_counter() - t0
+            st.seconds = time.perf_counter() - t0
             if checkpoint is not None:
-                ckpt.save(checkpoint, settings, fingerprint,
-                          dict(st, y=self.y, t=self.t, h=self.h, status=self.status,
-                               counters=self.counters), pending)
+                ckpt.save(checkpoint, settings, fingerprint, st.as_dict(), pending)
             pending = {"events": {}, "samples": {}}
             if progress is not None:
                 progress(float(np.mean(np.minimum(self.t, t_stop)) / np.mean(t_stop)))
         megno = lyapunov = np.full(n, np.nan)
         if indicators:
-            ind = st["ind"]
+            ind = st.ind
             with np.errstate(divide="ignore", invalid="ignore"):
                 megno = ind[:, 2] / self.t
                 lyapunov = ind[:, 0] / self.t * 2.0 * np.pi   # per orbit (2π scaled time)
         return RunOutput(
             events=[self._spatial_records(e) for e in events],
             samples=[self._spatial_records(s) for s in samples],
-            diag_start=st["diag_start"], diag_end=self.diagnostics(), t=self.t.copy(),
+            diag_start=st.diag_start, diag_end=self.diagnostics(), t=self.t.copy(),
             y=self.spatial(self.y), status=self.status.copy(), counters=self.counters.copy(),
-            launches=st["launches"], seconds=st["seconds"], megno=megno, lyapunov=lyapunov)
+            launches=st.launches, seconds=st.seconds, megno=megno, lyapunov=lyapunov)
 
     def _fresh_run_state(self, sampling, sample_dt, indicators, separation):
-        """Everything a run carries between windows besides y, t, h, status, counters."""
+        """The :class:`RunState` of a run from the start (y, t, h, status, counters are this
+        ensemble's own arrays)."""
         from .kernels import ensemble as K
 
         kern = self.kernels
@@ -307,11 +348,12 @@ class Ensemble:
         if sampling:  # the first sample is the initial state
             for i in range(n):
                 samples[i].append(np.concatenate([[0.0], self.y[i]])[None])
-        return {"yc": np.zeros_like(self.y), "tc": np.zeros(n), "f": f,
-                "next_sample": np.full(n, float(sample_dt)) if sampling else np.zeros(n),
-                "shadow": shadow, "shadow_f": shadow_f, "ind": ind,
-                "events": [[] for _ in range(n)], "samples": samples,
-                "diag_start": self.diagnostics(), "launches": 0, "seconds": 0.0}
+        return RunState(y=self.y, t=self.t, h=self.h, status=self.status,
+                        counters=self.counters, yc=np.zeros_like(self.y), tc=np.zeros(n), f=f,
+                        next_sample=np.full(n, float(sample_dt)) if sampling else np.zeros(n),
+                        shadow=shadow, shadow_f=shadow_f, ind=ind,
+                        events=[[] for _ in range(n)], samples=samples,
+                        diag_start=self.diagnostics(), launches=0, seconds=0.0)
 
     def _fingerprint(self, t_stop):
         """Digest of what determines a run's results (inputs at the start of the run)."""
