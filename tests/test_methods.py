@@ -15,6 +15,8 @@ import ti_spinorbit as tso
 from ti_spinorbit.checkpoint import CheckpointError
 from ti_spinorbit.ensemble import Ensemble
 
+from conftest import run_cli
+
 ORBITS = 5
 T_STOP = 2.0 * np.pi * ORBITS
 SPINS = (0.9, 1.3, 2.1, 0.5)
@@ -140,3 +142,22 @@ def test_dop853_resume_equals_uninterrupted(members, tmp_path):
         assert np.array_equal(getattr(resumed, name), getattr(whole, name)), name
     for a, b in zip(resumed.events, whole.events):
         assert np.array_equal(a, b)
+
+
+def test_entry_points_forward_the_method(vh):
+    """chaos_map and libration_amplitude pass method= down to every launch."""
+    cmap = tso.chaos_map(vh, [0.0, 90.0], [1.3], orbits=2, method="dop853", fraction_orbits=())
+    assert cmap.method == "dop853" and cmap.section.method == "dop853"
+    amp = {m: tso.libration_amplitude(vh, [0.95], orbits=2, samples_per_orbit=32, rtol=1e-11,
+                                      method=m) for m in ("cash-karp", "dop853")}
+    assert np.all(np.isfinite(amp["dop853"]))
+    assert np.allclose(amp["dop853"], amp["cash-karp"], atol=1e-5), amp
+
+
+def test_cli_method_flag(tmp_path):
+    p = run_cli("section", "--system", "1991 VH", "--thetadot", "1.3", "--orbits", "2",
+                "--method", "dop853", "--quiet", "--out", str(tmp_path / "s.png"), cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert tso.io.read_metadata(tmp_path / "s.npz")["method"] == "dop853"
+    bad = run_cli("section", "--method", "rk4", cwd=tmp_path)
+    assert bad.returncode == 2 and "--method: invalid choice: 'rk4'" in bad.stderr
