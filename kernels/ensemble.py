@@ -100,6 +100,77 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     _EXPONENT = tableau.error_exponent   # 1/5 for Cash-Karp (error estimate O(h^5)), 1/8 DOP853
 
     @ti.func
+    def _trial_size(h, t, ts, t_sample, sampling: ti.template()):
+        """Size of the next trial step from t with proposal h, shortened to land on the hard
+        end ts or (``sampling``) on the next sample time: (hs, hit_end, hit_sample)."""
+        hs = h
+        hit_end = 0
+        hit_sample = 0
+        if ts - t <= hs:
+            hs = ts - t
+            hit_end = 1
+        if ti.static(sampling):
+            if t_sample - t <= hs:
+                hs = t_sample - t
+                hit_sample = 1
+                hit_end = 0
+                if ts - t <= hs:
+                    hit_end = 1
+        return hs, hit_end, hit_sample
+
+    @ti.func
+    def _newton_tau(y_tau, f_tau, tau, h_step):
+        """One Newton iterate for the event time τ in [0, h_step] from the state y(τ) and
+        its derivative: τ − g/g' with g the pericentre function."""
+        g = model.pericentre_function(y_tau)
+        gp = model.pericentre_rate(y_tau, f_tau)
+        return ti.min(h_step, ti.max(0.0, tau - g / gp))
+
+    @ti.func
+    def _renormalised_shadow(y, ys_try, fy, f_s1, d0):
+        """The shadow's log growth over the step and its state and derivative renormalised
+        to the separation d0 (the derivative rescaled linearly: exact to O(d0²)), and
+        whether it moved at all: (dl, y_s, f_s, grew)."""
+        delta = ys_try - y
+        d = delta.norm()
+        dl = 0.0
+        y_s = ys_try
+        f_s = f_s1
+        grew = 0
+        if d > 0.0:
+            dl = ti.log(d / d0)
+            scale = d0 / d
+            y_s = y + delta * scale
+            f_s = fy + (f_s1 - fy) * scale
+            grew = 1
+        return dl, y_s, f_s, grew
+
+    @ti.func
+    def _kahan_add(x, comp, dx):
+        """x + dx with Kahan compensation comp (the true sum is x - comp): (sum, new comp)."""
+        xk = dx - comp
+        xsum = x + xk
+        return xsum, (xsum - x) - xk
+
+    @ti.func
+    def _stop_status(par: ti.template(), i, y):
+        """RUNNING, or why member i stops at the accepted state y: non-finite, collision
+        (distance at most P_CONTACT), escape (beyond P_ESCAPE, or unbound and receding)."""
+        st = RUNNING
+        r = model.distance(y)
+        if not (r == r):
+            st = NONFINITE
+        elif r <= par[i, model.P_CONTACT]:
+            st = COLLISION
+        elif r >= par[i, model.P_ESCAPE]:
+            st = ESCAPE
+        else:
+            a_osc, e_osc = model.osculating_elements(y)
+            if a_osc < 0.0 and model.pericentre_function(y) > 0.0:
+                st = ESCAPE                     # unbound and receding
+        return st
+
+    @ti.func
     def _load(a: ti.template(), i):
         y = state(0.0)
         for k in ti.static(range(NSTATE)):
@@ -182,19 +253,8 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 it = 0
                 while st == RUNNING and t < te and nev < cap and nsm < scap:
                     if new_attempt == 1:         # a new trial step from (t, y) with proposal h
-                        hs = h
-                        hit_end = 0
-                        hit_sample = 0
-                        if ts - t <= hs:
-                            hs = ts - t
-                            hit_end = 1
-                        if ti.static(sampling):
-                            if next_sample[i] - t <= hs:
-                                hs = next_sample[i] - t
-                                hit_sample = 1
-                                hit_end = 0
-                                if ts - t <= hs:
-                                    hit_end = 1
+                        hs, hit_end, hit_sample = _trial_size(h, t, ts, next_sample[i],
+                                                              sampling)
                         stage = 1
                         new_attempt = 0
                     copies = 1
@@ -254,9 +314,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                         else:
                             do_accept = 1
                     else:                                       # Newton iterate at y_try = y(τ)
-                        g = model.pericentre_function(y_try)
-                        gp = model.pericentre_rate(y_try, fy)
-                        new_tau = ti.min(hs_acc, ti.max(0.0, tau - g / gp))
+                        new_tau = _newton_tau(y_try, fy, tau, hs_acc)
                         it += 1
                         if ctl.event_converged(new_tau, tau, hs_acc, it):
                             _record(events, i, nev, t - tc + tau, y_try)   # Kahan: true t = t - tc
@@ -273,14 +331,8 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                             stage = 1
                     if do_accept == 1:
                         t_mid = t + 0.5 * hs
-                        yk = dy - yc                            # Kahan-compensated y += dy
-                        ysum = y + yk
-                        yc = (ysum - y) - yk
-                        y = ysum
-                        tk = hs - tc                            # and t += hs
-                        tsum = t + tk
-                        tc = (tsum - t) - tk
-                        t = tsum
+                        y, yc = _kahan_add(y, yc, dy)           # Kahan-compensated y += dy
+                        t, tc = _kahan_add(t, tc, hs)           # and t += hs
                         if hit_sample == 1 or hit_end == 1:     # landed on a grid time: exact
                             tc = 0.0
                             t = ti.select(hit_end == 1, ts, next_sample[i])
@@ -288,19 +340,15 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                         for c in ti.static(range(NSTATE)):
                             K[0, c] = fy[c]
                         if ti.static(indicators):
-                            # separation growth over the step, then renormalise to d0 (the
-                            # shadow's derivative is rescaled linearly: exact to O(d0²))
-                            delta = ys_try - y
-                            d = delta.norm()
-                            if d > 0.0:
-                                dl = ti.log(d / d0)
+                            dl, ys_new, fs_new, grew = _renormalised_shadow(y, ys_try, fy, f_s1,
+                                                                            d0)
+                            if grew == 1:
                                 ell += dl
                                 s_weighted += t_mid * dl
                                 ybar_int += 2.0 * s_weighted / t * hs
-                                scale = d0 / d
-                                y_s = y + delta * scale
+                                y_s = ys_new
                                 for c in ti.static(range(NSTATE)):
-                                    K2[0, c] = fy[c] + (f_s1[c] - fy[c]) * scale
+                                    K2[0, c] = fs_new[c]
                         acc += 1
                         # (a step shortened for a sample or the end that did well keeps h)
                         h = ctl.accepted(h, hs, en, after_reject, hit_end == 1 or hit_sample == 1,
@@ -312,17 +360,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 _record(samples, i, nsm, t, y)
                                 nsm += 1
                                 next_sample[i] += sample_dt
-                        r = model.distance(y)
-                        if not (r == r):
-                            st = NONFINITE
-                        elif r <= par[i, model.P_CONTACT]:
-                            st = COLLISION
-                        elif r >= par[i, model.P_ESCAPE]:
-                            st = ESCAPE
-                        else:
-                            a_osc, e_osc = model.osculating_elements(y)
-                            if a_osc < 0.0 and model.pericentre_function(y) > 0.0:
-                                st = ESCAPE                     # unbound and receding
+                        st = _stop_status(par, i, y)
                 _store(y_nd, i, y)
                 _store(yc_nd, i, yc)
                 _store(f_nd, i, f0)
