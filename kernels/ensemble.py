@@ -1,4 +1,8 @@
-"""Ensemble kernels: every member advances with its own adaptive Cash-Karp loop in one launch.
+"""Ensemble kernels: every member advances with its own adaptive Runge-Kutta loop in one launch.
+
+The method (a ``tableau.Tableau``: Cash-Karp 4(5), the default, or DOP853) and the step-size
+policy (a ``controller.Controller``) are arguments of the kernel factory :func:`make_kernels`;
+:func:`kernels_for` builds and caches one kernel set per (model, method).
 
 One launch of :func:`advance` takes each running member from its current time until its
 first accepted step that reaches ``t_end[i]`` (a soft window end: steps are never shortened
@@ -7,7 +11,7 @@ end: the last step lands on it exactly). On the way it records
 
 * pericentre crossings (osculating true anomaly through 0, i.e. g = R·V changing sign from
   − to +): time and full state at the crossing. The crossing is located inside the accepted
-  step by Newton iteration on g(τ), where the state at τ comes from a Cash-Karp step of
+  step by Newton iteration on g(τ), where the state at τ comes from a step of the same method of
   length τ from the step start, so event states carry the integrator's own local accuracy
   (near the tolerance), not an interpolant's;
 * optionally (``sampling``), time and state on a regular time grid (steps are shortened to
@@ -34,10 +38,10 @@ import taichi as ti
 
 from . import eom, planar
 from .eom import NSTATE
-from .integrator import (NONFINITE_ERROR, error_norm, make_primitives, stage_matrix_type,
-                         step_factor)
+from .controller import DEFAULT_CONTROLLER, NONFINITE_ERROR
+from .integrator import make_error_norm, make_primitives, stage_matrix_type
 from .potential import mutual, vec3
-from .tableau import CASH_KARP
+from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 
 RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE = range(6)
 #: Set on the host only, after a run, by the accuracy check (ti_spinorbit.accuracy): a
@@ -56,9 +60,12 @@ DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
 # Counter columns.
 C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2
 
-NEWTON_MAX_ITER = 8
-_STAGES = CASH_KARP.stages
-_EXPONENT = 1.0 / CASH_KARP.order  # controller exponent: the error estimate is O(h^5)
+NEWTON_MAX_ITER = DEFAULT_CONTROLLER.event_max_iter
+#: Largest stage matrix (stages x state components) kept in registers with unrolled
+#: component loops: Cash-Karp planar (6 x 10). Larger ones (Cash-Karp 3-D 6 x 30, DOP853
+#: 12 x 10 and 12 x 30) spill anyway, and unrolled they took 3-6x longer to compile
+#: (docs/design.md, "Compile time").
+UNROLL_LIMIT = 60
 _STEP, _LOCATE = 0, 1
 
 nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
@@ -68,17 +75,100 @@ nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd2l = ti.types.ndarray(dtype=ti.i64, ndim=2)
 
 
-def make_kernels(model):
-    """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion.
+def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll_components=None):
+    """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion,
+    integrating with ``tableau`` under the step-size policy ``controller``.
 
     ``model`` is a module (``eom`` for the 3-D model, ``planar`` for the planar one) that
     provides NSTATE, state, rhs, pericentre_function, pericentre_rate, osculating_elements,
     distance, P_CONTACT and P_ESCAPE. Kernels compile on first call, per model and variant.
+
+    ``unroll_components`` (default: only when the stage matrix has at most
+    ``UNROLL_LIMIT`` entries, i.e. Cash-Karp on the planar model) unrolls the stage
+    combinations over the state components so the stage matrix lives in registers; otherwise
+    they are runtime loops (``integrator.make_primitives``; docs/design.md, "Compile time").
     """
     NSTATE = model.NSTATE
+    if unroll_components is None:
+        unroll_components = tableau.stages * NSTATE <= UNROLL_LIMIT
     state = model.state
-    stage_point, combine, put_stage = make_primitives(CASH_KARP, NSTATE)
-    kmat = stage_matrix_type(CASH_KARP, NSTATE)
+    stage_point, combine, put_stage = make_primitives(tableau, NSTATE, unroll_components)
+    kmat = stage_matrix_type(tableau, NSTATE)
+    error_norm = make_error_norm(tableau, unroll_components)
+    ctl = controller.funcs()
+    _STAGES = tableau.stages
+    _EXPONENT = tableau.error_exponent   # 1/5 for Cash-Karp (error estimate O(h^5)), 1/8 DOP853
+
+    @ti.func
+    def _trial_size(h, t, ts, t_sample, sampling: ti.template()):
+        """Size of the next trial step from t with proposal h, shortened to land on the hard
+        end ts or (``sampling``) on the next sample time: (hs, hit_end, hit_sample)."""
+        hs = h
+        hit_end = 0
+        hit_sample = 0
+        if ts - t <= hs:
+            hs = ts - t
+            hit_end = 1
+        if ti.static(sampling):
+            if t_sample - t <= hs:
+                hs = t_sample - t
+                hit_sample = 1
+                hit_end = 0
+                if ts - t <= hs:
+                    hit_end = 1
+        return hs, hit_end, hit_sample
+
+    @ti.func
+    def _newton_tau(y_tau, f_tau, tau, h_step):
+        """One Newton iterate for the event time τ in [0, h_step] from the state y(τ) and
+        its derivative: τ − g/g' with g the pericentre function."""
+        g = model.pericentre_function(y_tau)
+        gp = model.pericentre_rate(y_tau, f_tau)
+        return ti.min(h_step, ti.max(0.0, tau - g / gp))
+
+    @ti.func
+    def _renormalised_shadow(y, ys_try, fy, f_s1, d0):
+        """The shadow's log growth over the step and its state and derivative renormalised
+        to the separation d0 (the derivative rescaled linearly: exact to O(d0²)), and
+        whether it moved at all: (dl, y_s, f_s, grew)."""
+        delta = ys_try - y
+        d = delta.norm()
+        dl = 0.0
+        y_s = ys_try
+        f_s = f_s1
+        grew = 0
+        if d > 0.0:
+            dl = ti.log(d / d0)
+            scale = d0 / d
+            y_s = y + delta * scale
+            f_s = fy + (f_s1 - fy) * scale
+            grew = 1
+        return dl, y_s, f_s, grew
+
+    @ti.func
+    def _kahan_add(x, comp, dx):
+        """x + dx with Kahan compensation comp (the true sum is x - comp): (sum, new comp)."""
+        xk = dx - comp
+        xsum = x + xk
+        return xsum, (xsum - x) - xk
+
+    @ti.func
+    def _stop_status(par: ti.template(), i, y):
+        """RUNNING, or why member i stops at the accepted state y: non-finite, collision
+        (distance at most P_CONTACT), escape (beyond P_ESCAPE, or unbound and receding)."""
+        st = RUNNING
+        r = model.distance(y)
+        if not (r == r):
+            st = NONFINITE
+        elif r <= par[i, model.P_CONTACT]:
+            st = COLLISION
+        elif r >= par[i, model.P_ESCAPE]:
+            st = ESCAPE
+        else:
+            a_osc, e_osc = model.osculating_elements(y)
+            if a_osc < 0.0 and model.pericentre_function(y) > 0.0:
+                st = ESCAPE                     # unbound and receding
+        return st
 
     @ti.func
     def _load(a: ti.template(), i):
@@ -163,19 +253,8 @@ def make_kernels(model):
                 it = 0
                 while st == RUNNING and t < te and nev < cap and nsm < scap:
                     if new_attempt == 1:         # a new trial step from (t, y) with proposal h
-                        hs = h
-                        hit_end = 0
-                        hit_sample = 0
-                        if ts - t <= hs:
-                            hs = ts - t
-                            hit_end = 1
-                        if ti.static(sampling):
-                            if next_sample[i] - t <= hs:
-                                hs = next_sample[i] - t
-                                hit_sample = 1
-                                hit_end = 0
-                                if ts - t <= hs:
-                                    hit_end = 1
+                        hs, hit_end, hit_sample = _trial_size(h, t, ts, next_sample[i],
+                                                              sampling)
                         stage = 1
                         new_attempt = 0
                     copies = 1
@@ -205,19 +284,16 @@ def make_kernels(model):
                         put_stage(K, stage, fy)
                         stage += 1
                         if stage == _STAGES:
-                            dy, err = combine(K, hs)
+                            dy, err, err3 = combine(K, hs)
                             y_try = y + dy
                             if ti.static(indicators):
                                 if mode == _STEP:
-                                    dy_s, err_s = combine(K2, hs)
+                                    dy_s, err_s, err3_s = combine(K2, hs)
                                     ys_try = y_s + dy_s
-                            en = error_norm(y, y_try, err, rtol, atol, NSTATE)
+                            en = error_norm(y, y_try, err, err3, rtol, atol, NSTATE)
                             if mode == _STEP and en > 1.0:
                                 rej += 1
-                                if en >= NONFINITE_ERROR:
-                                    h = hs * 0.2
-                                else:
-                                    h = hs * step_factor(en, 1, _EXPONENT)
+                                h = ctl.rejected(hs, en, _EXPONENT)
                                 after_reject = 1
                                 new_attempt = 1
                                 if h < min_step:
@@ -238,11 +314,9 @@ def make_kernels(model):
                         else:
                             do_accept = 1
                     else:                                       # Newton iterate at y_try = y(τ)
-                        g = model.pericentre_function(y_try)
-                        gp = model.pericentre_rate(y_try, fy)
-                        new_tau = ti.min(hs_acc, ti.max(0.0, tau - g / gp))
+                        new_tau = _newton_tau(y_try, fy, tau, hs_acc)
                         it += 1
-                        if ti.abs(new_tau - tau) <= 4e-16 * hs_acc or it >= NEWTON_MAX_ITER:
+                        if ctl.event_converged(new_tau, tau, hs_acc, it):
                             _record(events, i, nev, t - tc + tau, y_try)   # Kahan: true t = t - tc
                             nev += 1
                             mode = _STEP
@@ -257,14 +331,8 @@ def make_kernels(model):
                             stage = 1
                     if do_accept == 1:
                         t_mid = t + 0.5 * hs
-                        yk = dy - yc                            # Kahan-compensated y += dy
-                        ysum = y + yk
-                        yc = (ysum - y) - yk
-                        y = ysum
-                        tk = hs - tc                            # and t += hs
-                        tsum = t + tk
-                        tc = (tsum - t) - tk
-                        t = tsum
+                        y, yc = _kahan_add(y, yc, dy)           # Kahan-compensated y += dy
+                        t, tc = _kahan_add(t, tc, hs)           # and t += hs
                         if hit_sample == 1 or hit_end == 1:     # landed on a grid time: exact
                             tc = 0.0
                             t = ti.select(hit_end == 1, ts, next_sample[i])
@@ -272,23 +340,19 @@ def make_kernels(model):
                         for c in ti.static(range(NSTATE)):
                             K[0, c] = fy[c]
                         if ti.static(indicators):
-                            # separation growth over the step, then renormalise to d0 (the
-                            # shadow's derivative is rescaled linearly: exact to O(d0²))
-                            delta = ys_try - y
-                            d = delta.norm()
-                            if d > 0.0:
-                                dl = ti.log(d / d0)
+                            dl, ys_new, fs_new, grew = _renormalised_shadow(y, ys_try, fy, f_s1,
+                                                                            d0)
+                            if grew == 1:
                                 ell += dl
                                 s_weighted += t_mid * dl
                                 ybar_int += 2.0 * s_weighted / t * hs
-                                scale = d0 / d
-                                y_s = y + delta * scale
+                                y_s = ys_new
                                 for c in ti.static(range(NSTATE)):
-                                    K2[0, c] = fy[c] + (f_s1[c] - fy[c]) * scale
+                                    K2[0, c] = fs_new[c]
                         acc += 1
-                        fac = step_factor(en, after_reject, _EXPONENT)
-                        if not ((hit_end == 1 or hit_sample == 1) and hs < h and fac >= 1.0):
-                            h = hs * fac                        # (a shortened step that did well keeps h)
+                        # (a step shortened for a sample or the end that did well keeps h)
+                        h = ctl.accepted(h, hs, en, after_reject, hit_end == 1 or hit_sample == 1,
+                                         _EXPONENT)
                         after_reject = 0
                         new_attempt = 1
                         if ti.static(sampling):
@@ -296,17 +360,7 @@ def make_kernels(model):
                                 _record(samples, i, nsm, t, y)
                                 nsm += 1
                                 next_sample[i] += sample_dt
-                        r = model.distance(y)
-                        if not (r == r):
-                            st = NONFINITE
-                        elif r <= par[i, model.P_CONTACT]:
-                            st = COLLISION
-                        elif r >= par[i, model.P_ESCAPE]:
-                            st = ESCAPE
-                        else:
-                            a_osc, e_osc = model.osculating_elements(y)
-                            if a_osc < 0.0 and model.pericentre_function(y) > 0.0:
-                                st = ESCAPE                     # unbound and receding
+                        st = _stop_status(par, i, y)
                 _store(y_nd, i, y)
                 _store(yc_nd, i, yc)
                 _store(f_nd, i, f0)
@@ -334,12 +388,24 @@ def make_kernels(model):
             _store(out, i, model.rhs(par, i, _load(y_nd, i), order, odd))
 
     return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, load=_load,
-                           NSTATE=NSTATE, RECORD_WIDTH=1 + NSTATE, model=model)
+                           NSTATE=NSTATE, RECORD_WIDTH=1 + NSTATE, model=model,
+                           tableau=tableau, controller=controller)
 
 
-#: The 3-D model's kernels (30-number state) and the planar model's (10 numbers).
+#: The 3-D model's kernels (30-number state) and the planar model's (10 numbers), Cash-Karp.
 SPATIAL = make_kernels(eom)
 PLANAR = make_kernels(planar)
+_KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
+
+
+def kernels_for(model, method=DEFAULT_METHOD):
+    """The kernel set of ``model`` ("planar" or "3d") integrating with ``method`` (a name of
+    ``tableau.METHODS``), built once per process (Taichi compiles each on first launch)."""
+    key = (model, check_method(method))
+    if key not in _KERNEL_SETS:
+        _KERNEL_SETS[key] = make_kernels(planar if model == "planar" else eom, METHODS[method],
+                                         DEFAULT_CONTROLLER)
+    return _KERNEL_SETS[key]
 advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs
 

@@ -1,12 +1,17 @@
-"""The Cash-Karp 4(5) tableau (kernels/tableau.py) and the generic Taichi step built from it
-(kernels/integrator.py, ``make_step``).
+"""The Cash-Karp 4(5) and DOP853 8(5,3) tableaux (kernels/tableau.py) and the generic Taichi
+step built from them (kernels/integrator.py, ``make_step``).
 
 * Exact identities and every Butcher order condition (all rooted trees) in rational
   arithmetic: order 5 for the propagated weights b, order 4 (and not 5) for the embedded b̂.
 * The compiled step on the Kepler problem (nonlinear system, exact solution from Kepler's
   equation): global error slope 5 on a log–log fit, and the embedded error estimate scales
   like h^5 and matches the true local error of the 4th-order solution.
+* DOP853: every order condition up to order 8 for b (200 trees), 5 for b̂ = b − e5, 3 for
+  b̂3, to 1e-25 (the published decimals carry 28–30 digits), and not order 9; the compiled
+  step's global error slope 8 on the Kepler problem and its 5th-order estimate's slope 6.
 """
+
+import functools
 
 import math
 from fractions import Fraction
@@ -17,7 +22,8 @@ import taichi as ti
 
 from ti_spinorbit import runtime
 from ti_spinorbit.kernels.integrator import make_step
-from ti_spinorbit.kernels.tableau import CASH_KARP, CASH_KARP_EXACT, Tableau
+from ti_spinorbit.kernels.tableau import (CASH_KARP, CASH_KARP_EXACT, DOP853, DOP853_EXACT,
+                                          METHODS, Tableau)
 
 EXACT_A, EXACT_B, EXACT_B_HAT, EXACT_C = (CASH_KARP_EXACT[k] for k in ("a", "b", "b_hat", "c"))
 STAGES = len(EXACT_B)
@@ -49,18 +55,20 @@ def density(tree):
     return tree_order(tree) * math.prod(density(c) for c in tree)
 
 
+@functools.lru_cache(maxsize=None)
 def stage_weights(tree, a):
     """Φ(t) per stage: Π over the root's children u of (A Φ(u)); the single node gives 1."""
-    phi = [Fraction(1)] * STAGES
+    stages = len(a)
+    phi = [Fraction(1)] * stages
     for child in tree:
         inner = stage_weights(child, a)
         phi = [phi[i] * sum((a[i][j] * inner[j] for j in range(i)), Fraction(0))
-               for i in range(STAGES)]
-    return phi
+               for i in range(stages)]
+    return tuple(phi)
 
 
-def condition_residual(tree, weights):
-    return sum(w * p for w, p in zip(weights, stage_weights(tree, EXACT_A))) - Fraction(1, density(tree))
+def condition_residual(tree, weights, a=EXACT_A):
+    return sum(w * p for w, p in zip(weights, stage_weights(tree, a))) - Fraction(1, density(tree))
 
 
 def tree_name(tree):
@@ -250,3 +258,76 @@ def test_local_error_estimate(cash_karp_steps):
     ratio = est / true4
     assert np.all((ratio > 0.9) & (ratio < 1.1)), ratio
     assert np.all(true5 < 0.3 * est), true5 / est
+
+
+# ---- DOP853 ------------------------------------------------------------------------------------
+DOP_A = DOP853_EXACT["a"]
+DOP_TOL = Fraction(1, 10**25)
+TREES_UP_TO_8 = [t for n in range(1, 9) for t in trees_of_order(n)]
+
+
+def test_dop853_exact_identities():
+    E = DOP853_EXACT
+    assert len(E["b"]) == DOP853.stages == 12 and [len(r) for r in DOP_A] == list(range(12))
+    assert all(isinstance(x, Fraction) for x in E["b"] + E["b_hat"] + E["b_hat3"] + E["c"])
+    for w in ("b", "b_hat", "b_hat3"):
+        assert abs(sum(E[w]) - 1) < DOP_TOL, w
+    for row, c in zip(DOP_A, E["c"]):
+        assert abs(sum(row, Fraction(0)) - c) < DOP_TOL
+    assert E["c"][-1] == 1 and E["b"][1:5] == (0,) * 4     # b1 and b6..b12 only
+
+
+def test_dop853_order_conditions():
+    """b: all 200 conditions up to order 8; b̂ = b − e5: order 5; b̂3: order 3 (to 1e-25)."""
+    assert len(TREES_UP_TO_8) == 200
+    for weights, order in (("b", 8), ("b_hat", 5), ("b_hat3", 3)):
+        bad = [tree_name(t) for t in TREES_UP_TO_8 if tree_order(t) <= order
+               and abs(condition_residual(t, DOP853_EXACT[weights], DOP_A)) > DOP_TOL]
+        assert bad == [], (weights, bad)
+
+
+def test_dop853_orders_are_not_higher():
+    """The error estimates are of orders 5 and 3 exactly, so they measure something."""
+    E = DOP853_EXACT
+    assert max(abs(condition_residual(t, E["b_hat"], DOP_A)) for t in trees_of_order(6)) > 1e-6
+    assert max(abs(condition_residual(t, E["b_hat3"], DOP_A)) for t in trees_of_order(4)) > 1e-6
+
+
+def test_dop853_float_tableau_matches_exact():
+    E = DOP853_EXACT
+    assert DOP853.order == 8 and DOP853.error_order == 7
+    assert DOP853.b == tuple(float(x) for x in E["b"])
+    assert DOP853.e == tuple(float(x) for x in E["e5"])
+    assert DOP853.e3 == tuple(float(x) for x in E["e3"])
+    assert DOP853.a == tuple(tuple(float(x) for x in row) for row in DOP_A)
+    assert set(METHODS) == {"cash-karp", "dop853"} and METHODS["dop853"] is DOP853
+
+
+@pytest.fixture(scope="module")
+def dop853_steps():
+    runtime.ensure_init()
+    return make_fixed_step_kernel(DOP853)
+
+
+def test_dop853_global_error_is_eighth_order(dop853_steps):
+    """Slope of log error against log h: 7.6 here (measured local slopes rise 7.2 -> 7.7
+    towards 8 as h shrinks until round-off, at 1e-13, takes over), far from 5 or 7."""
+    n_steps = np.array([19, 24, 30, 38, 48])
+    h = T_END / n_steps
+    y_end, _, _ = dop853_steps(kepler_exact(0.0), h, n_steps)
+    err = np.max(np.abs(y_end - kepler_exact(T_END)), axis=1)
+    assert np.all(err > 3e-13), err
+    assert np.all(np.diff(err) < 0), err
+    slope = np.polyfit(np.log(h), np.log(err), 1)[0]
+    assert 7.4 < slope < 8.5, (slope, err)
+
+
+def test_dop853_error_estimate_is_fifth_order(dop853_steps):
+    """The e5 estimate of one step scales like h^6 (the local error of a 5th-order method)."""
+    y0 = kepler_exact(0.7)
+    h = 0.2 * 2.0 ** (-np.arange(5) / 2)
+    _, _, err = dop853_steps(y0, h, np.ones(len(h), dtype=np.int32))
+    est = np.max(np.abs(err), axis=1)
+    assert np.all(est > 1e-13), est
+    slope = np.polyfit(np.log(h), np.log(est), 1)[0]
+    assert slope == pytest.approx(6.0, abs=0.3), slope

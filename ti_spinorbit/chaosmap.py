@@ -34,7 +34,7 @@ from .distributed import sections
 from .section import SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
-from .results import (CLASS, COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
+from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
                       renamed_keywords, unit)
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
@@ -125,6 +125,7 @@ class ChaosMap(Result, _display.Readable):
     n_inaccurate: int = unit('members', default=0)
     include_inaccurate: bool = unit('bool', default=False)
     coordinates: str = unit(COORDINATES, default="inertial")
+    method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     # chaotic fraction against integration length (chaos_map(fraction_orbits=...)): the
     # lengths (orbits, ascending, the map's own last) and the fraction at each; whether it
     # never decreases (⟨Y⟩ of a chaotic orbit only grows) and a one-line verdict
@@ -266,6 +267,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         energy_drift=section.energy_drift.reshape(shape),
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
+        method=section.method,
         coordinates=coordinates, **evidence)
 
 
@@ -339,6 +341,7 @@ class ParameterMap(Result, _display.Readable):
     inaccurate: np.ndarray = unit('members', default=None)
     include_inaccurate: bool = unit('bool', default=False)
     coordinates: str = unit(COORDINATES, default="inertial")
+    method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     # chaotic fraction against integration length (parameter_map(fraction_orbits=...)):
     # fraction_by_length has shape (len(fraction_lengths), len(elongations),
     # len(eccentricities)); fraction_monotone per grid point; fraction_message one line
@@ -473,5 +476,5 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
-        fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
+        method=section.method, fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
         fraction_message=message)

@@ -53,7 +53,7 @@ ANNOUNCE_MIN_S = 1.0
 #: The measurements, in the kernel cache folder (runtime.cache_folder()).
 RECORD_FILE = "compile_seconds.json"
 #: Methods warmup() accepts (the one place to extend when the kernels get more).
-METHODS = ("cash-karp",)
+METHODS = ("cash-karp", "dop853")   # kernels.tableau.METHODS (not imported: quiet import)
 MODELS = ("planar", "3d")
 
 _SEEN = set()              # (runtime generation, arch, variant) compiled in this process
@@ -299,7 +299,7 @@ def _choices(name, values, allowed):
     return list(dict.fromkeys(values))
 
 
-def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), methods=METHODS,
+def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), methods=("cash-karp",),
            order=4, verbose=True, stream=None):
     """Compile kernel variants ahead of time, so that later runs (in this process, and in
     later processes through the disk cache) start without waiting.
@@ -316,7 +316,8 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     sampling : sequence of bool
         Without (sections) and/or with dense sampling (``time_series``, libration).
     methods : sequence of str
-        Integration methods; currently only "cash-karp" (``METHODS``).
+        Integration methods among ``METHODS`` ("cash-karp", "dop853"); default the default
+        method only (each method is a separate set of compiles).
     order : {0, 2, 3, 4}
         Potential order of the variants (default 4, every entry point's default).
     verbose : bool

@@ -117,6 +117,8 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
     section.check_orbits(orbits)
     section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits)
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
+    from .kernels.tableau import check_method
+    check_method(call.arguments["method"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
                          "would share one file); failed chunks are retried instead")
@@ -126,8 +128,8 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
                                                      call.arguments["order"])
     if call.arguments.get("model") == "auto":
         # decided over the whole ensemble, as one launch would, not chunk by chunk
-        from .ensemble import _choose_model
-        kwargs["model"] = _choose_model("auto", par, y0)
+        from .models import choose
+        kwargs["model"] = choose("auto", par, y0).name
     n = len(members)
     if chunk_size is None:
         workers = max(len(client.nthreads()), 1)

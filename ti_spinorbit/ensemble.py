@@ -15,12 +15,12 @@ Decisions:
   them in place.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 from typing import Callable, List, Optional
 
 import numpy as np
 
-from . import compiling, planar, runtime
+from . import compiling, models, runtime
 from ._validate import (require_count, require_memory, require_positive, require_range,
                         require_real)
 
@@ -39,13 +39,8 @@ SHADOW_SEPARATION = 1e-8
 
 
 def _shadow_direction():
-    """Fixed unit direction of the initial separation: R_x, R_y, V_x, V_y and the secondary's
-    spin w2_z, so a planar start stays planar (same for every member: slot-invariant)."""
-    from .kernels import eom
-
-    u = np.zeros(eom.NSTATE)
-    u[[eom.Y_R, eom.Y_R + 1, eom.Y_V, eom.Y_V + 1, eom.Y_W2 + 2]] = 1.0
-    return u / np.linalg.norm(u)
+    """Fixed unit direction of the 3-D model's initial separation (``models.SPATIAL``)."""
+    return models.SPATIAL.shadow_direction()
 
 
 @dataclass
@@ -64,6 +59,51 @@ class RunOutput:
     seconds: float = 0.0
     megno: Optional[np.ndarray] = None      # (N,) MEGNO <Y> at the final time (indicators on)
     lyapunov: Optional[np.ndarray] = None   # (N,) finite-time max Lyapunov exponent, 1/orbit
+
+
+@dataclass
+class RunState:
+    """Everything a run carries between windows: the arrays a checkpoint holds
+    (``checkpoint._ARRAYS``: kernel-layout states, times with their Kahan compensations,
+    step proposals, status, counters, first-stage derivatives, sampling clock, shadow state
+    and indicator sums, diagnostics at t = 0), the records so far and the bookkeeping.
+    :meth:`launch` is the one place that hands them to the ``advance`` kernel, in its order."""
+
+    y: np.ndarray              # (N, nstate) kernel-layout state
+    t: np.ndarray              # (N,) scaled time
+    h: np.ndarray              # (N,) step proposal
+    status: np.ndarray         # (N,) int32, kernels.ensemble.STATUS_NAMES
+    counters: np.ndarray       # (N, 3) int64 accepted, rejected, RHS calls
+    yc: np.ndarray             # Kahan compensation of y
+    tc: np.ndarray             # Kahan compensation of t
+    f: np.ndarray              # dy/dt at (t, y): the next step's first stage
+    next_sample: np.ndarray    # (N,) next sample time (zeros without sampling)
+    shadow: np.ndarray         # (N, nstate) shadow state ((1, nstate) without indicators)
+    shadow_f: np.ndarray       # its derivative
+    ind: np.ndarray            # (N, 3) log-growth sums for the Lyapunov exponent and MEGNO
+    diag_start: np.ndarray     # (N, 14) DIAG_FIELDS at t = 0
+    events: list = field(default_factory=list)    # per member: list of record chunks
+    samples: list = field(default_factory=list)
+    launches: int = 0
+    seconds: float = 0.0
+    records_sha256: list = field(default_factory=list)   # digests (checkpoint.save)
+
+    def as_dict(self):
+        """The fields as a dict (the arrays themselves, not copies), for checkpoint.save."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
+
+    def launch(self, advance, par, t_end, t_stop, events_buf, n_events, samples_buf, n_samples,
+               rtol, atol, min_step, sample_dt, separation, order, odd, sampling, indicators):
+        """One launch of ``advance`` (a kernel set's ``advance``, or ``compiling.FirstUse``
+        wrapping it) on this state, updated in place."""
+        advance(par, self.y, self.yc, self.f, self.t, self.tc, self.h, t_end, t_stop,
+                     self.status, self.counters, events_buf, n_events, samples_buf, n_samples,
+                     self.next_sample, self.shadow, self.shadow_f, self.ind, rtol, atol,
+                     min_step, sample_dt, separation, order, odd, sampling, indicators)
 
 
 def check_tolerances(rtol, atol):
@@ -95,12 +135,18 @@ class Ensemble:
         (``kernels/planar.py``, about 3x cheaper per step), "3d" the general one; "auto"
         (default) takes the planar model when every member qualifies
         (``ti_spinorbit.planar.qualifies``). Inputs and outputs are 3-D states either way.
+    method : {"cash-karp", "dop853"}
+        Runge-Kutta pair (``kernels/tableau.py``): "cash-karp" (default; Cash-Karp 4(5), the
+        paper's) or "dop853" (Hairer's 8(5,3) pair: fewer, longer steps; faster at tight
+        tolerances). Both hold the same error norm to ``rtol``; events, sampling, indicators,
+        checkpoints and both models work with either.
     """
 
     def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,
-                 min_step=MIN_STEP, model="auto"):
+                 min_step=MIN_STEP, model="auto", method="cash-karp"):
         from .bodies import ROW_LENGTH
         from .kernels import eom
+        from .kernels.tableau import METHODS, check_method
 
         runtime.ensure_init()
         self.par = np.ascontiguousarray(par, dtype=np.float64)
@@ -116,28 +162,29 @@ class Ensemble:
             odd = bool(np.any(self.par[:, _odd_columns(ROW_LENGTH)] != 0.0))
         self.odd = bool(odd)
         self.min_step = float(min_step)
-        self.model = _choose_model(model, self.par, self.y)
-        if self.model == "planar":
-            self.kpar = planar.parameter_rows(self.par)
-            self.y = planar.to_planar(self.y)
-        else:
-            self.kpar = self.par
+        self.method = check_method(method)
+        #: the model object (``ti_spinorbit.models``); ``model`` is its name
+        self.equations = models.choose(model, self.par, self.y)
+        self.model = self.equations.name
+        self.kpar = self.equations.kernel_parameters(self.par)
+        self.y = self.equations.to_kernel_state(self.y)
         n = len(self.par)
         self.n = n
         self.t = np.zeros(n)
-        self.h = np.full(n, 0.5 * self.rtol ** 0.2)  # a first guess the controller fixes
+        # a first guess the controller fixes (Cash-Karp's kept as it was: results unchanged)
+        self.h = np.full(n, 0.5 * self.rtol ** (0.2 if self.method == "cash-karp" else
+                                                METHODS[self.method].error_exponent))
         self.status = np.zeros(n, dtype=np.int32)
         self.counters = np.zeros((n, 3), dtype=np.int64)
 
     @property
     def kernels(self):
-        """The kernel set of this ensemble's model (kernels.ensemble.SPATIAL or PLANAR)."""
-        from .kernels import ensemble as K
-        return K.PLANAR if self.model == "planar" else K.SPATIAL
+        """The kernel set of this ensemble's model and method (``kernels_for``)."""
+        return self.equations.kernels(self.method)
 
     def spatial(self, y):
         """Kernel states of this model -> 3-D scaled states (a copy)."""
-        return planar.to_spatial(y) if self.model == "planar" else np.array(y, dtype=np.float64)
+        return self.equations.to_spatial(y)
 
     def diagnostics(self, y=None, member=None) -> np.ndarray:
         """DIAG_FIELDS (energies, angular momenta, orthonormality) of 3-D states y (default:
@@ -196,7 +243,7 @@ class Ensemble:
         require_memory("the recorded crossings and samples",
                        _record_bytes(t_stop, sample_dt, kern.RECORD_WIDTH, cap),
                        "integrate fewer members or orbits per call, or sample less densely")
-        settings = {"model": self.model, "order": self.order, "odd": self.odd,
+        settings = {"model": self.model, "method": self.method, "order": self.order, "odd": self.odd,
                     "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
                     "indicators": bool(indicators), "separation": float(separation)}
@@ -233,31 +280,29 @@ class Ensemble:
             with advance.other_kernels():
                 st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
         else:
-            for name in ("y", "t", "h", "status", "counters"):
-                setattr(self, name, st.pop(name))
-        st.setdefault("records_sha256", [])   # digests of the records files (checkpoint.save)
+            st = RunState.from_dict(st)
+            for name in ("y", "t", "h", "status", "counters"):   # the same arrays
+                setattr(self, name, getattr(st, name))
         scap = int(np.ceil(window / sample_dt)) + 4 if sampling else 1
         events_buf = np.zeros((n, cap, kern.RECORD_WIDTH))
         samples_buf = np.zeros((n, scap, kern.RECORD_WIDTH))
         n_events = np.zeros(n, dtype=np.int32)
         n_samples = np.zeros(n, dtype=np.int32)
-        events, samples = st["events"], st["samples"]
+        events, samples = st.events, st.samples
         # records not yet in the checkpoint (a fresh run's first sample is the initial state)
-        pending = {"events": {}, "samples": {} if st["launches"] else
+        pending = {"events": {}, "samples": {} if st.launches else
                    {i: list(s) for i, s in enumerate(samples) if s}}
-        t0 = time.perf_counter() - st["seconds"]
+        t0 = time.perf_counter() - st.seconds
         span = min(window, 2.0 * np.pi)  # first window: one orbit, then adapted to wall time
         while np.any(self.status == K.RUNNING):
             t_end = np.minimum(t_stop, self.t + span)
             launched = time.perf_counter()
-            advance(self.kpar, self.y, st["yc"], st["f"], self.t, st["tc"], self.h, t_end,
-                         t_stop, self.status, self.counters, events_buf, n_events, samples_buf,
-                         n_samples, st["next_sample"], st["shadow"], st["shadow_f"], st["ind"],
-                         self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
-                         float(separation), self.order, self.odd, sampling, bool(indicators))
+            st.launch(advance, self.kpar, t_end, t_stop, events_buf, n_events, samples_buf,
+                      n_samples, self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
+                      float(separation), self.order, self.odd, sampling, bool(indicators))
             compiled = advance.take_seconds()
             t0, launched = t0 + compiled, launched + compiled
-            st["launches"] += 1
+            st.launches += 1
             # the kernel's time only: draining and checkpointing do not shrink with the span
             span = _next_span(span, time.perf_counter() - launched, window)
             for name, store, buf, count in (("events", events, events_buf, n_events),
@@ -270,29 +315,28 @@ class Ensemble:
             n_samples[:] = 0
             finished = (self.status == K.RUNNING) & (self.t >= t_stop)
             self.status[finished] = K.DONE
-            st["seconds"] = time.perf_counter() - t0
+            st.seconds = time.perf_counter() - t0
             if checkpoint is not None:
-                ckpt.save(checkpoint, settings, fingerprint,
-                          dict(st, y=self.y, t=self.t, h=self.h, status=self.status,
-                               counters=self.counters), pending)
+                ckpt.save(checkpoint, settings, fingerprint, st.as_dict(), pending)
             pending = {"events": {}, "samples": {}}
             if progress is not None:
                 progress(float(np.mean(np.minimum(self.t, t_stop)) / np.mean(t_stop)))
         megno = lyapunov = np.full(n, np.nan)
         if indicators:
-            ind = st["ind"]
+            ind = st.ind
             with np.errstate(divide="ignore", invalid="ignore"):
                 megno = ind[:, 2] / self.t
                 lyapunov = ind[:, 0] / self.t * 2.0 * np.pi   # per orbit (2π scaled time)
         return RunOutput(
             events=[self._spatial_records(e) for e in events],
             samples=[self._spatial_records(s) for s in samples],
-            diag_start=st["diag_start"], diag_end=self.diagnostics(), t=self.t.copy(),
+            diag_start=st.diag_start, diag_end=self.diagnostics(), t=self.t.copy(),
             y=self.spatial(self.y), status=self.status.copy(), counters=self.counters.copy(),
-            launches=st["launches"], seconds=st["seconds"], megno=megno, lyapunov=lyapunov)
+            launches=st.launches, seconds=st.seconds, megno=megno, lyapunov=lyapunov)
 
     def _fresh_run_state(self, sampling, sample_dt, indicators, separation):
-        """Everything a run carries between windows besides y, t, h, status, counters."""
+        """The :class:`RunState` of a run from the start (y, t, h, status, counters are this
+        ensemble's own arrays)."""
         from .kernels import ensemble as K
 
         kern = self.kernels
@@ -301,7 +345,7 @@ class Ensemble:
         kern.evaluate_rhs(self.kpar, self.y, f, self.order, self.odd)
         self.counters[:, K.C_RHS] += 1
         if indicators:
-            direction = planar.shadow_direction() if self.model == "planar" else _shadow_direction()
+            direction = self.equations.shadow_direction()
             shadow = self.y + separation * direction
             shadow_f = np.zeros_like(shadow)
             kern.evaluate_rhs(self.kpar, shadow, shadow_f, self.order, self.odd)
@@ -313,11 +357,12 @@ class Ensemble:
         if sampling:  # the first sample is the initial state
             for i in range(n):
                 samples[i].append(np.concatenate([[0.0], self.y[i]])[None])
-        return {"yc": np.zeros_like(self.y), "tc": np.zeros(n), "f": f,
-                "next_sample": np.full(n, float(sample_dt)) if sampling else np.zeros(n),
-                "shadow": shadow, "shadow_f": shadow_f, "ind": ind,
-                "events": [[] for _ in range(n)], "samples": samples,
-                "diag_start": self.diagnostics(), "launches": 0, "seconds": 0.0}
+        return RunState(y=self.y, t=self.t, h=self.h, status=self.status,
+                        counters=self.counters, yc=np.zeros_like(self.y), tc=np.zeros(n), f=f,
+                        next_sample=np.full(n, float(sample_dt)) if sampling else np.zeros(n),
+                        shadow=shadow, shadow_f=shadow_f, ind=ind,
+                        events=[[] for _ in range(n)], samples=samples,
+                        diag_start=self.diagnostics(), launches=0, seconds=0.0)
 
     def _fingerprint(self, t_stop):
         """Digest of what determines a run's results (inputs at the start of the run)."""
@@ -335,9 +380,9 @@ class Ensemble:
         if not chunks:
             return np.zeros((0, K.RECORD_WIDTH))
         rec = np.concatenate(chunks)
-        if self.model != "planar":
+        if self.equations is models.SPATIAL:
             return rec
-        return np.concatenate([rec[:, :1], planar.to_spatial(rec[:, 1:])], axis=1)
+        return np.concatenate([rec[:, :1], self.equations.to_spatial(rec[:, 1:])], axis=1)
 
 
 def _next_span(span, seconds, window):
@@ -365,18 +410,8 @@ def _record_bytes(t_stop, sample_dt, width, cap):
 
 
 def _choose_model(model, par, y0):
-    """"planar" or "3d" for Ensemble(model=...)."""
-    if model not in ("auto", "planar", "3d"):
-        raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
-    if model == "3d":
-        return "3d"
-    ok = planar.qualifies(par, y0)
-    if model == "planar" and not np.all(ok):
-        bad = np.nonzero(~ok)[0]
-        raise ValueError(f"model='planar' needs planar starts and bodies symmetric about their "
-                         f"equators; members {bad[:10].tolist()} do not qualify (use "
-                         "model='3d' or 'auto')")
-    return "planar" if np.all(ok) else "3d"
+    """"planar" or "3d" for Ensemble(model=...) (the name of ``models.choose``)."""
+    return models.choose(model, par, y0).name
 
 
 def _odd_columns(row_length):

@@ -293,7 +293,7 @@ def save(result, path, extra=None, include_sections=True):
     block = _encode(result, "", systems, arrays, units_out, bool(include_sections))
     fields = block["fields"]
     meta = {"kind": kind, "format_version": FORMAT_VERSION, **provenance(),
-            **{k: fields.get(k) for k in ("rtol", "atol", "order", "orbits")},
+            **{k: fields.get(k) for k in ("rtol", "atol", "order", "orbits", "method")},
             "systems": systems.descriptions, "units": units_out,
             "status_codes": {str(k): v for k, v in status_codes().items()}}
     if "status_names" in arrays:            # a top-level status array (not a nested one's)

@@ -52,7 +52,7 @@ from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
-from .results import COORDINATES, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
 DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
@@ -96,7 +96,8 @@ def _amplitudes(ts, include_inaccurate=False):
 def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbit=256,
                         rtol=1e-12, max_drift=None, include_inaccurate=False,
                         coordinates="inertial", model="auto", checkpoint=None, resume=False,
-                        overwrite_checkpoint=False, progress=None):
+                        overwrite_checkpoint=False, progress=None,
+                        method="cash-karp"):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -125,6 +126,8 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         As for :func:`~ti_spinorbit.section.time_series` (one launch).
     progress : bool or callable, optional
         As for :func:`~ti_spinorbit.section.surface_of_section` (:mod:`ti_spinorbit.progress`).
+    method : {"cash-karp", "dop853"}
+        Runge-Kutta pair (:func:`~ti_spinorbit.section.time_series`).
 
     Returns
     -------
@@ -137,7 +140,8 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         ts = time_series(system, 0.0, thetadot_p, orbits, samples_per_orbit=samples_per_orbit,
                          rtol=rtol, max_drift=max_drift, coordinates=coordinates, model=model,
                          checkpoint=checkpoint, resume=resume,
-                         overwrite_checkpoint=overwrite_checkpoint, progress=report)
+                         overwrite_checkpoint=overwrite_checkpoint, progress=report,
+                         method=method)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
@@ -188,6 +192,7 @@ class RelaxedLibration(Result, _display.Readable):
     angmom_drift: float = unit(RELATIVE, default=float("nan"))
     max_drift: float = unit(RELATIVE, default=float("nan"))
     coordinates: str = unit(COORDINATES, default="inertial")
+    method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     # convergence evidence (relaxed_libration(converge=True)): the centre and amplitude
     # found at each length of the doubling (orbits, 2·orbits, ...) and at rtol/10 at the
     # last length; the tolerances they were held to; the verdicts and a one-line message
@@ -504,6 +509,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     limit = accuracy.drift_limit(rtol, orbits, max_drift)
     coordinates = section_kwargs.get("coordinates", "inertial")
     model = section_kwargs.get("model", "auto")
+    method = section_kwargs.get("method", "cash-karp")
     x = DEFAULT_CANDIDATES.copy() if candidates is None else \
         np.asarray(candidates, dtype=np.float64).ravel()
     shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
@@ -538,7 +544,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     launched(1 + zooms_left(half_width, 0) + 2)
     librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol, max_drift=limit,
                                                samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT,
-                                               coordinates=coordinates, model=model,
+                                               coordinates=coordinates, model=model, method=method,
                                                **checkpoints.next()))
     launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
@@ -588,7 +594,8 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
                       f"{max_extent:g} deg) after {iterations} launches", RuntimeWarning,
                       stacklevel=2)
     ts = time_series(system, 0.0, center, orbits, samples_per_orbit=samples_per_orbit, rtol=rtol,
-                     max_drift=limit, coordinates=coordinates, model=model, **checkpoints.next())
+                     max_drift=limit, coordinates=coordinates, model=model, method=method,
+                     **checkpoints.next())
     amplitude = float(_amplitudes(ts, include_inaccurate=True)[0])   # kept, flagged below
     launched(0)
     if not np.isfinite(amplitude):
@@ -608,4 +615,4 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
         seconds=start.seconds(), system=system, status=status,
         energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
-        max_drift=limit, coordinates=coordinates, series=ts)
+        max_drift=limit, coordinates=coordinates, series=ts, method=method)

@@ -54,7 +54,7 @@ from .libration import section_extent
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
-from .results import COORDINATES, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
@@ -120,6 +120,7 @@ class OverlapScan(Result, _display.Readable):
     n_inaccurate: int = unit('members', default=0)
     include_inaccurate: bool = unit('bool', default=False)
     coordinates: str = unit(COORDINATES, default="inertial")
+    method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     # convergence in integration length (doubling; see overlap_threshold): the lengths run
     # (orbits), the geometric and MEGNO decisions at each (rows: lengths, columns:
     # elongations), the verdict, and the cost in member-orbits
@@ -398,7 +399,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                        converged_orbits=converged_at if converged else float("nan"),
                        max_orbits=float(lengths[-1]), message=message,
                        megno_first_overlap=megno_first, member_orbits=member_orbits,
-                       coordinates=coordinates)
+                       coordinates=coordinates, method=first_sec.method)
     scan._runs = runs
     return scan
 

@@ -25,7 +25,7 @@ from ._validate import (_as_floats, require_count, require_finite,
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
-from .results import COORDINATES, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -184,6 +184,7 @@ class SectionResult(Result, _display.Readable):
     max_drift: float = unit(RELATIVE, default=float("nan"))
     coordinates: str = unit(COORDINATES, default="inertial")
     apsidal_rate: np.ndarray = unit(SPIN, default=None)
+    method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -203,7 +204,8 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
                        progress=None, model="auto", checkpoint=None,
                        resume=False, overwrite_checkpoint=False,
-                       max_drift=None, coordinates="inertial") -> SectionResult:
+                       max_drift=None, coordinates="inertial",
+                       method="cash-karp") -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -259,6 +261,10 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
         apsides, spin rate − ϖ̇; a start θ̇_p = 1.08 is then the paper's 1.08 (the integration
         starts at the inertial rate 1.08 + ϖ̇(0)). Needs e ≥ 1e-3
         (``coordinates.APSIDAL_MIN_ECCENTRICITY``); θ_p is the same in both.
+    method : {"cash-karp", "dop853"}
+        Runge-Kutta pair (``Ensemble``): "cash-karp" (default, the paper's Cash-Karp 4(5))
+        or "dop853" (Hairer's 8(5,3) pair: fewer steps, faster at tight tolerances; same
+        error norm held to rtol). Recorded in the result (``method``) and saved files.
 
     Returns
     -------
@@ -273,7 +279,7 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
     members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
                                              coordinates, order)
     _warn_near_circular(members)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method)
     with _progress.reporting(progress, "surface_of_section") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
                       progress=report, checkpoint=checkpoint, resume=resume,
@@ -298,7 +304,7 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
         rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
-        max_drift=limit, coordinates=coordinates, apsidal_rate=rate)
+        max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method)
 
 
 def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
@@ -379,6 +385,7 @@ class TimeSeriesResult(Result, _display.Readable):
     orbits: float = unit(ORBITS, default=float("nan"))
     coordinates: str = unit(COORDINATES, default="inertial")
     seconds: float = unit('s', default=0.0)
+    method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
 
     def plot(self, ax=None, quantity="thetadot", members=None, title=None):
         """Each member's θ̇/n (or ``quantity`` "alpha", "theta", "r") against time:
@@ -422,14 +429,15 @@ def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orb
                 rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                 escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
                 resume=False, overwrite_checkpoint=False,
-                max_drift=None, coordinates="inertial") -> TimeSeriesResult:
+                max_drift=None, coordinates="inertial", method="cash-karp") -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
     initial orbital period), so samples carry the integrator's accuracy. orbits must lie in
     (0, 1e7] (``MAX_ORBITS``), as for surface_of_section. The drifts are the largest over
     every sample (and the end); ``max_drift`` and ``coordinates`` as for surface_of_section
-    (apsidal: θ from the osculating line of apsides and θ̇ its rate, the starts' θ̇_p too)."""
+    (apsidal: θ from the osculating line of apsides and θ̇ its rate, the starts' θ̇_p too);
+    ``method`` the Runge-Kutta pair, as for surface_of_section."""
     _coords.check_coordinates(coordinates)
     system = _system_argument(system)
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
@@ -440,7 +448,7 @@ def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orb
                model)
     members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
                                              coordinates, order)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method)
     with _progress.reporting(progress, "time_series") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
                       sample_dt=2.0 * np.pi / samples_per_orbit, progress=report,
@@ -467,7 +475,7 @@ def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orb
         **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
-        orbits=orbits, coordinates=coordinates, seconds=out.seconds)
+        orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method)
 
 
 def _sampled_drifts(cols, out: RunOutput):
