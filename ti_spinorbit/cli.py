@@ -322,7 +322,7 @@ def _parser():
                    help="without (sections) and/or with dense sampling (energy, libration) "
                         "(default both)")
     s.add_argument("--methods", nargs="+", default=["cash-karp"],
-                   help="integration methods (default cash-karp, the only one so far)")
+                   help="integration methods: cash-karp (default), dop853, or both")
     s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,
                    help="Taichi arch (default cpu, or $TI_SPINORBIT_ARCH)")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
