@@ -66,7 +66,24 @@ def euler_angles(y):
     with relative attitude = Rz(yaw) Ry(pitch) Rx(roll) (the order of
     :func:`ti_spinorbit.initial.tilted_start`). Yaw and roll in (−180°, 180°], pitch in
     [−90°, 90°]."""
-    M = relative_attitude(y)
+    return _euler(relative_attitude(y))
+
+
+def euler_angles_of_rows(rows):
+    """:func:`euler_angles` of SI state rows (``initial.ROW_SLICES``: inertial R, V and the
+    secondary's body -> inertial attitude), e.g. a time series' ``states``."""
+    from .initial import ROW_SLICES
+
+    rows = np.asarray(rows, dtype=np.float64)
+    R, V = rows[..., ROW_SLICES["R"]], rows[..., ROW_SLICES["V"]]
+    A2 = rows[..., ROW_SLICES["secondary_attitude"]].reshape(rows.shape[:-1] + (3, 3))
+    x = _unit(R)
+    z = _unit(np.cross(R, V))
+    O = np.stack([x, np.cross(z, x), z], axis=-1)
+    return _euler(np.swapaxes(O, -1, -2) @ A2)
+
+
+def _euler(M):
     yaw = np.arctan2(M[..., 1, 0], M[..., 0, 0])
     pitch = -np.arcsin(np.clip(M[..., 2, 0], -1.0, 1.0))
     roll = np.arctan2(M[..., 2, 1], M[..., 2, 2])

@@ -25,6 +25,8 @@ from ._validate import (_as_floats, require_count, require_finite,
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
+from .initial import ROW_UNIT as STATE_ROW
+from .attitude import CLASSES as _ATTITUDE_CLASSES
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
@@ -32,6 +34,9 @@ SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 #: Largest ``orbits`` accepted by surface_of_section and time_series (10 million orbits is
 #: days of CPU time even for one member; the command line's --orbits has the same bound).
 MAX_ORBITS = 1e7
+
+#: Unit text of TimeSeriesResult.attitude_class.
+ATTITUDE_CLASS = "code: " + ", ".join(f"{k} {c}" for k, c in enumerate(_ATTITUDE_CLASSES)) + ", -1 none"
 
 
 def check_orbits(orbits):
@@ -140,6 +145,77 @@ def build_members(system: SystemLike, theta_p, thetadot_p,
     return members, par, y0, theta_p.copy(), thetadot_p.copy()
 
 
+def state_members(system: SystemLike, initial_states, escape_distance=ESCAPE_DISTANCE):
+    """Member table of explicit 3-D starts (:class:`ti_spinorbit.InitialState`): as
+    :func:`build_members`, with one member per state. ``system`` is one system for all or
+    one per state. The returned θ_p and θ̇_p are each start's α (degrees, docs/physics.md
+    §6.2) and inertial spin rate about the orbit normal (units of n), so sections and time
+    series report them as for the paper's starts."""
+    from .initial import InitialState, as_scaled_states
+    from .observables import derive
+
+    states = [initial_states] if isinstance(initial_states, InitialState) else list(initial_states)
+    systems = [system] if isinstance(system, BinarySystem) else list(system)
+    if not systems or not all(isinstance(x, BinarySystem) for x in systems):
+        raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
+                        f"of them (got {show(system)})")
+    if len(systems) not in (1, len(states)):
+        raise ValueError(f"with initial_states, system must be one system or one per state "
+                         f"(got {len(systems)} systems for {len(states)} states)")
+    members = systems * len(states) if len(systems) == 1 else systems
+    distance = _as_floats("escape_distance", escape_distance)
+    if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
+        raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
+                         f"(got {escape_distance!r})")
+    y0 = np.concatenate([as_scaled_states(m, [st]) for m, st in zip(members, states)]) \
+        if len(systems) > 1 else as_scaled_states(members[0], states)
+    rows = {}
+    par = np.stack([rows.setdefault(id(m), m.parameter_row(escape_distance)) for m in members])
+    d = derive(par, y0)
+    return members, par, y0, np.degrees(d["alpha"]), d["thetadot"]
+
+
+def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordinates, order,
+             initial_states, samples_per_orbit=None, model="auto"):
+    """The member table of an entry point, from (θ_p, θ̇_p) or from ``initial_states``,
+    after the memory check."""
+    if initial_states is None:
+        if theta_p is None or thetadot_p is None:
+            raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
+                            "initial_states=[InitialState, ...]")
+        check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit, model)
+        return build_members(system, theta_p, thetadot_p, escape_distance, coordinates, order)
+    if theta_p is not None or thetadot_p is not None:
+        raise ValueError(f"{what}: give theta_p and thetadot_p or initial_states, not both")
+    if coordinates != "inertial":
+        raise ValueError(f"{what}: initial_states need coordinates='inertial' (the apsidal "
+                         "coordinates are defined for the paper's planar starts)")
+    count = 1 if not isinstance(initial_states, (list, tuple, np.ndarray)) else len(initial_states)
+    if count == 0:
+        raise ValueError("initial_states must hold at least one InitialState")
+    check_size(what, system, np.zeros(count), 0.0, orbits, samples_per_orbit, "3d")
+    return state_members(system, initial_states, escape_distance)
+
+
+def _state_rows_and_tilt(members, records_list, y0, y_end):
+    """Per member: its start as a state row (docs/physics.md §6.8) and the largest pole tilt
+    (degrees, docs/physics.md §6.9) over the start, every record and the end."""
+    from .attitude import pole_tilt
+    from .initial import physical_rows
+
+    rows = np.empty((len(members), 30))
+    groups = {}
+    for k, m in enumerate(members):
+        groups.setdefault(id(m), (m, []))[1].append(k)
+    for m, idx in groups.values():
+        rows[idx] = physical_rows(m, y0[idx])
+    tilt = np.fmax(pole_tilt(y0), pole_tilt(y_end))
+    for k, rec in enumerate(records_list):
+        if len(rec):
+            tilt[k] = max(tilt[k], float(np.nanmax(pole_tilt(rec[:, 1:]))))
+    return rows, tilt
+
+
 @dataclass(repr=False)
 class SectionResult(Result, _display.Readable):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
@@ -185,6 +261,8 @@ class SectionResult(Result, _display.Readable):
     coordinates: str = unit(COORDINATES, default="inertial")
     apsidal_rate: np.ndarray = unit(SPIN, default=None)
     method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
+    initial_states: np.ndarray = unit(STATE_ROW, default=None)
+    max_tilt: np.ndarray = unit('deg', default=None)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -199,13 +277,13 @@ class SectionResult(Result, _display.Readable):
 
 
 @renamed_keywords(system_or_systems="system")
-def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-12,
-                       atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
+def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
+                       rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
                        progress=None, model="auto", checkpoint=None,
                        resume=False, overwrite_checkpoint=False,
                        max_drift=None, coordinates="inertial",
-                       method="cash-karp") -> SectionResult:
+                       method="cash-karp", initial_states=None) -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -265,6 +343,14 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
         Runge-Kutta pair (``Ensemble``): "cash-karp" (default, the paper's Cash-Karp 4(5))
         or "dop853" (Hairer's 8(5,3) pair: fewer steps, faster at tight tolerances; same
         error norm held to rtol). Recorded in the result (``method``) and saved files.
+    initial_states : InitialState or sequence of them, optional
+        Explicit 3-D starts (:class:`ti_spinorbit.InitialState`, SI units, inertial frame;
+        e.g. ``system.tilted_start(θ_p, θ̇_p, roll=...)``) instead of θ_p and θ̇_p (leave
+        those None): one member per state, ``system`` one system or one per state,
+        coordinates "inertial". The planar model is used only when every state is planar
+        (docs/physics.md §6.8). Every result records its members' starts as state rows
+        (``initial_states``, SI) and the largest tilt of the secondary's pole from the orbit
+        normal (``max_tilt``, degrees, docs/physics.md §6.9).
 
     Returns
     -------
@@ -275,9 +361,9 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
-    check_size("surface_of_section", system, theta_p, thetadot_p, orbits, model=model)
-    members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
-                                             coordinates, order)
+    members, par, y0, tp, td = _members("surface_of_section", system, theta_p, thetadot_p,
+                                        orbits, escape_distance, coordinates, order,
+                                        initial_states, model=model)
     _warn_near_circular(members)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method)
     with _progress.reporting(progress, "surface_of_section") as report:
@@ -296,6 +382,7 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
     energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
+    rows, tilt = _state_rows_and_tilt(members, out.events, y0, out.y)
     return SectionResult(
         theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=thetadot,
         t=cols["t"] / n[:, None], r=cols["r"] * a[:, None], a=cols["a"] * a[:, None], e=cols["e"],
@@ -304,7 +391,8 @@ def surface_of_section(system: SystemLike, theta_p, thetadot_p, orbits, rtol=1e-
         rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
-        max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method)
+        max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
+        initial_states=rows, max_tilt=tilt)
 
 
 def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
@@ -386,6 +474,64 @@ class TimeSeriesResult(Result, _display.Readable):
     coordinates: str = unit(COORDINATES, default="inertial")
     seconds: float = unit('s', default=0.0)
     method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
+    initial_states: np.ndarray = unit(STATE_ROW, default=None)
+    max_tilt: np.ndarray = unit('deg', default=None)
+    attitude_class: np.ndarray = unit(ATTITUDE_CLASS, default=None)
+    states: np.ndarray = unit(STATE_ROW, default=None)
+
+    def _state(self, name, shape):
+        from .initial import ROW_SLICES
+
+        if self.states is None:
+            raise ValueError(f"{name}: this time series kept no states; run time_series(..., "
+                             "states=True)")
+        part = self.states[..., ROW_SLICES[name]]
+        return part.reshape(part.shape[:-1] + shape)
+
+    @property
+    def R(self):
+        """Secondary's position relative to the primary, inertial frame, m (N, samples, 3)."""
+        return self._state("R", (3,))
+
+    @property
+    def V(self):
+        """Secondary's velocity relative to the primary, inertial frame, m/s."""
+        return self._state("V", (3,))
+
+    @property
+    def primary_attitude(self):
+        """Primary's body -> inertial rotation (N, samples, 3, 3)."""
+        return self._state("primary_attitude", (3, 3))
+
+    @property
+    def secondary_attitude(self):
+        """Secondary's body -> inertial rotation (N, samples, 3, 3)."""
+        return self._state("secondary_attitude", (3, 3))
+
+    @property
+    def primary_omega(self):
+        """Primary's angular velocity in its body frame, rad/s."""
+        return self._state("primary_omega", (3,))
+
+    @property
+    def secondary_omega(self):
+        """Secondary's angular velocity in its body frame, rad/s."""
+        return self._state("secondary_omega", (3,))
+
+    @property
+    def euler_angles(self):
+        """Roll, pitch, yaw of the secondary in the orbit frame, degrees (N, samples, 3):
+        :func:`ti_spinorbit.attitude.euler_angles_of_rows`."""
+        from .attitude import euler_angles_of_rows
+        self._state("R", (3,))                                    # the message if none kept
+        return euler_angles_of_rows(self.states)
+
+    @property
+    def attitude_class_names(self):
+        """``attitude_class`` as text ("planar libration", ..., "" where not classified)."""
+        from .attitude import CLASSES
+        return [CLASSES[c] if c >= 0 else "" for c in np.asarray(self.attitude_class).tolist()]
+
 
     def plot(self, ax=None, quantity="thetadot", members=None, title=None):
         """Each member's θ̇/n (or ``quantity`` "alpha", "theta", "r") against time:
@@ -425,11 +571,12 @@ class TimeSeriesResult(Result, _display.Readable):
 
 
 @renamed_keywords(system_or_systems="system")
-def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orbit=64,
-                rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
-                escape_distance=ESCAPE_DISTANCE, progress=None, model="auto", checkpoint=None,
-                resume=False, overwrite_checkpoint=False,
-                max_drift=None, coordinates="inertial", method="cash-karp") -> TimeSeriesResult:
+def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
+                samples_per_orbit=64, rtol=1e-12, atol=None, order=4,
+                window_orbits=DEFAULT_WINDOW_ORBITS, escape_distance=ESCAPE_DISTANCE,
+                progress=None, model="auto", checkpoint=None, resume=False,
+                overwrite_checkpoint=False, max_drift=None, coordinates="inertial",
+                method="cash-karp", initial_states=None, states=False) -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
@@ -437,17 +584,27 @@ def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orb
     (0, 1e7] (``MAX_ORBITS``), as for surface_of_section. The drifts are the largest over
     every sample (and the end); ``max_drift`` and ``coordinates`` as for surface_of_section
     (apsidal: θ from the osculating line of apsides and θ̇ its rate, the starts' θ̇_p too);
-    ``method`` the Runge-Kutta pair, as for surface_of_section."""
+    ``method`` the Runge-Kutta pair and ``initial_states`` explicit 3-D starts, as for
+    surface_of_section.
+
+    Every member is classified by its attitude (``attitude_class``: planar libration, 3-D
+    libration, circulation, tumbling; docs/physics.md §6.9) and carries its largest pole
+    tilt ``max_tilt``. With ``states=True`` the result also keeps the full physical state at
+    every sample (``states``, SI state rows of docs/physics.md §6.8; read through ``R``,
+    ``V``, ``primary_attitude``, ``secondary_attitude``, ``primary_omega``,
+    ``secondary_omega`` and the Euler angles ``roll``, ``pitch``, ``yaw``): 30 more numbers
+    per sample, off by default to keep long series small."""
     _coords.check_coordinates(coordinates)
     system = _system_argument(system)
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
-    check_size("time_series", system, theta_p, thetadot_p, orbits, samples_per_orbit,
-               model)
-    members, par, y0, tp, td = build_members(system, theta_p, thetadot_p, escape_distance,
-                                             coordinates, order)
+    if not isinstance(states, (bool, np.bool_)):
+        raise TypeError(f"states must be True or False (got {show(states)})")
+    members, par, y0, tp, td = _members("time_series", system, theta_p, thetadot_p, orbits,
+                                        escape_distance, coordinates, order, initial_states,
+                                        samples_per_orbit * (2 if states else 1), model)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method)
     with _progress.reporting(progress, "time_series") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
@@ -469,13 +626,38 @@ def time_series(system: SystemLike, theta_p, thetadot_p, orbits, samples_per_orb
     energy_drift, angmom_drift = _sampled_drifts(cols, out)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
+    rows, tilt = _state_rows_and_tilt(members, out.samples, y0, out.y)
     return TimeSeriesResult(
         t=cols["t"] / n[:, None], alpha=np.degrees(cols["alpha"]), theta=np.degrees(cols["theta"]),
         thetadot=cols["thetadot"], r=cols["r"] * a[:, None], energy=sum(energies.values()),
         **energies, **{k: cols[k] * l_unit for k in ("angmom_orbit", "angmom_primary", "angmom_secondary")},
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
-        orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method)
+        orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method,
+        initial_states=rows, max_tilt=tilt, attitude_class=_attitude_classes(members, out.samples),
+        states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None)
+
+
+def _attitude_classes(members, samples):
+    """Attitude class code per member (``attitude.CLASSES``; −1 with fewer than 2 samples)."""
+    from .attitude import classify
+
+    out = np.full(len(members), -1, dtype=np.int8)
+    for k, (m, rec) in enumerate(zip(members, samples)):
+        if np.count_nonzero(np.all(np.isfinite(rec[:, 1:]), axis=1)) >= 2:
+            out[k] = classify([rec[:, 1:]], m)[0]
+    return out
+
+
+def _sample_rows(members, samples, width):
+    """State rows (SI, docs/physics.md §6.8) at every sample, (N, width, 30), NaN-padded."""
+    from .initial import physical_rows
+
+    rows = np.full((len(members), width, 30), np.nan)
+    for k, (m, rec) in enumerate(zip(members, samples)):
+        if len(rec):
+            rows[k, :len(rec)] = physical_rows(m, rec[:, 1:])
+    return rows
 
 
 def _sampled_drifts(cols, out: RunOutput):
