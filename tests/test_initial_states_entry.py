@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import attitude
 
 
 @pytest.fixture(scope="module")
