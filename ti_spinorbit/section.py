@@ -180,7 +180,7 @@ def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordin
     """The member table of an entry point, from (θ_p, θ̇_p) or from ``initial_states``,
     after the memory check."""
     if initial_states is None:
-        if theta_p is None or thetadot_p is None:
+        if theta_p is None and thetadot_p is None:     # one None: build_members names it
             raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
                             "initial_states=[InitialState, ...]")
         check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit, model)
