@@ -65,12 +65,9 @@ def circular_speed(system):
     return float(np.sqrt(system.a * -force[0] / m_red))
 
 
-def inertial_longitude(samples):
-    """Unwrapped angle of the secondary's position in the inertial xy plane (rad)."""
-    R = samples[:, 1:4]
-    S1 = samples[:, 22:31].reshape(-1, 3, 3)
-    Rin = np.einsum("mij,mj->mi", S1, R)
-    return np.unwrap(np.arctan2(Rin[:, 1], Rin[:, 0]))
+def inertial_longitude(R):
+    """Unwrapped angle of the secondary's inertial position R (samples, 3) in the xy plane."""
+    return np.unwrap(np.arctan2(R[:, 1], R[:, 0]))
 
 
 def main():
@@ -82,14 +79,14 @@ def main():
     args, started = _common.parse(__doc__.splitlines()[0], extra=extra)
     import matplotlib.pyplot as plt
 
+    import ti_spinorbit as tso
     from ti_spinorbit import attitude
-    from ti_spinorbit.ensemble import Ensemble
 
     orbits = args.orbits or (8.0 if args.quick else 100.0)
     shapes = [(q, r) for q in ELONGATIONS for r in FLATTENINGS]
     if args.quick:
         shapes = [(1.3, 1.15), (1.5, 1.3)]
-    members, par, y0 = [], [], []
+    members, systems, states = [], [], []
     for q, r in shapes:
         system = system_for(q, r)
         v_circular = circular_speed(system)
@@ -99,26 +96,29 @@ def main():
             kick = np.array([0.0, v_circular - system.a * system.mean_motion + 1e-3 * dv,
                              1e-3 * args.normal_fraction * abs(dv)])
             members.append((q, r, dv, system))
-            par.append(system.parameter_row())
-            y0.append(state.kicked(kick).to_scaled(system))
-    ens = Ensemble(np.array(par), np.array(y0), rtol=1e-11, model="3d")
-    out = ens.run(2 * np.pi * orbits, sample_dt=2 * np.pi / 32)
-    ok = out.status == 1
+            systems.append(system)
+            states.append(state.kicked(kick))
+    # every member its own shape: one launch of the 3-D model
+    ts = tso.time_series(systems, orbits=orbits, samples_per_orbit=32, rtol=1e-11, model="3d",
+                         initial_states=states, states=True, progress=False)
+    ok = ts.status == tso.Status.DONE
     if not np.all(ok):
-        print(f"[dart_kick] {np.count_nonzero(~ok)} members stopped early: statuses "
-              f"{sorted(set(out.status.tolist()))} (kept, excluded from the table)")
+        print(f"[dart_kick] {np.count_nonzero(~ok)} members stopped early or failed the "
+              f"accuracy check: {sorted(set(ts.status_names))} (kept, excluded from the table)")
     n = members[0][3].mean_motion
     period_h = np.full(len(members), np.nan)
     amplitude = np.full(len(members), np.nan)
     classes = np.full(len(members), -1, dtype=np.int8)
-    for k, s in enumerate(out.samples):
+    yaw = ts.euler_angles[..., 2]
+    for k in range(len(members)):
         if not ok[k]:
             continue
-        t = s[:, 0] / n
-        rate = np.polyfit(t, inertial_longitude(s), 1)[0]
+        t = ts.t[k]
+        fine = np.isfinite(t)
+        rate = np.polyfit(t[fine], inertial_longitude(ts.R[k][fine]), 1)[0]
         period_h[k] = 2 * np.pi / rate / 3600
-        amplitude[k] = np.max(np.abs(attitude.euler_angles(s[:, 1:])[:, 2]))
-        classes[k] = attitude.classify([s[:, 1:]], members[k][3])[0]
+        amplitude[k] = np.nanmax(np.abs(yaw[k]))
+        classes[k] = ts.attitude_class[k]
     base = {(q, r): period_h[k] for k, (q, r, dv, _) in enumerate(members) if dv == 0.0}
     dp_min = np.array([(period_h[k] - base[(q, r)]) * 60 for k, (q, r, dv, _) in enumerate(members)])
     v = members[0][3].a * n
@@ -156,7 +156,7 @@ def main():
     }
     arrays = {"a_over_b": np.array([m[0] for m in members]), "b_over_c": np.array([m[1] for m in members]),
               "dv_mm_s": dvs, "period_h": period_h, "dP_min": dp_min, "kepler_dP_min": kepler_min,
-              "amplitude_deg": amplitude, "attitude_class": classes, "status": out.status}
+              "amplitude_deg": amplitude, "attitude_class": classes, "status": ts.status}
     _common.save(args, "dart_kick", fig, arrays,
                  {"orbits": orbits, "rtol": 1e-11, "normal_fraction": args.normal_fraction,
                   "dv_mm_s": list(DV_MM_S), "shapes": shapes, "samples_per_orbit": 32,

@@ -96,3 +96,28 @@ def test_one_system_per_state(vh, didymos):
     assert sec.max_tilt[0] >= 1.0 - 1e-9 and sec.max_tilt[1] == 0.0
     with pytest.raises(ValueError, match="one system or one per state"):
         tso.surface_of_section([vh, didymos], orbits=1, initial_states=[vh.tilted_start(0, 1)] * 3)
+
+
+def test_cli_section_with_a_tilt(tmp_path):
+    from conftest import run_cli
+
+    p = run_cli("section", "--system", "1991 VH", "--orbits", "10", "--rtol", "1e-10",
+                "--thetadot", "0.43", "--tilt", "5", "0", "0", "--no-progress", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    assert "largest pole tilt 5 deg" in p.stdout
+    npz, = tmp_path.glob("sos_1991VH_td0.43_o10_rtol1e-10_tilt5-0-0.npz")
+    back = tso.load(npz)
+    start = tso.InitialState.from_row(back.initial_states[0])
+    assert np.degrees(np.arccos(start.secondary_attitude[2, 2])) == pytest.approx(5.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("flags, text", [
+    (["--tilt", "5", "0", "0", "--coordinates", "apsidal"], "need --coordinates inertial"),
+    (["--tilt", "400", "0", "0"], "--tilt must lie in [-360, 360]"),
+    (["--spin-xy", "0", "1e3"], "--spin-xy must lie in [-100, 100]"),
+])
+def test_cli_tilt_errors(tmp_path, flags, text):
+    from conftest import run_cli
+
+    p = run_cli("section", "--orbits", "1", *flags, cwd=tmp_path)
+    assert p.returncode == 2 and text in p.stderr and not list(tmp_path.iterdir())

@@ -79,6 +79,9 @@ FLAG_RANGES = {
     "xtol": ("--xtol", 1e-12, 0.1, False, False),
     "only": ("--only", 1, 99, False, False),
     "max_orbits": ("--max-orbits", 0.0, MAX_ORBITS, True, False),
+    "tilt": ("--tilt", -360.0, 360.0, False, False),
+    "spin_xy": ("--spin-xy", -MAX_SPIN, MAX_SPIN, False, False),
+    "inclination": ("--inclination", -360.0, 360.0, False, False),
 }
 #: Figures and data files.
 FIGURE_EXTENSIONS = (".png", ".pdf", ".svg")
@@ -216,6 +219,17 @@ def _parser():
                             "minus the apsidal precession rate; needs e >= 0.001); "
                             "docs/physics.md §6.7")
 
+    def tilt_flags(s):
+        s.add_argument("--tilt", type=float, nargs=3, default=None,
+                       metavar=("ROLL", "PITCH", "YAW"),
+                       help="tilt every start out of the plane: the secondary turned by these "
+                            "angles (deg, each in [-360, 360]) about the orbit frame's radial, "
+                            "along-track and normal axes (docs/physics.md §6.8; 3-D model)")
+        s.add_argument("--spin-xy", type=float, nargs=2, default=None, metavar=("SX", "SY"),
+                       help="off-axis spin of the secondary in its body frame, units of n")
+        s.add_argument("--inclination", type=float, default=None,
+                       help="inclination of the mutual orbit to the primary's equator, deg")
+
     def system_flags(s, default="1991 VH", shape=True):
         s.add_argument("--system", default=default,
                        help=f"catalogued system name (default: {default}; see 'ti-spinorbit "
@@ -244,6 +258,7 @@ def _parser():
                    help="initial θ_p, deg, in [-360, 360] (default 0)")
     s.add_argument("--thetadot", type=float, nargs="+",
                    help="initial θ̇_p/n values (default: the paper's starts for this system)")
+    tilt_flags(s)
     common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12, resume=True)
     accuracy_flags(s)
     coordinates_flag(s)
@@ -629,7 +644,8 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("elongations", "ab"), ("theta_p", "tp"), ("thetadot", "td"), ("grid", "g"),
              ("thetadot_range", "tdr"), ("candidates", "cand"), ("xtol", "xtol"),
              ("samples_per_orbit", "spo"), ("orbits", "o"), ("max_orbits", "maxo"),
-             ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""))
+             ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""),
+             ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"))
 
 
 def default_stem(args, prefix, system_name):
@@ -851,10 +867,22 @@ def _cmd_section(args):
     known = _catalogue_name(system)
     starts = args.thetadot or (catalog.section_starts(known) if known else
                                list(catalog.DEFAULT_SECTION_STARTS))
+    tilted = args.tilt is not None or args.spin_xy is not None or args.inclination is not None
+    if tilted and args.coordinates != "inertial":
+        raise ValueError("--tilt, --spin-xy and --inclination need --coordinates inertial (the "
+                         "apsidal coordinates are defined for planar starts)")
     out, data = _paths(args, "sos", system.name)
     _init(args)
+    if tilted:                     # explicit 3-D starts (docs/physics.md §6.8)
+        roll, pitch, yaw = args.tilt or (0.0, 0.0, 0.0)
+        sx, sy = args.spin_xy or (0.0, 0.0)
+        starts_kw = {"initial_states": [system.tilted_start(
+            args.theta_p, v, roll=roll, pitch=pitch, yaw=yaw, spin_x=sx, spin_y=sy,
+            inclination=args.inclination or 0.0) for v in starts]}
+    else:
+        starts_kw = {"theta_p": args.theta_p, "thetadot_p": np.array(starts)}
     with _progress(args) as bar:
-        result = surface_of_section(system, args.theta_p, np.array(starts), orbits=args.orbits,
+        result = surface_of_section(system, orbits=args.orbits, **starts_kw,
                                     rtol=args.rtol, progress=bar, max_drift=args.max_drift,
                                     coordinates=args.coordinates, **_run_flags(args, data))
     out, data = _write(result, data, {"command": args.command_line},
@@ -865,9 +893,10 @@ def _cmd_section(args):
                  f"({result.member_orbits_per_second:.0f} member-orbits/s), drift limit "
                  f"{result.max_drift:.1e}")
     for k, v in enumerate(starts):
+        tilt = f", largest pole tilt {result.max_tilt[k]:.3g} deg" if tilted else ""
         _print(args, f"  thetadot_p/n = {v:5.2f}: {result.count[k]} crossings, status "
                      f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}, "
-                     f"angular-momentum drift {result.angmom_drift[k]:.1e}")
+                     f"angular-momentum drift {result.angmom_drift[k]:.1e}{tilt}")
     _print(args, f"wrote {out} and {data}", *filter(None, [_finish_checkpoint(args, data)]))
     return _accuracy_status(args, result.status, result.energy_drift, result.max_drift)
 

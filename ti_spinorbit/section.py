@@ -527,6 +527,13 @@ class TimeSeriesResult(Result, _display.Readable):
         return euler_angles_of_rows(self.states)
 
     @property
+    def pole_tilt(self):
+        """Angle between the secondary's short axis and the orbit normal, degrees (N, samples):
+        cos tilt = cos roll cos pitch (docs/physics.md §6.9)."""
+        roll, pitch = np.radians(self.euler_angles[..., 0]), np.radians(self.euler_angles[..., 1])
+        return np.degrees(np.arccos(np.clip(np.cos(roll) * np.cos(pitch), -1.0, 1.0)))
+
+    @property
     def attitude_class_names(self):
         """``attitude_class`` as text ("planar libration", ..., "" where not classified)."""
         from .attitude import CLASSES
