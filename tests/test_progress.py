@@ -56,6 +56,23 @@ def test_plain_lines_every_ten_percent_with_the_right_eta():
     assert lines[-1] == "map: 100%  elapsed 1:40, ETA 0:00"
 
 
+def test_plain_lines_wait_for_the_delay():
+    # a run shorter than the delay writes nothing; a longer one writes its first line as
+    # soon as the delay has passed, then one per step (the CLI uses progress.DELAY_S)
+    bar, clock, stream = make(tty=False, delay=25.0)
+    for k in range(1, 101):
+        clock.now += 1.0
+        bar(k / 100)
+    lines = stream.getvalue().splitlines()
+    assert lines[0] == "map:  25%  elapsed 0:25, ETA 1:15" and len(lines) == 9
+    assert lines[1].startswith("map:  30%")
+    short, clock, stream = make(tty=False, delay=25.0)
+    for k in range(1, 11):
+        clock.now += 1.0
+        short(k / 10)
+    assert stream.getvalue() == ""
+
+
 def test_plain_lines_jumps_and_odd_fractions():
     bar, clock, stream = make(tty=False)
     bar(float("nan"))                 # ignored

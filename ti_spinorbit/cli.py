@@ -708,9 +708,9 @@ def _paths(args, prefix, system_name):
 def _progress(args):
     """The command's reporter: a bar (terminal) or a line per 10 % (log) on stderr, compile
     announcements; nothing with --quiet, no bar with --no-progress."""
-    from .progress import Progress
+    from .progress import DELAY_S, Progress
 
-    return Progress(args.command, enabled=not args.quiet,
+    return Progress(args.command, enabled=not args.quiet, delay=DELAY_S,
                     bar=not getattr(args, "no_progress", False))
 
 

@@ -121,7 +121,8 @@ class Progress:
     tty : bool, optional
         Force bar (True) or plain-line (False) mode; default: :func:`interactive`.
     delay : float
-        Seconds before the bar first appears (tqdm's ``delay``); plain lines ignore it.
+        Seconds before the bar (tqdm's ``delay``) or the first plain line appears: a run
+        shorter than that shows no progress at all.
     bar : bool
         False: no bar and no lines, only the compile announcements (CLI ``--no-progress``).
     clock : callable
@@ -185,7 +186,10 @@ class Progress:
             if self.fraction >= 1.0:
                 self._bar.refresh()
             return
-        # plain lines: one each time the fraction crosses the next step, one at 100 %
+        # plain lines: one each time the fraction crosses the next step, one at 100 %; none
+        # before ``delay`` (a short run in a log stays quiet)
+        if self.elapsed() < self.delay:
+            return
         if self.fraction >= 1.0:
             if self._plain_finished:
                 return
