@@ -32,7 +32,8 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit.chaosmap import MEGNO_COLOR_RANGE, chaos_map
+    from ti_spinorbit.chaosmap import chaos_map
+    from ti_spinorbit.plotting import MEGNO_COLOR_RANGE
 
     maps = [m for m in MAPS if args.systems is None or m[0] in args.systems]
     if not maps:

@@ -34,7 +34,7 @@ from .io import load, save
 from .xarray_io import to_xarray
 from .results import Result, Status
 from .initial import InitialState
-from .compiling import warmup
+from .warmup import warmup
 
 __version__ = "0.1.0"
 

@@ -38,7 +38,6 @@ from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS
                       renamed_keywords, unit)
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
-MEGNO_COLOR_RANGE = (0.0, 8.0)
 #: Default starts per (a/b, e) of a parameter map: θ_p ∈ {0°, 90°} × θ̇_p/n in the 1:1-3:2 band.
 PARAMETER_MAP_THETA_P = (0.0, 90.0)
 PARAMETER_MAP_THETADOT_P = tuple(np.linspace(0.6, 2.0, 12))

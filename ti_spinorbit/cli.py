@@ -1132,7 +1132,7 @@ def _cmd_warmup(args):
     import time
 
     from . import runtime
-    from .compiling import warmup
+    from .warmup import warmup
 
     _init(args)
     started = time.perf_counter()

@@ -169,14 +169,13 @@ class InitialState:
         Bound: the two-point-mass orbital energy V²/2 − G(m1 + m2)/|R| must be negative; the
         mutual potential's higher orders change it by (size/|R|)² only, so this is the
         orbit's eccentricity < 1 test of the paper's set-up."""
-        from .systems import G
-
         r = float(np.linalg.norm(self.R))
         contact = system.primary.bounding_radius + system.secondary.bounding_radius
         if r <= contact:
             raise ValueError(f"{name}: the bodies overlap at the start: |R| = {r:.6g} m <= "
                              f"{contact:.6g} m, the sum of their bounding radii")
-        energy = 0.5 * float(self.V @ self.V) - G * system.total_mass / r
+        gm = system.mean_motion ** 2 * system.a ** 3          # G (m1 + m2), Kepler's third law
+        energy = 0.5 * float(self.V @ self.V) - gm / r
         if not energy < 0:
             raise ValueError(f"{name}: the mutual orbit is not bound (e >= 1): V²/2 - GM/|R| = "
                              f"{energy:.6g} J/kg must be < 0")

@@ -505,3 +505,13 @@ def _upgrade_v0(path, meta, arrays):
 __all__ = ["save", "load", "save_result", "read_metadata", "write_archive",
            "provenance", "describe_system", "units", "status_codes", "status_names", "kind_of",
            "FORMAT_VERSION", "ArchiveError"]
+
+
+def _register():
+    """Give every result its ``save`` (:data:`ti_spinorbit.results.BACKENDS`)."""
+    from . import results
+
+    results.BACKENDS["save"] = save
+
+
+_register()

@@ -7,6 +7,9 @@ quasi-periodic green)."""
 from .classify import COLORS as CLASS_COLORS  # the paper's red / blue / green
 from .coordinates import THETADOT_LABEL       # "θ̇_p/n (inertial)" or "(apsidal)"
 
+#: MEGNO colour scale of maps: 2 (regular) to 8 and beyond (chaotic; the colourbar says ≥ 8).
+MEGNO_COLOR_RANGE = (0.0, 8.0)
+
 
 def _pyplot():
     import matplotlib
@@ -172,7 +175,6 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
     import numpy as np
     from matplotlib.colors import ListedColormap
 
-    from .chaosmap import MEGNO_COLOR_RANGE
 
     ax = _axes(ax)
     x, y = _edges(cmap.theta_p, 0.0, 180.0), _edges(cmap.thetadot_p)

@@ -15,8 +15,10 @@ Every result class of the package (:class:`~ti_spinorbit.section.SectionResult`,
   (declared with :func:`unit`), which :mod:`ti_spinorbit.io` writes into every archive and
   :mod:`ti_spinorbit.xarray_io` puts on every variable; :func:`units` collects them.
 
-The data flow one way: this module imports neither io nor xarray_io at import time (the
-methods import them when called); xarray_io imports io; io imports neither.
+The data flow one way: the archive modules sit above the result classes (io decodes them,
+xarray_io labels them), so this module imports neither; ``save`` and ``to_xarray`` reach them
+through :data:`BACKENDS`, which io and xarray_io fill when they are imported (the package
+imports both).
 """
 
 import dataclasses
@@ -90,6 +92,18 @@ def units(cls_or_result):
     return out
 
 
+#: {"save": io.save, "to_xarray": xarray_io.to_xarray}, registered by those modules.
+BACKENDS = {}
+
+
+def _backend(name, module):
+    try:
+        return BACKENDS[name]
+    except KeyError:
+        raise RuntimeError(f"{name}: import ti_spinorbit.{module} first (importing "
+                           "ti_spinorbit does)") from None
+
+
 class Result:
     """The protocol every result shares (see the module docstring). Subclasses are
     dataclasses with ``status``, ``seconds``, ``rtol``, ``orbits`` fields (or properties)
@@ -124,16 +138,12 @@ class Result:
     def save(self, path, **kwargs):
         """Write this result to ``path`` (``.npz``): :func:`ti_spinorbit.io.save` (keywords
         ``extra``, ``include_sections``); returns the path written."""
-        from . import io
-
-        return io.save(self, path, **kwargs)
+        return _backend("save", "io")(self, path, **kwargs)
 
     def to_xarray(self):
         """This result as a labelled ``xarray.Dataset`` with units
         (:func:`ti_spinorbit.xarray_io.to_xarray`; needs xarray)."""
-        from .xarray_io import to_xarray
-
-        return to_xarray(self)
+        return _backend("to_xarray", "xarray_io")(self)
 
     @classmethod
     def units(cls):

@@ -27,6 +27,7 @@ import os
 import numpy as np
 
 from . import io
+from . import results as _results
 from .results import units as field_units
 
 INSTALL_HINT = 'to_xarray needs xarray: pip install "ti-spinorbit[xarray]"'
@@ -219,3 +220,6 @@ def to_xarray(result_or_path):
 
 
 __all__ = ["to_xarray"]
+
+
+_results.BACKENDS["to_xarray"] = to_xarray      # every result's to_xarray (results.BACKENDS)
