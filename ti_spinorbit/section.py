@@ -433,6 +433,11 @@ def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4)
     return cols
 
 
+def _state_property(name, shape, doc):
+    """A read-only view of one part of a time series' ``states`` (docs/physics.md §6.8)."""
+    return property(lambda self: self._state(name, shape), doc=doc)
+
+
 @dataclass(repr=False)
 class TimeSeriesResult(Result, _display.Readable):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
@@ -488,35 +493,18 @@ class TimeSeriesResult(Result, _display.Readable):
         part = self.states[..., ROW_SLICES[name]]
         return part.reshape(part.shape[:-1] + shape)
 
-    @property
-    def R(self):
-        """Secondary's position relative to the primary, inertial frame, m (N, samples, 3)."""
-        return self._state("R", (3,))
-
-    @property
-    def V(self):
-        """Secondary's velocity relative to the primary, inertial frame, m/s."""
-        return self._state("V", (3,))
-
-    @property
-    def primary_attitude(self):
-        """Primary's body -> inertial rotation (N, samples, 3, 3)."""
-        return self._state("primary_attitude", (3, 3))
-
-    @property
-    def secondary_attitude(self):
-        """Secondary's body -> inertial rotation (N, samples, 3, 3)."""
-        return self._state("secondary_attitude", (3, 3))
-
-    @property
-    def primary_omega(self):
-        """Primary's angular velocity in its body frame, rad/s."""
-        return self._state("primary_omega", (3,))
-
-    @property
-    def secondary_omega(self):
-        """Secondary's angular velocity in its body frame, rad/s."""
-        return self._state("secondary_omega", (3,))
+    R = _state_property("R", (3,), "Secondary's position relative to the primary, inertial "
+                        "frame, m (N, samples, 3).")
+    V = _state_property("V", (3,), "Secondary's velocity relative to the primary, inertial "
+                        "frame, m/s (N, samples, 3).")
+    primary_attitude = _state_property("primary_attitude", (3, 3),
+                                       "Primary's body -> inertial rotation (N, samples, 3, 3).")
+    secondary_attitude = _state_property("secondary_attitude", (3, 3), "Secondary's body -> "
+                                         "inertial rotation (N, samples, 3, 3).")
+    primary_omega = _state_property("primary_omega", (3,), "Primary's angular velocity in its "
+                                    "body frame, rad/s (N, samples, 3).")
+    secondary_omega = _state_property("secondary_omega", (3,), "Secondary's angular velocity "
+                                      "in its body frame, rad/s (N, samples, 3).")
 
     @property
     def euler_angles(self):
