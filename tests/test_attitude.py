@@ -101,3 +101,28 @@ def test_too_few_samples_and_wrong_width(vh):
         att.classify([np.stack([vh.initial_state(0.0, 1.0), np.full(30, np.nan)])], vh)
     with pytest.raises(ValueError, match="30 columns"):
         att.euler_angles(np.zeros((4, 31)))
+
+
+def test_hyperion_like_synchronous_state_is_attitude_unstable(didymos):
+    # Wisdom, Peale & Mignard (1984): for Hyperion (ω0 ≈ 0.89, e = 0.1, decoupled) the
+    # synchronous state is attitude-unstable, the tilt e-folding in a few orbits; the
+    # synchronous Didymos secondary is stable out of the plane. A 1e-4° roll, 14 orbits.
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "experiments"))
+    try:
+        from attitude_hyperion import e_folding, hyperion_system
+    finally:
+        sys.path.pop(0)
+    hyp = hyperion_system()
+    centre = 0.544395            # its synchronous island centre (relaxed_libration, 50 orbits)
+    ts = tso.time_series([hyp, didymos], orbits=14, samples_per_orbit=16, rtol=1e-12,
+                         model="3d", states=True, progress=False,
+                         initial_states=[hyp.tilted_start(0.0, centre, roll=1e-4),
+                                         didymos.tilted_start(0.0, 1.0, roll=1e-4)])
+    assert np.all(ts.status == tso.Status.DONE)
+    tilt = ts.pole_tilt
+    assert np.nanmax(tilt[0]) > 0.1 and np.nanmax(tilt[1]) < 1e-3       # grew 1000x / did not
+    fold = e_folding(ts.t[0] / hyp.orbital_period, tilt[0], 1e-4)
+    assert 0.8 < fold < 2.5                     # orbits ("a few orbital periods"; 1.4 at 40)
