@@ -26,6 +26,9 @@ MEGNO_CHAOTIC = 4.0
 TILT_LIMIT = 10.0            # degrees: "left the plane"
 THETADOT_RANGE = (0.4, 2.6)  # units of n: the 1:1, 3:2 and 2:1 bands
 RTOL = 1e-10
+#: Bands of θ̇_p/n for the printed breakdown: the 1:1 island and below, between, the 3:2
+#: band, the 2:1 band.
+BANDS = (0.0, 1.0, 1.45, 2.2, np.inf)
 
 
 def grid(n_theta, n_thetadot):
@@ -45,9 +48,15 @@ def shares(planar, full):
     chaotic = regular & (full.megno >= MEGNO_CHAOTIC)
     tilted = regular & (full.max_tilt > TILT_LIMIT)
     frac = (lambda m: float(m.sum()) / n if n else float("nan"))
+    sea = ok & (planar.megno >= MEGNO_CHAOTIC)
+    spin = np.broadcast_to(planar.thetadot_p[None, :], regular.shape)
+    bands = [(int((regular & (spin >= lo) & (spin < hi)).sum()),
+              int((tilted & (spin >= lo) & (spin < hi)).sum())) for lo, hi in zip(BANDS, BANDS[1:])]
     return {"planar_regular_area": n / max(int(ok.sum()), 1), "regular_cells": n,
             "full_chaotic_share": frac(chaotic), "tilted_share": frac(tilted),
-            "either_share": frac(chaotic | tilted), "unusable_cells": int((~ok).sum())}
+            "either_share": frac(chaotic | tilted), "unusable_cells": int((~ok).sum()),
+            "band_regular_cells": [b[0] for b in bands], "band_tilted_cells": [b[1] for b in bands],
+            "sea_tilted_share": float((sea & (full.max_tilt > TILT_LIMIT)).sum() / max(sea.sum(), 1))}
 
 
 def main():
@@ -91,6 +100,10 @@ def main():
               f"{got['full_chaotic_share']:.2f} chaotic in full space, {got['tilted_share']:.2f} "
               f"tilt past {TILT_LIMIT:g} deg, {got['either_share']:.2f} either "
               f"({planar.seconds + full.seconds:.1f} s)", flush=True)
+        print(f"  by band of spin/n {', '.join(f'{lo:g}-{hi:g}' for lo, hi in zip(BANDS, BANDS[1:]))}: "
+              f"planar-regular cells {got['band_regular_cells']}, of them tilted past "
+              f"{TILT_LIMIT:g} deg {got['band_tilted_cells']}; chaotic-sea cells tilted past "
+              f"{TILT_LIMIT:g} deg: {got['sea_tilted_share']:.2f}", flush=True)
     fig.suptitle(f"Planar states out of the plane: {nt} x {nd} starts, {orbits:g} orbits, "
                  f"rtol {RTOL:g}, start tilt {TILT0:g} deg (roll and pitch)", fontsize=10)
     _common.save(args, "planar_stability", fig, arrays,
