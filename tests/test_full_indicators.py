@@ -175,3 +175,9 @@ def test_chaos_map_tilt_and_max_tilt(tmp_path):
 def test_chaos_map_bad_tilt_refused(tilt):
     with pytest.raises((ValueError, TypeError), match=r"tilt"):
         tso.chaos_map("1991 VH", [0.0], [1.0], orbits=1, tilt=tilt)
+
+
+def test_parameter_map_records_full_space():
+    pm = tso.parameter_map("1991 VH", [1.5], [0.05], orbits=2, theta_p=[0.0], thetadot_p=[1.0],
+                           fraction_orbits=(), indicator_space="full", progress=False)
+    assert pm.indicator_space == "full" and np.isfinite(pm.megno).all()

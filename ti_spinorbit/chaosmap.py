@@ -392,6 +392,7 @@ class ParameterMap(Result, _display.Readable):
     fraction_by_length: np.ndarray = unit('1', default=None)
     fraction_monotone: np.ndarray = unit('bool', default=None)
     fraction_message: str = unit('text', default="")
+    indicator_space: str = unit(INDICATOR_SPACE, default="planar")   # docs/physics.md §10.4
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -436,7 +437,8 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint,
     max_drift, include_inaccurate, coordinates, fraction_orbits, section_kwargs
         As for :func:`chaos_map` ("apsidal" needs every e ≥ 1e-3, docs/physics.md §6.7; the
-        fraction against orbits per grid point).
+        fraction against orbits per grid point). ``indicator_space="full"`` passes through
+        ``section_kwargs`` (docs/physics.md §10.4) and is recorded in the map.
 
     Returns
     -------
@@ -520,4 +522,4 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
         method=section.method, fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
-        fraction_message=message)
+        fraction_message=message, indicator_space=section.indicator_space)
