@@ -235,3 +235,13 @@ def test_ensemble_wide_model_choice_is_made_over_all_members(client, rng, faulty
         with pytest.raises(tsd.ChunkError, match=f"chunk got model='{model}'"):
             tsd.run_sections(client, systems, 30.0, [1.0, 0.8, 1.2, 1.6], ORBITS,
                              chunk_size=2, retries=0, rtol=RTOL)
+
+
+def test_full_space_chaos_map_with_client_equals_local(client, vh):
+    """indicator_space="full" makes every chunk use the 3-D model (as one launch would), so
+    the map equals the single-process one bit for bit (docs/physics.md §10.4)."""
+    kw = dict(rtol=RTOL, indicator_space="full", fraction_orbits=(), progress=False)
+    local = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, **kw)
+    remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, client=client, chunk_size=2, **kw)
+    assert remote.indicator_space == local.indicator_space == "full"
+    assert_sections_equal(remote.section, local.section)

@@ -31,7 +31,7 @@ from ._validate import (_as_floats, require_positive, require_real,
 from .classify import MIN_POINTS, classify_section
 from .coordinates import check_coordinates
 from .distributed import sections
-from .section import SectionResult, check_orbits
+from .section import INDICATOR_SPACE, SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
 from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
@@ -132,6 +132,11 @@ class ChaosMap(Result, _display.Readable):
     fraction_by_length: np.ndarray = unit('1', default=None)
     fraction_monotone: bool = unit('bool', default=True)
     fraction_message: str = unit('text', default="")
+    # docs/physics.md §10.4: the shadow direction, the start tilt (roll, pitch) of every
+    # grid start, and the largest tilt of the secondary's pole each member reached
+    indicator_space: str = unit(INDICATOR_SPACE, default="planar")
+    tilt: np.ndarray = unit('deg (roll, pitch)', default=None)
+    max_tilt: np.ndarray = unit('deg', default=None)
 
     mean_spin = alias("mean_thetadot")      # old name (read-only)
 
@@ -147,8 +152,9 @@ class ChaosMap(Result, _display.Readable):
     def plot(self, ax=None, quantity="megno", overlay=False, overlay_members=64, colorbar=True,
              title=None):
         """pcolormesh of MEGNO (colours 0-8, the colourbar's top marks ⟨Y⟩ ≥ 8), the Lyapunov
-        exponent (``quantity="lyapunov"``) or the classes (``"classification"``) over θ_p and
-        θ̇_p/n: :func:`ti_spinorbit.plotting.plot_chaos_map`. Returns the Axes."""
+        exponent (``quantity="lyapunov"``), the classes (``"classification"``) or the largest
+        pole tilt (``"max_tilt"``, deg, log colours) over θ_p and θ̇_p/n:
+        :func:`ti_spinorbit.plotting.plot_chaos_map`. Returns the Axes."""
         from .plotting import plot_chaos_map
 
         return plot_chaos_map(self, ax=ax, quantity=quantity, overlay=overlay,
@@ -160,7 +166,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
               chunk_size=None, model="auto", checkpoint=None, resume=False,
               overwrite_checkpoint=False, max_drift=None,
               include_inaccurate=False, coordinates="inertial", fraction_orbits=None,
-              **section_kwargs) -> ChaosMap:
+              indicator_space="planar", tilt=None, **section_kwargs) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -207,6 +213,15 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         integrated, from the start, so that the chaotic fraction is reported against
         orbits (``fraction_lengths``, ``fraction_by_length``, ``fraction_message``); default
         (orbits/4, orbits/2), about 75 % more work; ``()`` skips it.
+    indicator_space : {"planar", "full"}
+        Shadow direction of MEGNO and λ (docs/physics.md §10.4): "planar" (default) the
+        planar-restricted indicators, "full" deviations of the whole state (the 3-D model
+        runs). Recorded in the map (``indicator_space``).
+    tilt : (roll, pitch), optional
+        Start every grid point tilted out of the plane by these angles, degrees in
+        [-90, 90] (``BinarySystem.tilted_start``; inertial coordinates, single process):
+        the map's ``max_tilt`` then shows how far each pole strays (``plot(quantity=
+        "max_tilt")``). Without it every start is planar and stays so.
     **section_kwargs
         Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
@@ -223,10 +238,20 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
+    from .models import check_indicator_space
+    indicator_space = check_indicator_space(indicator_space)
+    tilt = _check_tilt(tilt, client, coordinates)
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
                            advice="use a coarser grid or fewer orbits",
-                           width=resources.record_width(system, model))
+                           width=resources.record_width(system, "3d" if (
+                               indicator_space == "full" or tilt is not None) else model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
+    section_kwargs["indicator_space"] = indicator_space
+    if tilt is not None:     # explicit tilted starts instead of the (θ_p, θ̇_p) grid
+        section_kwargs["initial_states"] = [
+            system.tilted_start(float(a), float(b), roll=tilt[0], pitch=tilt[1])
+            for a, b in zip(tp.ravel(), td.ravel())]
+    grid_tp, grid_td = (tp, td) if tilt is None else (None, None)
     started = compiling.Stopwatch()          # compile time left out of seconds
     # the shorter lengths first, each dropped after its fraction: the peak memory stays
     # that of the map itself
@@ -235,7 +260,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     done = 0.0
     with _progress.reporting(progress, "chaos_map") as report:
         for length in shorter:
-            short = sections(client, system, tp, td, length, chunk_size=chunk_size, rtol=rtol,
+            short = sections(client, system, grid_tp, grid_td, length, chunk_size=chunk_size, rtol=rtol,
                              indicators=True, model=model, max_drift=max_drift,
                              coordinates=coordinates,
                              progress=_progress.stage(report, done / work, length / work),
@@ -244,8 +269,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
             fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length),
                                                short.status, include_inaccurate))
             del short
-        section = sections(client, system, tp, td, orbits, chunk_size=chunk_size, rtol=rtol,
-                           indicators=True,
+        section = sections(client, system, grid_tp, grid_td, orbits, chunk_size=chunk_size,
+                           rtol=rtol, indicators=True,
                            progress=_progress.stage(report, done / work, orbits / work),
                            model=model, checkpoint=checkpoint,
                            resume=resume, overwrite_checkpoint=overwrite_checkpoint,
@@ -267,7 +292,25 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         angmom_drift=section.angmom_drift.reshape(shape), max_drift=section.max_drift,
         n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
         method=section.method,
-        coordinates=coordinates, **evidence)
+        coordinates=coordinates, indicator_space=indicator_space, tilt=tilt,
+        max_tilt=section.max_tilt.reshape(shape), **evidence)
+
+
+def _check_tilt(tilt, client, coordinates):
+    """chaos_map's ``tilt`` as a float (roll, pitch) array in degrees, or None."""
+    if tilt is None:
+        return None
+    values = _as_floats("tilt", tilt)
+    if values.shape != (2,) or not np.all(np.isfinite(values)) or np.any(np.abs(values) > 90):
+        raise ValueError(f"tilt must be (roll, pitch), two finite angles in [-90, 90] degrees "
+                         f"(got {show(tilt)})")
+    if client is not None:
+        raise ValueError("tilt does not combine with client (tilted starts run in this "
+                         "process): leave client=None")
+    if coordinates != "inertial":
+        raise ValueError("tilt needs coordinates='inertial' (the apsidal coordinates are "
+                         "defined for planar starts)")
+    return values
 
 
 def _fraction_lengths(orbits, fraction_orbits):
@@ -348,6 +391,7 @@ class ParameterMap(Result, _display.Readable):
     fraction_by_length: np.ndarray = unit('1', default=None)
     fraction_monotone: np.ndarray = unit('bool', default=None)
     fraction_message: str = unit('text', default="")
+    indicator_space: str = unit(INDICATOR_SPACE, default="planar")   # docs/physics.md §10.4
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -392,7 +436,8 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     progress, client, chunk_size, model, checkpoint, resume, overwrite_checkpoint,
     max_drift, include_inaccurate, coordinates, fraction_orbits, section_kwargs
         As for :func:`chaos_map` ("apsidal" needs every e ≥ 1e-3, docs/physics.md §6.7; the
-        fraction against orbits per grid point).
+        fraction against orbits per grid point). ``indicator_space="full"`` passes through
+        ``section_kwargs`` (docs/physics.md §10.4) and is recorded in the map.
 
     Returns
     -------
@@ -476,4 +521,4 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
         method=section.method, fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
-        fraction_message=message)
+        fraction_message=message, indicator_space=section.indicator_space)

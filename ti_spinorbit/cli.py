@@ -269,6 +269,9 @@ def _parser():
                    help=f"grid size, each in [1, {MAX_GRID}] (default 32 32)")
     s.add_argument("--thetadot-range", type=float, nargs=2, default=[0.2, 3.0],
                    metavar=("LO", "HI"), help="θ̇_p/n range, LO < HI (default 0.2 3.0)")
+    s.add_argument("--indicator-space", choices=("planar", "full"), default="planar",
+                   help="shadow direction of MEGNO: planar-restricted (default) or the full "
+                        "state, attitudes included (the 3-D model runs; docs/physics.md §10.4)")
     common(s, "PNG path (default map_<system>.png)", resume=True)
     accuracy_flags(s)
     coordinates_flag(s)
@@ -916,7 +919,7 @@ def _cmd_map(args):
         cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
                          rtol=args.rtol, progress=bar, max_drift=args.max_drift,
                          include_inaccurate=args.allow_inaccurate, coordinates=args.coordinates,
-                         **_run_flags(args, data))
+                         indicator_space=args.indicator_space, **_run_flags(args, data))
     out, data = _write(cmap, data, {"command": args.command_line}, cmap.plot, out)
     counted = "all finished members" if args.allow_inaccurate else \
         f"{cmap.n_inaccurate} inaccurate left out"

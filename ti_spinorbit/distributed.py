@@ -126,7 +126,10 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
                                                      call.arguments["escape_distance"],
                                                      call.arguments["coordinates"],
                                                      call.arguments["order"])
-    if call.arguments.get("model") == "auto":
+    if call.arguments.get("indicators") and call.arguments.get("indicator_space") == "full" \
+            and call.arguments.get("model") == "auto":
+        kwargs["model"] = "3d"            # full-space indicators need the 3-D model
+    elif call.arguments.get("model") == "auto":
         # decided over the whole ensemble, as one launch would, not chunk by chunk
         from .models import choose
         kwargs["model"] = choose("auto", par, y0).name

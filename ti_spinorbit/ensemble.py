@@ -165,6 +165,7 @@ class Ensemble:
         self.method = check_method(method)
         #: the model object (``ti_spinorbit.models``); ``model`` is its name
         self.equations = models.choose(model, self.par, self.y)
+        self._model_request = model      # "auto" may still turn 3-D for full-space indicators
         self.model = self.equations.name
         self.kpar = self.equations.kernel_parameters(self.par)
         self.y = self.equations.to_kernel_state(self.y)
@@ -203,7 +204,7 @@ class Ensemble:
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
             indicators=False, separation=SHADOW_SEPARATION,
             progress: Optional[Callable[[float], None]] = None, checkpoint=None,
-            resume=False, overwrite_checkpoint=False) -> RunOutput:
+            resume=False, overwrite_checkpoint=False, indicator_space="planar") -> RunOutput:
         """Integrate every member to ``t_stop`` (scaled; scalar or per member).
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
@@ -216,6 +217,14 @@ class Ensemble:
         ``separation`` away (scaled-state Euclidean norm) along a fixed planar direction and
         renormalised to that separation after every accepted step; it yields the finite-time
         maximal Lyapunov exponent and MEGNO ⟨Y⟩ (``RunOutput.lyapunov``, ``.megno``).
+
+        ``indicator_space`` chooses that direction (docs/physics.md §10.4): "planar"
+        (default) the fixed planar one above, blind to out-of-plane instability by
+        construction; "full" a seeded random direction spanning the whole state (position,
+        velocity, both spins, and both attitudes through a small rotation,
+        :meth:`ti_spinorbit.models.Spatial.full_direction`). "full" needs the 3-D model: an
+        ensemble built with model="auto" switches to it for the run, model="planar" is
+        refused (ValueError). Ignored without ``indicators``.
 
         ``checkpoint`` (a directory path) saves everything needed to resume after every
         window, with atomic replaces (``ti_spinorbit.checkpoint``); with ``resume=True`` a run
@@ -240,13 +249,18 @@ class Ensemble:
             require_positive("sample_dt", sample_dt)
         if indicators:
             require_range("separation", separation, 1e-14, 1e-3)
+        indicator_space = models.check_indicator_space(indicator_space)
+        if indicators and indicator_space == "full":
+            self._use_spatial()
+            kern = self.kernels
         require_memory("the recorded crossings and samples",
                        _record_bytes(t_stop, sample_dt, kern.RECORD_WIDTH, cap),
                        "integrate fewer members or orbits per call, or sample less densely")
         settings = {"model": self.model, "method": self.method, "order": self.order, "odd": self.odd,
                     "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
-                    "indicators": bool(indicators), "separation": float(separation)}
+                    "indicators": bool(indicators), "separation": float(separation),
+                    "indicator_space": indicator_space}
         args = (t_stop, window_orbits, sample_dt, indicators, separation, progress, checkpoint,
                 resume, settings)
         if checkpoint is None:
@@ -278,7 +292,8 @@ class Ensemble:
             getattr(self, "method", "cash-karp")), lambda: self.status)
         if st is None:
             with advance.other_kernels():
-                st = self._fresh_run_state(sampling, sample_dt, indicators, separation)
+                st = self._fresh_run_state(sampling, sample_dt, indicators, separation,
+                                           settings.get("indicator_space", "planar"))
         else:
             st = RunState.from_dict(st)
             for name in ("y", "t", "h", "status", "counters"):   # the same arrays
@@ -334,7 +349,22 @@ class Ensemble:
             y=self.spatial(self.y), status=self.status.copy(), counters=self.counters.copy(),
             launches=st.launches, seconds=st.seconds, megno=megno, lyapunov=lyapunov)
 
-    def _fresh_run_state(self, sampling, sample_dt, indicators, separation):
+    def _use_spatial(self):
+        """Integrate with the 3-D model from now on (full-space indicators), or refuse when
+        the planar model was asked for by name."""
+        if self.equations is models.SPATIAL:
+            return
+        if self._model_request == "planar":
+            raise ValueError("indicator_space='full' needs the 3-D model (the planar model "
+                             "cannot carry out-of-plane deviations): use model='auto' or '3d'")
+        # the exact 3-D start before any step (no round trip through the planar layout)
+        self.y = self._y_start.copy() if not np.any(self.t) else self.spatial(self.y)
+        self.equations = models.SPATIAL
+        self.model = self.equations.name
+        self.kpar = self.equations.kernel_parameters(self.par)
+
+    def _fresh_run_state(self, sampling, sample_dt, indicators, separation,
+                         indicator_space="planar"):
         """The :class:`RunState` of a run from the start (y, t, h, status, counters are this
         ensemble's own arrays)."""
         from .kernels import ensemble as K
@@ -345,7 +375,8 @@ class Ensemble:
         kern.evaluate_rhs(self.kpar, self.y, f, self.order, self.odd)
         self.counters[:, K.C_RHS] += 1
         if indicators:
-            direction = self.equations.shadow_direction()
+            direction = self.equations.full_direction(self.y) if indicator_space == "full" \
+                else self.equations.shadow_direction()
             shadow = self.y + separation * direction
             shadow_f = np.zeros_like(shadow)
             kern.evaluate_rhs(self.kpar, shadow, shadow_f, self.order, self.odd)

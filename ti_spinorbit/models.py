@@ -19,6 +19,35 @@ from . import planar as _planar
 
 #: Number of state components of the public (3-D) layout.
 SPATIAL_NSTATE = 30
+#: Seed of the full-space shadow direction (``indicator_space="full"``): fixed, so that runs
+#: are reproducible and every member gets the same random components.
+FULL_DIRECTION_SEED = 20151030
+#: The two values of ``indicator_space`` (docs/physics.md §10.4).
+INDICATOR_SPACES = ("planar", "full")
+
+
+def check_indicator_space(value):
+    """``value`` if it is "planar" or "full", else a one-line ValueError."""
+    if not isinstance(value, str) or value not in INDICATOR_SPACES:
+        raise ValueError(f"indicator_space must be 'planar' or 'full' (got {value!r})")
+    return value
+
+
+def hat(v):
+    """Antisymmetric matrices hat(v) (..., 3, 3) with hat(v) @ x = v × x."""
+    v = np.asarray(v, dtype=np.float64)
+    z = np.zeros(v.shape[:-1])
+    x, y, w = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([np.stack([z, -w, y], -1), np.stack([w, z, -x], -1),
+                     np.stack([-y, x, z], -1)], -2)
+
+
+def full_components(seed=FULL_DIRECTION_SEED):
+    """The random components of the full-space direction, one draw for all members: a dict
+    of 3-vectors "R", "V", "w1", "w2" (state components) and "dS", "dS1" (the small-rotation
+    vectors δ of the secondary's and the primary's attitude, body frames)."""
+    draw = np.random.default_rng(seed).standard_normal((6, 3))
+    return dict(zip(("R", "V", "w1", "w2", "dS", "dS1"), draw))
 
 
 class Model:
@@ -57,6 +86,12 @@ class Model:
         """Unit direction (kernel layout) of the shadow trajectory's initial separation."""
         raise NotImplementedError
 
+    def full_direction(self, y):
+        """Per-member unit directions (N, nstate) spanning the whole state
+        (``indicator_space="full"``); only the 3-D model has them."""
+        raise ValueError(f"indicator_space='full' needs the 3-D model (the {self.name} model "
+                         "cannot carry out-of-plane deviations): use model='auto' or '3d'")
+
     def __repr__(self):
         return f"<model {self.name!r}>"
 
@@ -85,6 +120,23 @@ class Spatial(Model):
         u = np.zeros(SPATIAL_NSTATE)
         u[[0, 1, 3, 4, 9 + 2]] = 1.0
         return u / np.linalg.norm(u)
+
+    def full_direction(self, y):
+        """Unit directions (N, 30) of the full-space shadow (docs/physics.md §10.4): the
+        same seeded random components (:func:`full_components`) in R, V and both spins for
+        every member, and each attitude A (S, S1) moved along the tangent A·hat(δ) of the
+        small rotation A' = A·exp(hat(δ)) (to first order; AᵀA' − 1 = hat(δ) is
+        antisymmetric), each row normalised in the scaled-state Euclidean norm. A member's
+        direction depends on its own state only (slot-invariant)."""
+        y = np.atleast_2d(np.asarray(y, dtype=np.float64))
+        c = full_components()
+        # state offsets of kernels/eom.py: Y_R 0, Y_V 3, Y_W1 6, Y_W2 9, Y_S 12, Y_S1 21
+        d = np.zeros_like(y)
+        d[:, 0:3], d[:, 3:6], d[:, 6:9], d[:, 9:12] = c["R"], c["V"], c["w1"], c["w2"]
+        for lo, key in ((12, "dS"), (21, "dS1")):
+            A = y[:, lo:lo + 9].reshape(-1, 3, 3)
+            d[:, lo:lo + 9] = (A @ hat(c[key])).reshape(-1, 9)
+        return d / np.linalg.norm(d, axis=1, keepdims=True)
 
 
 class Planar(Model):

@@ -165,11 +165,17 @@ def _edges(centres, low=None, high=None):
     return np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
 
 
+#: Colour range (deg, log scale) of chaos maps of the largest pole tilt.
+TILT_COLOR_RANGE = (1e-3, 90.0)
+
+
 def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_members=64,
                    colorbar=True, title=None):
     """pcolormesh of a ChaosMap: MEGNO (colours 0-8, ``extend="max"``: the top colour is
     ⟨Y⟩ ≥ 8), the Lyapunov exponent (``quantity="lyapunov"``, 1/orbit) or the classes
-    (``"classification"``, with a legend of the classes) over θ_p (x, deg) and θ̇_p/n (y).
+    (``"classification"``, with a legend of the classes) or the largest pole tilt
+    (``"max_tilt"``, deg, log colours over ``TILT_COLOR_RANGE``) over θ_p (x, deg) and θ̇_p/n
+    (y).
     ``overlay=True`` adds the section points of up to ``overlay_members`` evenly spaced members
     as small black dots. Returns the Axes."""
     import numpy as np
@@ -185,6 +191,15 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
         extend = "max"
     elif quantity == "lyapunov":
         z, kw, label = cmap.lyapunov, dict(cmap="magma", vmin=0.0), r"$\lambda$ (1/orbit)"
+    elif quantity == "max_tilt":
+        from matplotlib.colors import LogNorm
+
+        if getattr(cmap, "max_tilt", None) is None:
+            raise ValueError("quantity='max_tilt' needs a map that recorded the tilt")
+        # log scale: a regular member stays near its start tilt, an unstable one tumbles
+        z = np.clip(cmap.max_tilt, TILT_COLOR_RANGE[0], TILT_COLOR_RANGE[1])
+        kw = dict(cmap="viridis", norm=LogNorm(*TILT_COLOR_RANGE))
+        label = "largest tilt of the pole (deg)"
     elif quantity == "classification":
         z = np.vectorize(lambda c: CLASS_ORDER.index(c) if c in CLASS_ORDER else 3)(
             cmap.classification).astype(float)
@@ -192,8 +207,8 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
                   vmax=3.5)
         label = "class"
     else:
-        raise ValueError(f"quantity must be 'megno', 'lyapunov' or 'classification' "
-                         f"(got {quantity!r})")
+        raise ValueError(f"quantity must be 'megno', 'lyapunov', 'classification' or "
+                         f"'max_tilt' (got {quantity!r})")
     mesh = ax.pcolormesh(x, y, np.asarray(z).T, shading="flat", **kw)
     if colorbar and quantity == "classification":
         class_legend(ax, np.asarray(cmap.classification).ravel())

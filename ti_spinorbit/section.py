@@ -35,6 +35,9 @@ SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 #: days of CPU time even for one member; the command line's --orbits has the same bound).
 MAX_ORBITS = 1e7
 
+#: Unit text of the indicator_space fields (docs/physics.md §10.4).
+INDICATOR_SPACE = ("text: shadow direction of MEGNO and the Lyapunov exponent, 'planar' (fixed "
+                   "planar direction) or 'full' (the whole state, attitudes by a small rotation)")
 #: Unit text of TimeSeriesResult.attitude_class.
 ATTITUDE_CLASS = "code: " + ", ".join(f"{k} {c}" for k, c in enumerate(_ATTITUDE_CLASSES)) + ", -1 none"
 
@@ -263,6 +266,7 @@ class SectionResult(Result, _display.Readable):
     method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     initial_states: np.ndarray = unit(STATE_ROW, default=None)
     max_tilt: np.ndarray = unit('deg', default=None)
+    indicator_space: str = unit(INDICATOR_SPACE, default="planar")
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -283,7 +287,8 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
                        progress=None, model="auto", checkpoint=None,
                        resume=False, overwrite_checkpoint=False,
                        max_drift=None, coordinates="inertial",
-                       method="cash-karp", initial_states=None) -> SectionResult:
+                       method="cash-karp", initial_states=None,
+                       indicator_space="planar") -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
     Parameters
@@ -351,6 +356,12 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         (docs/physics.md §6.8). Every result records its members' starts as state rows
         (``initial_states``, SI) and the largest tilt of the secondary's pole from the orbit
         normal (``max_tilt``, degrees, docs/physics.md §6.9).
+    indicator_space : {"planar", "full"}
+        Direction of the shadow trajectory with ``indicators`` (docs/physics.md §10.4):
+        "planar" (default) a fixed planar direction, blind to out-of-plane instability;
+        "full" a seeded direction spanning the whole state (attitudes perturbed through a
+        small rotation). "full" integrates with the 3-D model (model="auto" picks it;
+        model="planar" is refused). Recorded in the result.
 
     Returns
     -------
@@ -361,6 +372,13 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
+    from .models import check_indicator_space
+    indicator_space = check_indicator_space(indicator_space)
+    if indicators and indicator_space == "full":
+        if model == "planar":
+            raise ValueError("indicator_space='full' needs the 3-D model (the planar model "
+                             "cannot carry out-of-plane deviations): use model='auto' or '3d'")
+        model = "3d" if model == "auto" else model
     members, par, y0, tp, td = _members("surface_of_section", system, theta_p, thetadot_p,
                                         orbits, escape_distance, coordinates, order,
                                         initial_states, model=model)
@@ -369,7 +387,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     with _progress.reporting(progress, "surface_of_section") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
                       progress=report, checkpoint=checkpoint, resume=resume,
-                      overwrite_checkpoint=overwrite_checkpoint)
+                      overwrite_checkpoint=overwrite_checkpoint, indicator_space=indicator_space)
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"),
                             apsidal=coordinates == "apsidal", order=order)
     thetadot, rate = cols["thetadot"], None
@@ -392,7 +410,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
         max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
-        initial_states=rows, max_tilt=tilt)
+        initial_states=rows, max_tilt=tilt, indicator_space=indicator_space)
 
 
 def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
