@@ -29,7 +29,6 @@ def main():
     for ax, name in zip(axes, SYSTEMS):
         system = tso.catalog.system(name)
         starts = tso.catalog.section_starts(name)
-        q = system.secondary.semi_axes[0] / system.secondary.semi_axes[1]
         result, cls = section_panel(ax, system, starts, orbits,
                                     what=rf"$\omega_0$ = {system.omega0:.3f}")
         numbers.update(numbers_for(name, starts, cls))

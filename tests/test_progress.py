@@ -242,7 +242,7 @@ def cold(monkeypatch, tmp_path):
 
 
 def test_compile_is_announced_once_and_left_out_of_seconds_and_rates(vh, cold, tmp_path):
-    clock, stream = FakeClock(), io.StringIO()
+    stream = io.StringIO()
     bar = Progress("section", stream=stream, tty=False)
     first = tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10, progress=bar)
     again = tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10, progress=bar)
