@@ -641,14 +641,15 @@ def _system(args):
 #: e0.1, tp30 (--theta-p), td1.13-1.63 (--thetadot; over three values: first-last n count),
 #: g64x64 (--grid), tdr0.5-2 (--thetadot-range), ab1.01-1.1-0.01 (--elongations), cand0.2-1.3-45
 #: (--candidates), xtol1e-8, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
-#: (--max-orbits), rtol1e-13; --model, --coordinates and --method by their value alone (3d,
-#: apsidal, dop853). --max-drift, --arch and output flags change no physics: not named.
+#: (--max-orbits), rtol1e-13, tilt5-0-0, sxy0-0.1, inc10; --model, --coordinates, --method and
+#: --indicator-space by their value alone (3d, apsidal, dop853, full). --max-drift, --arch and output flags change no physics: not named.
 NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("elongations", "ab"), ("theta_p", "tp"), ("thetadot", "td"), ("grid", "g"),
              ("thetadot_range", "tdr"), ("candidates", "cand"), ("xtol", "xtol"),
              ("samples_per_orbit", "spo"), ("orbits", "o"), ("max_orbits", "maxo"),
              ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""),
-             ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"))
+             ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"),
+             ("indicator_space", ""))
 
 
 def default_stem(args, prefix, system_name):
