@@ -126,3 +126,29 @@ def test_hyperion_like_synchronous_state_is_attitude_unstable(didymos):
     assert np.nanmax(tilt[0]) > 0.1 and np.nanmax(tilt[1]) < 1e-3       # grew 1000x / did not
     fold = e_folding(ts.t[0] / hyp.orbital_period, tilt[0], 1e-4)
     assert 0.8 < fold < 2.5                     # orbits ("a few orbital periods"; 1.4 at 40)
+
+
+def test_classify_crossings_rule():
+    codes = att.classify_crossings(
+        synchronous=[True, True, False, True, False, True],
+        max_tilt=[0.5, 5.0, 0.2, 0.5, 80.0, np.nan],
+        max_npa=[0.1, 3.0, 0.1, 45.0, 2.0, 0.1])
+    assert att.class_names(codes) == ["planar libration", "3-D libration", "circulation",
+                                           "tumbling", "circulation", ""]
+
+
+def test_chaos_maps_carry_attitude_classes(tmp_path):
+    grid = dict(theta_p=[0.0, 90.0], thetadot_p=[0.43, 1.63], orbits=40, rtol=1e-10,
+                progress=False)
+    flat = tso.chaos_map("1991 VH", **grid)
+    tilted = tso.chaos_map("1991 VH", **grid, tilt=(5.0, 0.0))
+    # planar: synchronous-island starts librate in the plane, the others circulate
+    sync = (flat.classification == "resonant")
+    assert flat.attitude_class_names[0, 0] == "planar libration"      # θ_p 0, 0.43: the island
+    assert set(flat.attitude_class_names[~sync]) <= {"circulation"}
+    assert np.all(flat.max_tilt == 0.0)
+    # tilted by 5°: the island start librates in 3-D, the chaotic start (1.63) tumbles
+    assert tilted.attitude_class_names[0, 0] == "3-D libration"
+    assert tilted.attitude_class_names[1, 0] == "tumbling"
+    back = tso.load(tso.save(tilted, tmp_path / "m.npz"))
+    np.testing.assert_array_equal(back.attitude_class, tilted.attitude_class)

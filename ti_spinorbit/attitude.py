@@ -29,6 +29,10 @@ import numpy as np
 #: Class labels, in the order of the integer codes :func:`classify` returns.
 CLASSES = ("planar libration", "3-D libration", "circulation", "tumbling")
 PLANAR_LIBRATION, LIBRATION_3D, CIRCULATION, TUMBLING = range(4)
+#: Unit text of stored class codes (results' ``attitude_class``).
+CLASS_UNIT = "code: " + ", ".join(f"{k} {c}" for k, c in enumerate(CLASSES)) + ", -1 none"
+#: Default thresholds, degrees (module docstring).
+TILT_ANGLE, NPA_ANGLE = 1.0, 30.0
 
 _R, _V, _W2, _S = slice(0, 3), slice(3, 6), slice(9, 12), slice(12, 21)
 
@@ -131,7 +135,7 @@ def _unwrapped_span(angles_deg, axis=-1):
     return np.nanmax(u, axis=axis) - np.nanmin(u, axis=axis)
 
 
-def classify(samples, system, *, tilt_angle=1.0, npa_angle=30.0):
+def classify(samples, system, *, tilt_angle=TILT_ANGLE, npa_angle=NPA_ANGLE):
     """Per-member class codes (indices into :data:`CLASSES`) from time series.
 
     ``samples`` is (members, times, 30) scaled states (NaN rows, e.g. padding after a member
@@ -165,6 +169,33 @@ def classify(samples, system, *, tilt_angle=1.0, npa_angle=30.0):
     return out
 
 
+def npa_angle(y):
+    """Angle (degrees) between the secondary's spin angular momentum and its short body axis
+    (either direction): 0 for rotation about the short axis."""
+    l = body_angular_momentum(y)
+    return np.degrees(np.arccos(np.clip(np.abs(l[..., 2]), 0.0, 1.0)))
+
+
+def classify_crossings(synchronous, max_tilt, max_npa, *, tilt_angle=TILT_ANGLE,
+                       npa_angle=NPA_ANGLE):
+    """Class codes (:data:`CLASSES`) of section members, from once-per-orbit records.
+
+    A section cannot follow the yaw angle between crossings, so the libration/circulation
+    decision is taken from the spin classification instead: a member librates when its
+    section is resonant in the synchronous (1:1) resonance (``synchronous``, boolean), else
+    it circulates. Tumbling (``max_npa`` > ``npa_angle``, the largest angle of the spin
+    angular momentum from the short axis over the records) comes first; a librating member
+    is "3-D" when its pole tilts more than ``tilt_angle`` (``max_tilt``). Arrays broadcast;
+    NaN inputs give −1 ("none")."""
+    synchronous = np.asarray(synchronous, dtype=bool)
+    max_tilt, max_npa = np.asarray(max_tilt, dtype=float), np.asarray(max_npa, dtype=float)
+    out = np.where(max_npa > npa_angle, TUMBLING,
+                   np.where(~synchronous, CIRCULATION,
+                            np.where(max_tilt > tilt_angle, LIBRATION_3D, PLANAR_LIBRATION)))
+    out = np.where(np.isfinite(max_tilt) & np.isfinite(max_npa), out, -1)
+    return out.astype(np.int8)
+
+
 def class_names(codes):
     """Labels of class codes (:data:`CLASSES`)."""
-    return [CLASSES[int(c)] for c in np.ravel(codes)]
+    return [CLASSES[int(c)] if c >= 0 else "" for c in np.ravel(codes)]

@@ -34,6 +34,7 @@ from .distributed import sections
 from .section import INDICATOR_SPACE, SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
+from .attitude import CLASS_UNIT as ATTITUDE_CLASS
 from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
                       renamed_keywords, unit)
 
@@ -73,15 +74,33 @@ def _chaotic_fraction(labels, status, include_inaccurate=False):
     return float(np.mean(labels[ok] == "chaotic")) if ok.any() else float("nan")
 
 
-def _labels(section, megno_chaotic, orbits):
-    """classify_section labels. MEGNO settles chaos on its own, so short runs (fewer than the
-    classifier's 64 points) still get labels: the point minimum is relaxed to ~0.8 per orbit
-    (at least 8), which only affects the geometric rule used in the 2.5 < ⟨Y⟩ < 4 gap and for
-    resonant vs quasi-periodic."""
+def _classified(section, megno_chaotic, orbits):
+    """classify_section of a map's section. MEGNO settles chaos on its own, so short runs
+    (fewer than the classifier's 64 points) still get labels: the point minimum is relaxed to
+    ~0.8 per orbit (at least 8), which only affects the geometric rule used in the
+    2.5 < ⟨Y⟩ < 4 gap and for resonant vs quasi-periodic."""
     min_points = int(min(MIN_POINTS, max(8, np.floor(0.8 * orbits))))
     # inaccurate members are labelled too (their data are kept); summaries exclude them
     return classify_section(section, megno_chaotic=megno_chaotic, min_points=min_points,
-                            geometric=False, include_inaccurate=True).classification
+                            geometric=False, include_inaccurate=True)
+
+
+def _labels(section, megno_chaotic, orbits):
+    """The classification labels of :func:`_classified`."""
+    return _classified(section, megno_chaotic, orbits).classification
+
+
+def _attitude_classes(section, classes):
+    """Attitude class codes of a map's members (``attitude.classify_crossings``): libration
+    where the section is resonant in the synchronous resonance, tumbling, circulation."""
+    from .attitude import classify_crossings
+
+    if section.max_tilt is None or section.max_npa_angle is None:
+        return None
+    with np.errstate(invalid="ignore"):
+        synchronous = (classes.classification == "resonant") & \
+            (np.abs(np.asarray(classes.resonance_p, dtype=float) - 1.0) < 1e-9)
+    return classify_crossings(synchronous, section.max_tilt, section.max_npa_angle)
 
 
 def _mean_thetadot(section):
@@ -137,8 +156,20 @@ class ChaosMap(Result, _display.Readable):
     indicator_space: str = unit(INDICATOR_SPACE, default="planar")
     tilt: np.ndarray = unit('deg (roll, pitch)', default=None)
     max_tilt: np.ndarray = unit('deg', default=None)
+    # attitude class per start from its crossings (attitude.classify_crossings)
+    attitude_class: np.ndarray = unit(ATTITUDE_CLASS, default=None)
 
     mean_spin = alias("mean_thetadot")      # old name (read-only)
+
+    @property
+    def attitude_class_names(self):
+        """``attitude_class`` as text, the map's shape (an object array; "" where none)."""
+        from .attitude import CLASSES
+        if self.attitude_class is None:
+            return None
+        codes = np.asarray(self.attitude_class)
+        return np.array([CLASSES[c] if c >= 0 else "" for c in codes.ravel()],
+                        dtype=object).reshape(codes.shape)
 
     @property
     def shape(self):
@@ -276,7 +307,9 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
                            resume=resume, overwrite_checkpoint=overwrite_checkpoint,
                            max_drift=max_drift, coordinates=coordinates,
                            **section_kwargs)
-    labels = _labels(section, megno_chaotic, orbits)
+    classes = _classified(section, megno_chaotic, orbits)
+    labels = classes.classification
+    attitude_class = _attitude_classes(section, classes)
     seconds = started.seconds()
     full = _chaotic_fraction(labels, section.status, include_inaccurate)
     evidence = fraction_evidence(shorter + [float(orbits)], fractions + [full])
@@ -293,7 +326,9 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         n_inaccurate=section.n_inaccurate, include_inaccurate=bool(include_inaccurate),
         method=section.method,
         coordinates=coordinates, indicator_space=indicator_space, tilt=tilt,
-        max_tilt=section.max_tilt.reshape(shape), **evidence)
+        max_tilt=section.max_tilt.reshape(shape),
+        attitude_class=None if attitude_class is None else attitude_class.reshape(shape),
+        **evidence)
 
 
 def _check_tilt(tilt, client, coordinates):

@@ -26,7 +26,7 @@ from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
 from .initial import ROW_UNIT as STATE_ROW
-from .attitude import CLASSES as _ATTITUDE_CLASSES
+from .attitude import CLASS_UNIT as ATTITUDE_CLASS
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
@@ -38,8 +38,6 @@ MAX_ORBITS = 1e7
 #: Unit text of the indicator_space fields (docs/physics.md §10.4).
 INDICATOR_SPACE = ("text: shadow direction of MEGNO and the Lyapunov exponent, 'planar' (fixed "
                    "planar direction) or 'full' (the whole state, attitudes by a small rotation)")
-#: Unit text of TimeSeriesResult.attitude_class.
-ATTITUDE_CLASS = "code: " + ", ".join(f"{k} {c}" for k, c in enumerate(_ATTITUDE_CLASSES)) + ", -1 none"
 
 
 def check_orbits(orbits):
@@ -201,9 +199,10 @@ def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordin
 
 
 def _state_rows_and_tilt(members, records_list, y0, y_end):
-    """Per member: its start as a state row (docs/physics.md §6.8) and the largest pole tilt
-    (degrees, docs/physics.md §6.9) over the start, every record and the end."""
-    from .attitude import pole_tilt
+    """Per member: its start as a state row (docs/physics.md §6.8), the largest pole tilt and
+    the largest angle of the spin angular momentum from the short axis (degrees,
+    docs/physics.md §6.9) over the start, every record and the end."""
+    from .attitude import npa_angle, pole_tilt
     from .initial import physical_rows
 
     rows = np.empty((len(members), 30))
@@ -213,10 +212,12 @@ def _state_rows_and_tilt(members, records_list, y0, y_end):
     for m, idx in groups.values():
         rows[idx] = physical_rows(m, y0[idx])
     tilt = np.fmax(pole_tilt(y0), pole_tilt(y_end))
+    npa = np.fmax(npa_angle(y0), npa_angle(y_end))
     for k, rec in enumerate(records_list):
         if len(rec):
             tilt[k] = max(tilt[k], float(np.nanmax(pole_tilt(rec[:, 1:]))))
-    return rows, tilt
+            npa[k] = max(npa[k], float(np.nanmax(npa_angle(rec[:, 1:]))))
+    return rows, tilt, npa
 
 
 @dataclass(repr=False)
@@ -266,6 +267,7 @@ class SectionResult(Result, _display.Readable):
     method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     initial_states: np.ndarray = unit(STATE_ROW, default=None)
     max_tilt: np.ndarray = unit('deg', default=None)
+    max_npa_angle: np.ndarray = unit('deg', default=None)
     indicator_space: str = unit(INDICATOR_SPACE, default="planar")
 
     @property
@@ -400,7 +402,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
-    rows, tilt = _state_rows_and_tilt(members, out.events, y0, out.y)
+    rows, tilt, npa = _state_rows_and_tilt(members, out.events, y0, out.y)
     return SectionResult(
         theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=thetadot,
         t=cols["t"] / n[:, None], r=cols["r"] * a[:, None], a=cols["a"] * a[:, None], e=cols["e"],
@@ -410,7 +412,8 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
         max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
-        initial_states=rows, max_tilt=tilt, indicator_space=indicator_space)
+        initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
+        indicator_space=indicator_space)
 
 
 def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
@@ -499,6 +502,7 @@ class TimeSeriesResult(Result, _display.Readable):
     method: str = unit(METHOD, default="cash-karp")   # Runge-Kutta pair
     initial_states: np.ndarray = unit(STATE_ROW, default=None)
     max_tilt: np.ndarray = unit('deg', default=None)
+    max_npa_angle: np.ndarray = unit('deg', default=None)
     attitude_class: np.ndarray = unit(ATTITUDE_CLASS, default=None)
     states: np.ndarray = unit(STATE_ROW, default=None)
 
@@ -639,7 +643,7 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     energy_drift, angmom_drift = _sampled_drifts(cols, out)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
-    rows, tilt = _state_rows_and_tilt(members, out.samples, y0, out.y)
+    rows, tilt, npa = _state_rows_and_tilt(members, out.samples, y0, out.y)
     return TimeSeriesResult(
         t=cols["t"] / n[:, None], alpha=np.degrees(cols["alpha"]), theta=np.degrees(cols["theta"]),
         thetadot=cols["thetadot"], r=cols["r"] * a[:, None], energy=sum(energies.values()),
@@ -647,7 +651,7 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
         orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method,
-        initial_states=rows, max_tilt=tilt, attitude_class=_attitude_classes(members, out.samples),
+        initial_states=rows, max_tilt=tilt, max_npa_angle=npa, attitude_class=_attitude_classes(members, out.samples),
         states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None)
 
 
