@@ -85,6 +85,18 @@ def build_kernels(lanes_list, ck_lanes=()):
     nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
     NS, NP = P.NSTATE, P.NPAR
 
+    # ---- lane helpers shared by the explicit-lane variants ----
+    @ti.func
+    def column(M, l: ti.template(), n: ti.template()):
+        """Column l (one member) of an (n, L) lane matrix as an n-vector."""
+        return ti.Vector([M[k, l] for k in ti.static(range(n))], ti.f64)
+
+    @ti.func
+    def gather(a: ti.template(), base, L: ti.template(), n: ti.template()):
+        """Rows 0..n-1 of members base .. base+L-1 of an (n, members) array: (n, L)."""
+        return ti.Matrix([[a[k, base + l] for l in ti.static(range(L))]
+                          for k in ti.static(range(n))], ti.f64)
+
     # ---- scalar: one member per iteration (AoS, the package's layout) ----
     @ti.kernel
     def scalar_rhs(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
@@ -116,18 +128,12 @@ def build_kernels(lanes_list, ck_lanes=()):
 
     # ---- unrolled: L members per iteration, scalar code per member (SoA) ----
     def unrolled(L, workload):
-        @ti.func
-        def column(M, l: ti.template(), n: ti.template()):
-            return ti.Vector([M[k, l] for k in ti.static(range(n))], ti.f64)
-
         @ti.kernel
         def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
             for g in range(y.shape[1] // L):
                 base = g * L
-                PV = ti.Matrix([[par[k, base + l] for l in ti.static(range(L))]
-                                for k in ti.static(range(NP))], ti.f64)
-                Y0 = ti.Matrix([[y[k, base + l] for l in ti.static(range(L))]
-                                for k in ti.static(range(NS))], ti.f64)
+                PV = gather(par, base, L, NP)
+                Y0 = gather(y, base, L, NS)
                 Z = Y0
                 h = RK4_STEP
                 for _ in range(repeats):
@@ -208,10 +214,8 @@ def build_kernels(lanes_list, ck_lanes=()):
         def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
             for g in range(y.shape[1] // L):
                 base = g * L
-                PV = ti.Matrix([[par[k, base + l] for l in ti.static(range(L))]
-                                for k in ti.static(range(NP))], ti.f64)
-                Y0 = ti.Matrix([[y[k, base + l] for l in ti.static(range(L))]
-                                for k in ti.static(range(NS))], ti.f64)
+                PV = gather(par, base, L, NP)
+                Y0 = gather(y, base, L, NS)
                 Z = Y0
                 h = RK4_STEP
                 for _ in range(repeats):
@@ -288,18 +292,12 @@ def build_kernels(lanes_list, ck_lanes=()):
                 out[i, k] = z[k]
 
     def unrolled_ck(L):
-        @ti.func
-        def column(M, l: ti.template(), n: ti.template()):
-            return ti.Vector([M[k, l] for k in ti.static(range(n))], ti.f64)
-
         @ti.kernel
         def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
             for g in range(y.shape[1] // L):
                 base = g * L
-                PV = ti.Matrix([[par[k, base + l] for l in ti.static(range(L))]
-                                for k in ti.static(range(NP))], ti.f64)
-                Z = ti.Matrix([[y[k, base + l] for l in ti.static(range(L))]
-                               for k in ti.static(range(NS))], ti.f64)
+                PV = gather(par, base, L, NP)
+                Z = gather(y, base, L, NS)
                 t_end = repeats * CK_UNIT
                 T = ti.Vector([0.0] * L, ti.f64)
                 H = ti.Vector([CK_H0] * L, ti.f64)
