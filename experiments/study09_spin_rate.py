@@ -1,8 +1,11 @@
 """Paper Fig. 11 (Naidu & Margot 2015; script study09): spin rate vs time for four 1991 VH trajectories.
 
 θ_p = 0 and θ̇_p/n = 0.45 (synchronous island, shifted by relaxed-mode libration), 1.70
-(chaotic), 2.38 (resonant), 2.60 (quasi-periodic, circulating). A chaotic spin wanders
-irregularly between resonances; regular ones stay in a band.
+(chaotic), 2.38 (the paper's resonant example), 2.60 (quasi-periodic, circulating). A chaotic
+spin wanders irregularly between resonances; regular ones stay in a band. Measured here
+(300 orbits, apsidal): 0.45 resonant, 1.70 chaotic, 2.60 quasi-periodic, and 2.38 chaotic:
+at θ_p = 0 the 2:1 island of this model tops out near 2.3 (study06's section), so 2.38 starts
+in the chaotic layer just above it and wanders down to θ̇/n ≈ −0.1.
 
 Coordinates: apsidal, the paper's (docs/physics.md §6.7): the starts are the paper's and the
 plotted θ̇/n is the rate of θ measured from the osculating line of apsides (spin rate − ϖ̇).
