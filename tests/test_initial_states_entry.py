@@ -121,3 +121,13 @@ def test_cli_tilt_errors(tmp_path, flags, text):
 
     p = run_cli("section", "--orbits", "1", *flags, cwd=tmp_path)
     assert p.returncode == 2 and text in p.stderr and not list(tmp_path.iterdir())
+
+
+def test_one_system_per_state_errors_name_the_member(vh, didymos):
+    # each state is checked against its own system, and the message names its index
+    touching = tso.InitialState(R=[300.0, 0, 0], V=[0, 0.1, 0], primary_attitude=np.eye(3),
+                                primary_omega=[0, 0, 0], secondary_attitude=np.eye(3),
+                                secondary_omega=[0, 0, 1e-4])
+    with pytest.raises(ValueError, match=r"^initial_states\[1\]: the bodies overlap at the start"):
+        tso.surface_of_section([vh, didymos], orbits=1,
+                               initial_states=[vh.tilted_start(0.0, 1.0), touching])

@@ -182,9 +182,10 @@ class InitialState:
         return self
 
     # ---- conversions ----------------------------------------------------------------------
-    def to_scaled(self, system):
-        """The kernels' 30-element scaled state (docs/physics.md §4.3) for ``system``."""
-        self.check(system)
+    def to_scaled(self, system, name="initial state"):
+        """The kernels' 30-element scaled state (docs/physics.md §4.3) for ``system``, after
+        :meth:`check` (whose errors start with ``name``)."""
+        self.check(system, name=name)
         A1, A2 = self.primary_attitude, self.secondary_attitude
         S = A1.T @ A2                                   # secondary -> primary frame
         m_red = system.primary.mass * system.secondary.mass / system.total_mass
@@ -254,7 +255,7 @@ class InitialState:
 
 
 def _unit(v):
-    return v / np.linalg.norm(v)
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 def _nearest_rotation(A):
@@ -265,10 +266,13 @@ def _nearest_rotation(A):
 
 
 def orbit_frame(R, V):
-    """Columns: radial R/|R|, along-track (normal × radial), orbit normal (R × V)/|R × V|."""
-    x = _unit(np.asarray(R, dtype=np.float64))
+    """Orbit frame of positions R and velocities V (any leading shape, ..., 3): a matrix
+    (..., 3, 3) whose columns are radial R/|R|, along-track (normal × radial) and the orbit
+    normal (R × V)/|R × V|."""
+    R = np.asarray(R, dtype=np.float64)
+    x = _unit(R)
     z = _unit(np.cross(R, V))
-    return np.column_stack([x, np.cross(z, x), z])
+    return np.stack([x, np.cross(z, x), z], axis=-1)
 
 
 def tilted_start(system, theta_p, thetadot_p, *, roll=0.0, pitch=0.0, yaw=0.0,
@@ -324,16 +328,17 @@ def tilted_start(system, theta_p, thetadot_p, *, roll=0.0, pitch=0.0, yaw=0.0,
 
 
 def as_scaled_states(system, states):
-    """(N, 30) scaled states of a sequence of :class:`InitialState` for ``system`` (each
-    checked; errors name the member)."""
+    """(N, 30) scaled states of a sequence of :class:`InitialState`, for one ``system`` or a
+    list of one system per state (each state checked once; errors name the member)."""
     if isinstance(states, InitialState):
         states = [states]
+    states = list(states)
+    systems = system if isinstance(system, (list, tuple)) else [system] * len(states)
     out = []
-    for k, s in enumerate(states):
+    for k, (m, s) in enumerate(zip(systems, states)):
         if not isinstance(s, InitialState):
             raise TypeError(f"initial_states[{k}] must be an InitialState (got {show(s)})")
-        s.check(system, name=f"initial_states[{k}]")
-        out.append(s.to_scaled(system))
+        out.append(s.to_scaled(m, name=f"initial_states[{k}]"))
     if not out:
         raise ValueError("initial_states must hold at least one InitialState")
     return np.stack(out)

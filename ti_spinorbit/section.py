@@ -102,6 +102,34 @@ def _warn_near_circular(members):
                       NearCircularWarning, stacklevel=3)
 
 
+def _system_list(system):
+    """The systems of a member table as a non-empty list, or TypeError naming ``system``."""
+    try:
+        systems = [system] if isinstance(system, BinarySystem) else list(system)
+    except TypeError:                       # not iterable (a number, None)
+        systems = []
+    if not systems or not all(isinstance(s, BinarySystem) for s in systems):
+        raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
+                        f"of them (got {show(system)})")
+    return systems
+
+
+def _check_escape_distance(escape_distance):
+    distance = _as_floats("escape_distance", escape_distance)
+    if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
+        raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
+                         f"(got {escape_distance!r})")
+
+
+def _parameter_rows(members, escape_distance):
+    """(N, NPAR) kernel parameter rows, one ``parameter_row`` per distinct system."""
+    rows = {}
+    for m in members:
+        if id(m) not in rows:
+            rows[id(m)] = m.parameter_row(escape_distance)
+    return np.stack([rows[id(m)] for m in members])
+
+
 def build_members(system: SystemLike, theta_p, thetadot_p,
                   escape_distance=ESCAPE_DISTANCE, coordinates="inertial", order=4):
     """Broadcast systems and initial conditions into a member table.
@@ -111,18 +139,8 @@ def build_members(system: SystemLike, theta_p, thetadot_p,
     ``coordinates="apsidal"`` thetadot_p is the apsidal spin rate θ̇ − ϖ̇ at the start and y0
     carries the inertial spin θ̇_p + ϖ̇(0) (docs/physics.md §6.7; ϖ̇ of the ``order`` model)."""
     _coords.check_coordinates(coordinates)
-    distance = _as_floats("escape_distance", escape_distance)
-    if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
-        raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
-                         f"(got {escape_distance!r})")
-    try:
-        systems = [system] if isinstance(system, BinarySystem) else \
-            list(system)
-    except TypeError:                       # not iterable (a number, None)
-        systems = []
-    if not systems or not all(isinstance(s, BinarySystem) for s in systems):
-        raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
-                        f"of them (got {show(system)})")
+    _check_escape_distance(escape_distance)
+    systems = _system_list(system)
     # checked before the conversion, so complex values and text are refused, not cast
     theta_p = np.asarray(require_finite("theta_p", theta_p), dtype=np.float64)
     thetadot_p = np.asarray(require_spin("thetadot_p", thetadot_p), dtype=np.float64)
@@ -137,8 +155,7 @@ def build_members(system: SystemLike, theta_p, thetadot_p,
                          f"{theta_p.shape} and thetadot_p of shape {thetadot_p.shape}") from None
     index, theta_p, thetadot_p = (np.ravel(x) for x in (index, theta_p, thetadot_p))
     members = [systems[k] for k in index]
-    rows = {}
-    par = np.stack([rows.setdefault(id(s), s.parameter_row(escape_distance)) for s in members])
+    par = _parameter_rows(members, escape_distance)
     y0 = np.stack([s.initial_state(np.radians(tp), td)
                    for s, tp, td in zip(members, theta_p, thetadot_p)])
     if coordinates == "apsidal":
@@ -156,22 +173,14 @@ def state_members(system: SystemLike, initial_states, escape_distance=ESCAPE_DIS
     from .observables import derive
 
     states = [initial_states] if isinstance(initial_states, InitialState) else list(initial_states)
-    systems = [system] if isinstance(system, BinarySystem) else list(system)
-    if not systems or not all(isinstance(x, BinarySystem) for x in systems):
-        raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
-                        f"of them (got {show(system)})")
+    systems = _system_list(system)
     if len(systems) not in (1, len(states)):
         raise ValueError(f"with initial_states, system must be one system or one per state "
                          f"(got {len(systems)} systems for {len(states)} states)")
     members = systems * len(states) if len(systems) == 1 else systems
-    distance = _as_floats("escape_distance", escape_distance)
-    if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
-        raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
-                         f"(got {escape_distance!r})")
-    y0 = np.concatenate([as_scaled_states(m, [st]) for m, st in zip(members, states)]) \
-        if len(systems) > 1 else as_scaled_states(members[0], states)
-    rows = {}
-    par = np.stack([rows.setdefault(id(m), m.parameter_row(escape_distance)) for m in members])
+    _check_escape_distance(escape_distance)
+    y0 = as_scaled_states(members, states)
+    par = _parameter_rows(members, escape_distance)
     d = derive(par, y0)
     return members, par, y0, np.degrees(d["alpha"]), d["thetadot"]
 
