@@ -51,11 +51,11 @@ def _split(y):
 
 def orbit_frame(y):
     """Orbit frame of each state in the primary's frame: matrix (..., 3, 3) whose columns
-    are the radial, along-track and normal unit vectors."""
+    are the radial, along-track and normal unit vectors (:func:`ti_spinorbit.initial.orbit_frame`)."""
+    from .initial import orbit_frame as frame
+
     R, V, _, _ = _split(y)
-    x = _unit(R)
-    z = _unit(np.cross(R, V))
-    return np.stack([x, np.cross(z, x), z], axis=-1)
+    return frame(R, V)
 
 
 def relative_attitude(y):
@@ -76,14 +76,11 @@ def euler_angles(y):
 def euler_angles_of_rows(rows):
     """:func:`euler_angles` of SI state rows (``initial.ROW_SLICES``: inertial R, V and the
     secondary's body -> inertial attitude), e.g. a time series' ``states``."""
-    from .initial import ROW_SLICES
+    from .initial import ROW_SLICES, orbit_frame as frame
 
     rows = np.asarray(rows, dtype=np.float64)
-    R, V = rows[..., ROW_SLICES["R"]], rows[..., ROW_SLICES["V"]]
     A2 = rows[..., ROW_SLICES["secondary_attitude"]].reshape(rows.shape[:-1] + (3, 3))
-    x = _unit(R)
-    z = _unit(np.cross(R, V))
-    O = np.stack([x, np.cross(z, x), z], axis=-1)
+    O = frame(rows[..., ROW_SLICES["R"]], rows[..., ROW_SLICES["V"]])
     return _euler(np.swapaxes(O, -1, -2) @ A2)
 
 

@@ -142,6 +142,7 @@ def _help_epilog(command):
 
 
 def _parser():
+    from .compiling import METHODS
     from .runtime import _KNOWN_ARCHS
 
     p = _Parser(prog="ti-spinorbit", description=(
@@ -177,7 +178,7 @@ def _parser():
         s.add_argument("--rtol", type=float, default=rtol,
                        help=f"relative tolerance in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}] "
                             f"(default {rtol:g})")
-        s.add_argument("--method", choices=("cash-karp", "dop853"), default="cash-karp",
+        s.add_argument("--method", choices=METHODS, default="cash-karp",
                        help="Runge-Kutta pair: cash-karp (default, the paper's 4(5)) or dop853 "
                             "(8(5,3): fewer steps, faster at tight tolerances)")
         s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,

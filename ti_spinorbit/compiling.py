@@ -27,7 +27,7 @@ fingerprint (the kernel sources, Taichi version, arch) of the last compile made 
 cache on. Same fingerprint: it is a load, not announced (Taichi may still evict old entries:
 then a compile happens unannounced, and is measured and recorded as usual).
 
-:func:`warmup` (CLI ``ti-spinorbit warmup``) compiles chosen variants ahead of time by
+:func:`ti_spinorbit.warmup.warmup` (CLI ``ti-spinorbit warmup``) compiles chosen variants ahead of time by
 running each on one member for a hundredth of an orbit.
 """
 
