@@ -36,7 +36,7 @@ from types import SimpleNamespace
 
 import taichi as ti
 
-from . import eom, planar
+from . import eom, perturb, planar
 from .eom import NSTATE
 from .controller import DEFAULT_CONTROLLER, NONFINITE_ERROR
 from .integrator import make_error_norm, make_primitives, stage_matrix_type
@@ -75,7 +75,8 @@ nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 nd2l = ti.types.ndarray(dtype=ti.i64, ndim=2)
 
 
-def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll_components=None):
+def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll_components=None,
+                 perturbed=False):
     """``advance`` and ``evaluate_rhs`` kernels for one model of the equations of motion,
     integrating with ``tableau`` under the step-size policy ``controller``.
 
@@ -87,13 +88,20 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     ``UNROLL_LIMIT`` entries, i.e. Cash-Karp on the planar model) unrolls the stage
     combinations over the state components so the stage matrix lives in registers; otherwise
     they are runtime loops (``integrator.make_primitives``; docs/design.md, "Compile time").
+
+    ``perturbed`` integrates the model's ``rhs_perturbed`` (tides, YORP, BYORP from a
+    block of ``perturb.NPERT`` columns after the model's parameters) and carries the
+    ``perturb.NACC`` accumulators (work, external angular momentum) after the model's state;
+    they ride in every step, record and checkpoint but not in the error norm.
     """
-    NSTATE = model.NSTATE
+    NSTATE = model.NSTATE                   # what the error norm holds to the tolerance
+    NK = NSTATE + (perturb.NACC if perturbed else 0)   # what the kernel carries
     if unroll_components is None:
-        unroll_components = tableau.stages * NSTATE <= UNROLL_LIMIT
-    state = model.state
-    stage_point, combine, put_stage = make_primitives(tableau, NSTATE, unroll_components)
-    kmat = stage_matrix_type(tableau, NSTATE)
+        unroll_components = tableau.stages * NK <= UNROLL_LIMIT
+    state = model.state_perturbed if perturbed else model.state
+    rhs = model.rhs_perturbed if perturbed else model.rhs
+    stage_point, combine, put_stage = make_primitives(tableau, NK, unroll_components)
+    kmat = stage_matrix_type(tableau, NK)
     error_norm = make_error_norm(tableau, unroll_components)
     ctl = controller.funcs()
     _STAGES = tableau.stages
@@ -132,6 +140,8 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
         to the separation d0 (the derivative rescaled linearly: exact to O(d0²)), and
         whether it moved at all: (dl, y_s, f_s, grew)."""
         delta = ys_try - y
+        for k in ti.static(range(NSTATE, NK)):  # accumulators: the shadow shares the member's
+            delta[k] = 0.0
         d = delta.norm()
         dl = 0.0
         y_s = ys_try
@@ -173,19 +183,19 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     @ti.func
     def _load(a: ti.template(), i):
         y = state(0.0)
-        for k in ti.static(range(NSTATE)):
+        for k in ti.static(range(NK)):
             y[k] = a[i, k]
         return y
 
     @ti.func
     def _store(a: ti.template(), i, y):
-        for k in ti.static(range(NSTATE)):
+        for k in ti.static(range(NK)):
             a[i, k] = y[k]
 
     @ti.func
     def _record(buf: ti.template(), i, slot, t, y):
         buf[i, slot, 0] = t
-        for k in ti.static(range(NSTATE)):
+        for k in ti.static(range(NK)):
             buf[i, slot, 1 + k] = y[k]
 
     @ti.kernel
@@ -217,7 +227,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 calls = 0
                 after_reject = 0
                 K = kmat(0.0)
-                for c in ti.static(range(NSTATE)):
+                for c in ti.static(range(NK)):
                     K[0, c] = f0[c]
                 # shadow trajectory (chaos indicators): same steps, its own stages in K2
                 y_s = state(0.0)
@@ -229,7 +239,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 ybar_int = 0.0
                 if ti.static(indicators):
                     y_s = _load(shadow_nd, i)
-                    for c in ti.static(range(NSTATE)):
+                    for c in ti.static(range(NK)):
                         K2[0, c] = shadow_f_nd[i, c]
                     ell = ind[i, 0]
                     s_weighted = ind[i, 1]
@@ -271,7 +281,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                             pt = ys_try
                             if stage < _STAGES:
                                 pt = stage_point(y_s, K2, hs, stage)
-                        fc = model.rhs(par, i, pt, order, odd)    # the only RHS call site
+                        fc = rhs(par, i, pt, order, odd)          # the only RHS call site
                         calls += 1
                         if copy == 0:
                             fy = fc
@@ -337,7 +347,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                             tc = 0.0
                             t = ti.select(hit_end == 1, ts, next_sample[i])
                         f0 = fy
-                        for c in ti.static(range(NSTATE)):
+                        for c in ti.static(range(NK)):
                             K[0, c] = fy[c]
                         if ti.static(indicators):
                             dl, ys_new, fs_new, grew = _renormalised_shadow(y, ys_try, fy, f_s1,
@@ -347,7 +357,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 s_weighted += t_mid * dl
                                 ybar_int += 2.0 * s_weighted / t * hs
                                 y_s = ys_new
-                                for c in ti.static(range(NSTATE)):
+                                for c in ti.static(range(NK)):
                                     K2[0, c] = fs_new[c]
                         acc += 1
                         # (a step shortened for a sample or the end that did well keeps h)
@@ -366,7 +376,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 _store(f_nd, i, f0)
                 if ti.static(indicators):
                     _store(shadow_nd, i, y_s)
-                    for c in ti.static(range(NSTATE)):
+                    for c in ti.static(range(NK)):
                         shadow_f_nd[i, c] = K2[0, c]
                     ind[i, 0] = ell
                     ind[i, 1] = s_weighted
@@ -385,11 +395,11 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     def evaluate_rhs(par: nd2f, y_nd: nd2f, out: nd2f, order: ti.template(), odd: ti.template()):
         """dy/dt for each row of y (also the first stage of every member's first step)."""
         for i in range(y_nd.shape[0]):
-            _store(out, i, model.rhs(par, i, _load(y_nd, i), order, odd))
+            _store(out, i, rhs(par, i, _load(y_nd, i), order, odd))
 
     return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, load=_load,
-                           NSTATE=NSTATE, RECORD_WIDTH=1 + NSTATE, model=model,
-                           tableau=tableau, controller=controller)
+                           NSTATE=NK, MODEL_NSTATE=NSTATE, RECORD_WIDTH=1 + NK, model=model,
+                           tableau=tableau, controller=controller, perturbed=bool(perturbed))
 
 
 #: The 3-D model's kernels (30-number state) and the planar model's (10 numbers), Cash-Karp.
@@ -398,13 +408,14 @@ PLANAR = make_kernels(planar)
 _KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
 
 
-def kernels_for(model, method=DEFAULT_METHOD):
+def kernels_for(model, method=DEFAULT_METHOD, perturbed=False):
     """The kernel set of ``model`` ("planar" or "3d") integrating with ``method`` (a name of
-    ``tableau.METHODS``), built once per process (Taichi compiles each on first launch)."""
-    key = (model, check_method(method))
+    ``tableau.METHODS``), with or without perturbations, built once per process (Taichi
+    compiles each on first launch)."""
+    key = (model, check_method(method)) + (("perturbed",) if perturbed else ())
     if key not in _KERNEL_SETS:
         _KERNEL_SETS[key] = make_kernels(planar if model == "planar" else eom, METHODS[method],
-                                         DEFAULT_CONTROLLER)
+                                         DEFAULT_CONTROLLER, perturbed=perturbed)
     return _KERNEL_SETS[key]
 advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs

@@ -24,10 +24,13 @@ import taichi as ti
 
 from ti_spinorbit.bodies import ROW_LENGTH
 
+from . import perturb
 from .potential import mutual, vec3, mat3
 
 NSTATE = 30
 state = ti.types.vector(NSTATE, ti.f64)
+#: State with the perturbation accumulators (W, L_ext) appended (``perturb.NACC``).
+state_perturbed = ti.types.vector(NSTATE + perturb.NACC, ti.f64)
 
 # Member parameter row layout (scaled units): two body rows, then derived constants.
 BODY_A = 0
@@ -96,6 +99,42 @@ def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
             dy[Y_S + 3 * r + c] = col[r]
     for r in ti.static(range(3)):  # rows of S1: d r/dt = r × Ω1
         put3(dy, Y_S1 + 3 * r, get3(y, Y_S1 + 3 * r).cross(om1))
+    return dy
+
+
+@ti.func
+def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """dy/dt with the tides, YORP and BYORP of member i's perturbation block (columns from
+    NPAR, ``kernels/perturb.py``), and the accumulators' rates: work and external torque."""
+    base = rhs(p, i, y, order, odd)
+    R = get3(y, Y_R)
+    V = get3(y, Y_V)
+    S = get33(y, Y_S)
+    om1, om2 = angular_velocities(p, i, y)
+    q = NPAR
+    F = vec3(0.0, 0.0, 0.0)
+    N1 = vec3(0.0, 0.0, p[i, q + perturb.Q_YORP1])          # YORP about the primary's z
+    N2 = p[i, q + perturb.Q_YORP2] * vec3(S[0, 2], S[1, 2], S[2, 2])   # the secondary's z
+    if p[i, q + perturb.Q_TIDE1] != 0.0:
+        f1 = perturb.tide_force(p[i, q + perturb.Q_TIDE1], p[i, q + perturb.Q_TIDE1 + 1],
+                                p[i, q + perturb.Q_TIDE1 + 2], R, V, om1)
+        F += f1
+        N1 -= R.cross(f1)
+    if p[i, q + perturb.Q_TIDE2] != 0.0:
+        f2 = perturb.tide_force(p[i, q + perturb.Q_TIDE2], p[i, q + perturb.Q_TIDE2 + 1],
+                                p[i, q + perturb.Q_TIDE2 + 2], R, V, om2)
+        F += f2
+        N2 -= R.cross(f2)
+    m = p[i, P_MRED]
+    F += (m * p[i, q + perturb.Q_BYORP] / V.norm()) * V
+    dy = state_perturbed(0.0)
+    for k in ti.static(range(NSTATE)):
+        dy[k] = base[k]
+    put3(dy, Y_V, get3(base, Y_V) + F / m)
+    put3(dy, Y_W1, get3(base, Y_W1) + N1 / p[i, P_C1])
+    put3(dy, Y_W2, get3(base, Y_W2) + N2 / p[i, P_C2])
+    dy[NSTATE] = F.dot(V) + N1.dot(om1) + N2.dot(om2)
+    put3(dy, NSTATE + 1, get33(y, Y_S1) @ (R.cross(F) + N1 + N2))
     return dy
 
 

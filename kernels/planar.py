@@ -49,8 +49,12 @@ The torques about z are τ_k = −V_k, so m ℓ + Γ1 + Γ2 is conserved exactly
 
 import taichi as ti
 
+from . import perturb
+
 NSTATE = 10
 state = ti.types.vector(NSTATE, ti.f64)
+#: State with the perturbation accumulators (W, L_ext) appended (``perturb.NACC``).
+state_perturbed = ti.types.vector(NSTATE + perturb.NACC, ti.f64)
 
 # Offsets in the state vector.
 Y_R, Y_VR, Y_L, Y_LAM, Y_CA, Y_SA, Y_W1, Y_CB, Y_SB, Y_W2 = range(10)
@@ -179,6 +183,52 @@ def rhs_member(pv, y, order: ti.template(), odd: ti.template()):
     dy[Y_CB] = -y[Y_SB] * rateB
     dy[Y_SB] = y[Y_CB] * rateB
     dy[Y_W2] = -VB * pv[P_K2]
+    return dy
+
+
+@ti.func
+def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """dy/dt with member i's tides, YORP and BYORP (``kernels/perturb.py``; the block starts
+    at column NPAR) in the plane, and the accumulators' rates (work, external torque along
+    z; the x and y components stay zero)."""
+    pv = member(p, i)
+    base = rhs_member(pv, y, order, odd)
+    q = NPAR
+    r = y[Y_R]
+    vr = y[Y_VR]
+    ell = y[Y_L]
+    om1 = pv[P_F1] * y[Y_W1]
+    om2 = pv[P_F2] * y[Y_W2]
+    Fr = 0.0
+    Ft = 0.0
+    N1 = p[i, q + perturb.Q_YORP1]
+    N2 = p[i, q + perturb.Q_YORP2]
+    if p[i, q + perturb.Q_TIDE1] != 0.0:
+        fr, ft = perturb.tide_polar(p[i, q + perturb.Q_TIDE1], p[i, q + perturb.Q_TIDE1 + 1],
+                                    p[i, q + perturb.Q_TIDE1 + 2], r, vr, ell, om1)
+        Fr += fr
+        Ft += ft
+        N1 -= r * ft
+    if p[i, q + perturb.Q_TIDE2] != 0.0:
+        fr, ft = perturb.tide_polar(p[i, q + perturb.Q_TIDE2], p[i, q + perturb.Q_TIDE2 + 1],
+                                    p[i, q + perturb.Q_TIDE2 + 2], r, vr, ell, om2)
+        Fr += fr
+        Ft += ft
+        N2 -= r * ft
+    vt = ell / r
+    speed = ti.sqrt(vr * vr + vt * vt)
+    fb = p[i, q + perturb.Q_BYORP] / (pv[P_INV_M] * speed)   # m a_B / |V|
+    Fr += fb * vr
+    Ft += fb * vt
+    dy = state_perturbed(0.0)
+    for k in ti.static(range(NSTATE)):
+        dy[k] = base[k]
+    dy[Y_VR] += pv[P_INV_M] * Fr
+    dy[Y_L] += pv[P_INV_M] * r * Ft
+    dy[Y_W1] += N1 * pv[P_K1]
+    dy[Y_W2] += N2 * pv[P_K2]
+    dy[NSTATE] = Fr * vr + Ft * vt + N1 * om1 + N2 * om2
+    dy[NSTATE + 3] = r * Ft + N1 + N2
     return dy
 
 

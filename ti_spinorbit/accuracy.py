@@ -65,11 +65,17 @@ def totals(diag):
     return diag[:, :3].sum(1), diag[:, 3:6] + diag[:, 6:9] + diag[:, 9:12]
 
 
-def drifts(diag_start, diag_end):
+def drifts(diag_start, diag_end, exchange=None):
     """Relative energy and angular-momentum drift per member from DIAG_FIELDS rows at the
-    start and at the end: |E1 − E0| / |E0| and |L1 − L0| / |L0|. NaN where a diagnostic is."""
+    start and at the end: |E1 − E0| / |E0| and |L1 − L0| / |L0|. NaN where a diagnostic is.
+
+    ``exchange`` (N, 4), with perturbations: the work W and external angular momentum L_ext
+    received by the end (``kernels/perturb.py``), taken off first, so that the drift is that
+    of E − W and L − L_ext, which the equations conserve (docs/physics.md §11.4)."""
     e0, l0 = totals(diag_start)
     e1, l1 = totals(diag_end)
+    if exchange is not None:
+        e1, l1 = e1 - exchange[:, 0], l1 - exchange[:, 1:4]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         energy = np.abs(e1 - e0) / np.abs(e0)
         angmom = np.linalg.norm(l1 - l0, axis=1) / np.linalg.norm(l0, axis=1)

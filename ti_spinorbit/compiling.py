@@ -61,12 +61,16 @@ _TOTAL = [0.0]             # compile seconds spent in this process
 _HOW = {}                  # variant -> how its last first use went ("compiled", "loaded")
 
 
-def variant_name(model, indicators, sampling, order=4, odd=False, method="cash-karp"):
-    """A variant as text (the key of the measurements): ``planar/indicators/order4/cash-karp``."""
+def variant_name(model, indicators, sampling, order=4, odd=False, method="cash-karp",
+                 perturbed=False):
+    """A variant as text (the key of the measurements): ``planar/indicators/order4/cash-karp``
+    (``.../perturbed/cash-karp`` with tides, YORP or BYORP)."""
     parts = [model, "indicators" if indicators else "plain", "sampling" if sampling else
              "sections", f"order{int(order)}"]
     if odd:
         parts.append("odd")
+    if perturbed:
+        parts.append("perturbed")
     return "/".join(parts + [method])
 
 
@@ -78,6 +82,8 @@ def describe(variant):
         what.append("with chaos indicators")
     if samp == "sampling":
         what.append("with dense sampling")
+    if "perturbed" in variant.split("/"):
+        what.append("with perturbations")
     method = variant.split("/")[-1]
     if method != "cash-karp":
         what.append(f"({method})")

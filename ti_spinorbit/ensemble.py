@@ -59,6 +59,12 @@ class RunOutput:
     seconds: float = 0.0
     megno: Optional[np.ndarray] = None      # (N,) MEGNO <Y> at the final time (indicators on)
     lyapunov: Optional[np.ndarray] = None   # (N,) finite-time max Lyapunov exponent, 1/orbit
+    #: with perturbations: per member, (count, 4) work W and external angular momentum
+    #: L_ext (scaled) at each event / sample, and (N, 4) at the final time
+    #: (``kernels/perturb.py``); None without
+    event_exchange: Optional[List[np.ndarray]] = None
+    sample_exchange: Optional[List[np.ndarray]] = None
+    exchange: Optional[np.ndarray] = None
 
 
 @dataclass
@@ -140,10 +146,14 @@ class Ensemble:
         paper's) or "dop853" (Hairer's 8(5,3) pair: fewer, longer steps; faster at tight
         tolerances). Both hold the same error norm to ``rtol``; events, sampling, indicators,
         checkpoints and both models work with either.
+    perturbation_rows : (N, NPERT) array, optional
+        Scaled tides / YORP / BYORP blocks (``ti_spinorbit.perturbations.perturbation_rows``):
+        the kernels then integrate the perturbed equations and carry the work and external
+        angular momentum after the state (``kernels/perturb.py``; docs/physics.md §11).
     """
 
     def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,
-                 min_step=MIN_STEP, model="auto", method="cash-karp"):
+                 min_step=MIN_STEP, model="auto", method="cash-karp", perturbation_rows=None):
         from .bodies import ROW_LENGTH
         from .kernels import eom
         from .kernels.tableau import METHODS, check_method
@@ -167,8 +177,15 @@ class Ensemble:
         self.equations = models.choose(model, self.par, self.y)
         self._model_request = model      # "auto" may still turn 3-D for full-space indicators
         self.model = self.equations.name
-        self.kpar = self.equations.kernel_parameters(self.par)
-        self.y = self.equations.to_kernel_state(self.y)
+        self.prows = None
+        if perturbation_rows is not None:
+            from .perturbations import NPERT
+            self.prows = np.ascontiguousarray(perturbation_rows, dtype=np.float64)
+            if self.prows.shape != (len(self.par), NPERT) or not np.all(np.isfinite(self.prows)):
+                raise ValueError(f"perturbation_rows must be a finite (N, {NPERT}) array")
+        self.perturbed = self.prows is not None
+        self.kpar = self._kernel_parameters()
+        self.y = self._kernel_state(self.y)
         n = len(self.par)
         self.n = n
         self.t = np.zeros(n)
@@ -181,11 +198,26 @@ class Ensemble:
     @property
     def kernels(self):
         """The kernel set of this ensemble's model and method (``kernels_for``)."""
-        return self.equations.kernels(self.method)
+        return self.equations.kernels(self.method, self.perturbed)
+
+    def _kernel_parameters(self):
+        """The kernels' parameter rows: the model's, then the perturbation block."""
+        kpar = self.equations.kernel_parameters(self.par)
+        return kpar if self.prows is None else np.ascontiguousarray(np.hstack([kpar, self.prows]))
+
+    def _kernel_state(self, y):
+        """3-D states -> kernel states, with zero accumulators when perturbed."""
+        from .perturbations import NACC
+        k = self.equations.to_kernel_state(y)
+        return k if not self.perturbed else np.hstack([k, np.zeros((len(k), NACC))])
 
     def spatial(self, y):
-        """Kernel states of this model -> 3-D scaled states (a copy)."""
-        return self.equations.to_spatial(y)
+        """Kernel states of this model -> 3-D scaled states (a copy; accumulators dropped)."""
+        return self.equations.to_spatial(np.asarray(y)[:, :self.equations.nstate])
+
+    def exchange(self, y):
+        """The accumulators (work, L_ext; (N, 4) scaled) of kernel states, or None."""
+        return np.array(np.asarray(y)[:, self.equations.nstate:]) if self.perturbed else None
 
     def diagnostics(self, y=None, member=None) -> np.ndarray:
         """DIAG_FIELDS (energies, angular momenta, orthonormality) of 3-D states y (default:
@@ -260,7 +292,7 @@ class Ensemble:
                     "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
                     "indicators": bool(indicators), "separation": float(separation),
-                    "indicator_space": indicator_space}
+                    "indicator_space": indicator_space, "perturbed": self.perturbed}
         args = (t_stop, window_orbits, sample_dt, indicators, separation, progress, checkpoint,
                 resume, settings)
         if checkpoint is None:
@@ -289,7 +321,7 @@ class Ensemble:
         # time stays out of seconds, rates and window lengths (ti_spinorbit.compiling)
         advance = compiling.FirstUse(kern.advance, compiling.variant_name(
             self.model, indicators, sampling, self.order, self.odd,
-            getattr(self, "method", "cash-karp")), lambda: self.status)
+            getattr(self, "method", "cash-karp"), self.perturbed), lambda: self.status)
         if st is None:
             with advance.other_kernels():
                 st = self._fresh_run_state(sampling, sample_dt, indicators, separation,
@@ -342,9 +374,13 @@ class Ensemble:
             with np.errstate(divide="ignore", invalid="ignore"):
                 megno = ind[:, 2] / self.t
                 lyapunov = ind[:, 0] / self.t * 2.0 * np.pi   # per orbit (2π scaled time)
+        ev = [self._spatial_records(e) for e in events]
+        sm = [self._spatial_records(s) for s in samples]
         return RunOutput(
-            events=[self._spatial_records(e) for e in events],
-            samples=[self._spatial_records(s) for s in samples],
+            events=[e for e, _ in ev], samples=[s for s, _ in sm],
+            event_exchange=[x for _, x in ev] if self.perturbed else None,
+            sample_exchange=[x for _, x in sm] if self.perturbed else None,
+            exchange=self.exchange(self.y),
             diag_start=st.diag_start, diag_end=self.diagnostics(), t=self.t.copy(),
             y=self.spatial(self.y), status=self.status.copy(), counters=self.counters.copy(),
             launches=st.launches, seconds=st.seconds, megno=megno, lyapunov=lyapunov)
@@ -358,10 +394,12 @@ class Ensemble:
             raise ValueError("indicator_space='full' needs the 3-D model (the planar model "
                              "cannot carry out-of-plane deviations): use model='auto' or '3d'")
         # the exact 3-D start before any step (no round trip through the planar layout)
-        self.y = self._y_start.copy() if not np.any(self.t) else self.spatial(self.y)
+        acc = self.exchange(self.y)
+        y = self._y_start.copy() if not np.any(self.t) else self.spatial(self.y)
         self.equations = models.SPATIAL
         self.model = self.equations.name
-        self.kpar = self.equations.kernel_parameters(self.par)
+        self.kpar = self._kernel_parameters()
+        self.y = y if acc is None else np.hstack([y, acc])
 
     def _fresh_run_state(self, sampling, sample_dt, indicators, separation,
                          indicator_space="planar"):
@@ -375,9 +413,11 @@ class Ensemble:
         kern.evaluate_rhs(self.kpar, self.y, f, self.order, self.odd)
         self.counters[:, K.C_RHS] += 1
         if indicators:
-            direction = self.equations.full_direction(self.y) if indicator_space == "full" \
+            ys = self.y[:, :self.equations.nstate]
+            direction = self.equations.full_direction(ys) if indicator_space == "full" \
                 else self.equations.shadow_direction()
-            shadow = self.y + separation * direction
+            shadow = self.y.copy()         # accumulators: the same as the member's
+            shadow[:, :self.equations.nstate] = ys + separation * direction
             shadow_f = np.zeros_like(shadow)
             kern.evaluate_rhs(self.kpar, shadow, shadow_f, self.order, self.odd)
             ind = np.zeros((n, 3))
@@ -400,20 +440,24 @@ class Ensemble:
         import hashlib
 
         h = hashlib.sha256()
-        for a in (self.par, self._y_start, t_stop):
+        for a in (self.par, self._y_start, t_stop) + (() if self.prows is None else (self.prows,)):
             h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
         return h.hexdigest()
 
     def _spatial_records(self, chunks):
-        """Concatenate a member's record chunks and convert them to (count, 31) 3-D rows."""
+        """Concatenate a member's record chunks and convert them to (count, 31) 3-D rows;
+        with the accumulators of a perturbed run apart, (count, 4) (else an empty array)."""
         from .kernels import ensemble as K
+        from .perturbations import NACC
 
         if not chunks:
-            return np.zeros((0, K.RECORD_WIDTH))
+            return np.zeros((0, K.RECORD_WIDTH)), np.zeros((0, NACC))
         rec = np.concatenate(chunks)
+        ns = 1 + self.equations.nstate
+        acc = rec[:, ns:]
         if self.equations is models.SPATIAL:
-            return rec
-        return np.concatenate([rec[:, :1], self.equations.to_spatial(rec[:, 1:])], axis=1)
+            return rec[:, :ns], acc
+        return np.concatenate([rec[:, :1], self.equations.to_spatial(rec[:, 1:ns])], axis=1), acc
 
 
 def _next_span(span, seconds, window):

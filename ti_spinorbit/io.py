@@ -41,7 +41,7 @@ import zipfile
 
 import numpy as np
 
-from . import runtime
+from . import perturbations, runtime
 from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 
 #: Layout version written into every archive's metadata; bump it when the layout changes.
@@ -195,7 +195,7 @@ def _is_system(x):
 
 #: Metadata entries that tell load() how to rebuild a result (empty ones are left out).
 _BLOCK_KEYS = {"arrays": [], "object_arrays": [], "array_lists": {}, "system_refs": {},
-               "records": {}, "nested": {}, "dropped": []}
+               "records": {}, "nested": {}, "dropped": [], "perturbations": {}}
 
 
 def _encode(result, prefix, systems, arrays, units_out, include_sections):
@@ -240,6 +240,8 @@ def _encode(result, prefix, systems, arrays, units_out, include_sections):
                 if name in table:
                     units_out[f"{key}/{k}"] = table[name]
             block["array_lists"][name] = len(value)
+        elif isinstance(value, tuple) and name == "perturbations":
+            block["perturbations"][name] = perturbations.describe(value)
         elif isinstance(value, list) and all(dataclasses.is_dataclass(r) for r in value):
             block["records"][name] = _encode_records(kind, name, value)
         elif value is None or isinstance(value, (bool, int, float, str, np.generic)):
@@ -471,6 +473,8 @@ def _decode(block, arrays, prefix, systems):
                         for item in rec["items"]]
     for name, sub in block.get("nested", {}).items():
         kwargs[name] = _decode(sub, arrays, f"{prefix}{name}/", systems)
+    for name, items in block.get("perturbations", {}).items():
+        kwargs[name] = perturbations.from_description(items)
     return cls(**{renamed.get(k, k): v for k, v in kwargs.items()})   # format 1's old names
 
 

@@ -61,10 +61,10 @@ class Model:
         """Columns of the kernels' event and sample records: time, then the state."""
         return 1 + self.nstate
 
-    def kernels(self, method="cash-karp"):
+    def kernels(self, method="cash-karp", perturbed=False):
         """The Taichi kernel set (``kernels.ensemble.kernels_for``); imports Taichi."""
         from .kernels import ensemble as K
-        return K.kernels_for(self.name, method)
+        return K.kernels_for(self.name, method, perturbed)
 
     def qualifies(self, par, y0):
         """Per member: can this model integrate it exactly?"""

@@ -7,6 +7,8 @@ offline kernel cache). Call :func:`init` yourself first to pick another arch.
 Decisions (docs/design.md, "Kernel design"):
 * ``default_fp = f64`` and ``default_ip = i32`` always: tolerances down to 1e-15 must work.
 * ``fast_math=False``: on CUDA fast math degrades f64 sqrt/division.
+* ``unrolling_limit=0``: the kernels unroll loops over state components on purpose (34 for
+  the perturbed 3-D state); Taichi's warning above 32 iterations would only alarm users.
 * The environment variable ``TI_SPINORBIT_ARCH`` (``cpu``, ``cuda``, ``vulkan``, ...)
   overrides the arch of the lazy default and of ``init()`` called without an arch.
 * ``TI_SKIP_VERSION_CHECK=ON`` is set before Taichi is imported (no network in CI).
@@ -86,7 +88,8 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
     ti_arch = {"cpu": ti.cpu, "x64": ti.x64, "arm64": ti.arm64, "cuda": ti.cuda,
                "vulkan": ti.vulkan, "metal": ti.metal, "opengl": ti.opengl, "gpu": ti.gpu}[name]
     kwargs = dict(arch=ti_arch, default_fp=ti.f64, default_ip=ti.i32, offline_cache=offline_cache,
-                  fast_math=False, debug=debug, log_level=ti.WARN, enable_fallback=False)
+                  fast_math=False, debug=debug, log_level=ti.WARN, enable_fallback=False,
+                  unrolling_limit=0)
     if cpu_max_num_threads:
         kwargs["cpu_max_num_threads"] = int(cpu_max_num_threads)
     if name in ("cpu", "x64", "arm64"):

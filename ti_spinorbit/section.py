@@ -27,6 +27,7 @@ from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
 from .initial import ROW_UNIT as STATE_ROW
 from .attitude import CLASS_UNIT as ATTITUDE_CLASS
+from .perturbations import UNIT as PERTURBATIONS, check_perturbations, perturbation_rows
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
@@ -278,6 +279,7 @@ class SectionResult(Result, _display.Readable):
     max_tilt: np.ndarray = unit('deg', default=None)
     max_npa_angle: np.ndarray = unit('deg', default=None)
     indicator_space: str = unit(INDICATOR_SPACE, default="planar")
+    perturbations: tuple = unit(PERTURBATIONS, default=())
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -298,7 +300,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
                        progress=None, model="auto", checkpoint=None,
                        resume=False, overwrite_checkpoint=False,
                        max_drift=None, coordinates="inertial",
-                       method="cash-karp", initial_states=None,
+                       method="cash-karp", initial_states=None, perturbations=None,
                        indicator_space="planar") -> SectionResult:
     """Surface of section at pericentre for an ensemble of trajectories.
 
@@ -373,6 +375,12 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         "full" a seeded direction spanning the whole state (attitudes perturbed through a
         small rotation). "full" integrates with the 3-D model (model="auto" picks it;
         model="planar" is refused). Recorded in the result.
+    perturbations : list of Tides, YORP, BYORP, optional
+        Dissipative and radiative forces in the equations (:mod:`ti_spinorbit.perturbations`,
+        docs/physics.md §11): tides on either body (constant time lag or constant Q), YORP
+        on either body, BYORP on the orbit, each with a ``strength`` factor. The accuracy
+        verdict then holds E − W and L − L_ext to the limit (W the work done by the
+        perturbations, L_ext the angular momentum they bring in). Recorded in the result.
 
     Returns
     -------
@@ -394,7 +402,9 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
                                         orbits, escape_distance, coordinates, order,
                                         initial_states, model=model)
     _warn_near_circular(members)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method)
+    perturbations = check_perturbations(perturbations)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
+                   perturbation_rows=perturbation_rows(members, perturbations))
     with _progress.reporting(progress, "surface_of_section") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
                       progress=report, checkpoint=checkpoint, resume=resume,
@@ -408,7 +418,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         thetadot = thetadot - rate
     n = np.array([s.mean_motion for s in members])
     a = np.array([s.a for s in members])
-    energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end)
+    energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end, out.exchange)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
     rows, tilt, npa = _state_rows_and_tilt(members, out.events, y0, out.y)
@@ -422,7 +432,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
         max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
-        indicator_space=indicator_space)
+        indicator_space=indicator_space, perturbations=perturbations)
 
 
 def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
@@ -514,6 +524,9 @@ class TimeSeriesResult(Result, _display.Readable):
     max_npa_angle: np.ndarray = unit('deg', default=None)
     attitude_class: np.ndarray = unit(ATTITUDE_CLASS, default=None)
     states: np.ndarray = unit(STATE_ROW, default=None)
+    perturbations: tuple = unit(PERTURBATIONS, default=())
+    work: np.ndarray = unit('J', default=None)
+    external_angmom: np.ndarray = unit('kg m^2 s^-1', default=None)
 
     def _state(self, name, shape):
         from .initial import ROW_SLICES
@@ -602,7 +615,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
                 window_orbits=DEFAULT_WINDOW_ORBITS, escape_distance=ESCAPE_DISTANCE,
                 progress=None, model="auto", checkpoint=None, resume=False,
                 overwrite_checkpoint=False, max_drift=None, coordinates="inertial",
-                method="cash-karp", initial_states=None, states=False) -> TimeSeriesResult:
+                method="cash-karp", initial_states=None, states=False,
+                perturbations=None) -> TimeSeriesResult:
     """Dense time series of spin rate, α, r and energy (same inputs as surface_of_section).
 
     Steps are shortened to land exactly on the sample times (every 1/samples_per_orbit of an
@@ -619,7 +633,12 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     every sample (``states``, SI state rows of docs/physics.md §6.8; read through ``R``,
     ``V``, ``primary_attitude``, ``secondary_attitude``, ``primary_omega``,
     ``secondary_omega`` and the Euler angles ``roll``, ``pitch``, ``yaw``): 30 more numbers
-    per sample, off by default to keep long series small."""
+    per sample, off by default to keep long series small.
+
+    ``perturbations`` (tides, YORP, BYORP; as for surface_of_section) also fill ``work``
+    (the energy the perturbations put in since the start, J, negative when they dissipate)
+    and ``external_angmom`` (the angular momentum they brought in, inertial, kg m² s⁻¹) at
+    every sample; the drifts are those of E − W and L − L_ext."""
     _coords.check_coordinates(coordinates)
     system = _system_argument(system)
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
@@ -631,7 +650,9 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     members, par, y0, tp, td = _members("time_series", system, theta_p, thetadot_p, orbits,
                                         escape_distance, coordinates, order, initial_states,
                                         samples_per_orbit * (2 if states else 1), model)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method)
+    perturbations = check_perturbations(perturbations)
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
+                   perturbation_rows=perturbation_rows(members, perturbations))
     with _progress.reporting(progress, "time_series") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
                       sample_dt=2.0 * np.pi / samples_per_orbit, progress=report,
@@ -649,7 +670,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])[:, None]
     l_unit = (e_unit / n[:, None])[..., None]
     energies = {k: cols[k] * e_unit for k in ("energy_orbit", "energy_primary", "energy_secondary")}
-    energy_drift, angmom_drift = _sampled_drifts(cols, out)
+    exchange = _padded_exchange(out, cols["t"].shape)
+    energy_drift, angmom_drift = _sampled_drifts(cols, out, exchange)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
     rows, tilt, npa = _state_rows_and_tilt(members, out.samples, y0, out.y)
@@ -661,7 +683,21 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
         orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa, attitude_class=_attitude_classes(members, out.samples),
-        states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None)
+        states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None,
+        perturbations=perturbations,
+        work=None if exchange is None else exchange[..., 0] * e_unit,
+        external_angmom=None if exchange is None else exchange[..., 1:4] * l_unit)
+
+
+def _padded_exchange(out: RunOutput, shape):
+    """The accumulators (W, L_ext) at every sample, (N, samples, 4) scaled, NaN-padded like
+    the sample columns; None without perturbations."""
+    if out.sample_exchange is None:
+        return None
+    x = np.full(tuple(shape) + (4,), np.nan)
+    for k, rec in enumerate(out.sample_exchange):
+        x[k, :len(rec)] = rec
+    return x
 
 
 def _attitude_classes(members, samples):
@@ -686,16 +722,20 @@ def _sample_rows(members, samples, width):
     return rows
 
 
-def _sampled_drifts(cols, out: RunOutput):
+def _sampled_drifts(cols, out: RunOutput, exchange=None):
     """Largest relative energy and angular-momentum drift per member over its samples and the
     end of the run (scaled units, ``_derived_columns`` with an ensemble). A non-finite
-    diagnostic in any recorded sample makes the member's drift NaN, so it can never pass."""
-    end_energy, end_angmom = accuracy.drifts(out.diag_start, out.diag_end)
+    diagnostic in any recorded sample makes the member's drift NaN, so it can never pass.
+    With perturbations (``exchange``, :func:`_padded_exchange`) the drifts are those of
+    E − W and L − L_ext (docs/physics.md §11.4)."""
+    end_energy, end_angmom = accuracy.drifts(out.diag_start, out.diag_end, out.exchange)
     e0, l0 = accuracy.totals(out.diag_start)
     e0, l0 = e0[:, None], l0[:, None]
     recorded = np.isfinite(cols["t"])
     energy = cols["energy_orbit"] + cols["energy_primary"] + cols["energy_secondary"]
     angmom = cols["angmom_orbit"] + cols["angmom_primary"] + cols["angmom_secondary"]
+    if exchange is not None:
+        energy, angmom = energy - exchange[..., 0], angmom - exchange[..., 1:4]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         de = np.abs(energy - e0) / np.abs(e0)
         dl = np.linalg.norm(angmom - l0, axis=-1) / np.linalg.norm(l0, axis=-1)

@@ -1,0 +1,379 @@
+"""Tides, YORP and BYORP as objects: SI parameters in, the kernels' scaled block out.
+
+``perturbations=[...]`` on every entry point takes a list of these objects; each member of
+an ensemble gets the sum of their contributions, converted with its own system's units
+(length a, time 1/n, mass m1 + m2), as a block of ``kernels.perturb.NPERT`` numbers after its
+parameter row. The equations, and how the diagnostics account for the energy and angular
+momentum the perturbations exchange, are in docs/physics.md §11 and ``kernels/perturb.py``.
+
+Decisions:
+
+* Every object has a ``strength`` factor (default 1) that multiplies its force and torque,
+  so that effects acting over 1e5–1e7 years can be studied in thousands of orbits. Rates
+  scale linearly with it (tested); an equilibrium between two effects scaled by the same
+  factor does not move.
+* A body's radius defaults to its volume-equivalent radius (a b c)^(1/3) (``radius=`` m
+  overrides it); a body that is not an ellipsoid or sphere needs ``radius=``.
+* Two perturbations of the same kind on the same body are refused (ValueError): their sum
+  is one perturbation with the summed coefficient.
+* YORP acts about the body's z axis (the spin axis of a principal-axis rotator, which every
+  catalogued body is); BYORP along the relative velocity. Both need the binary's
+  heliocentric orbit: catalogued where known (``catalog.heliocentric_orbit``), else give
+  ``heliocentric_a_au`` and ``heliocentric_e``.
+
+Importing this module does not import Taichi.
+"""
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Optional
+
+import numpy as np
+
+from ._validate import require_positive_scalar, require_range, require_real, show
+
+#: Layout of the kernels' perturbation block (``kernels/perturb.py``; kept here so this
+#: module does not import Taichi, and checked against it by the tests).
+Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP, NPERT = 0, 3, 6, 7, 8, 9
+#: Accumulator columns after the state in a perturbed kernel (work, L_ext x, y, z).
+NACC = 4
+#: Solar radiation constant F_⊙ = L_⊙ / (4π c), kg m s⁻² (≈ 1.0e17; Jacobson & Scheeres 2011
+#: round it to 1e14 kg km s⁻²).
+BODIES = ("primary", "secondary")
+#: Unit text of a result's ``perturbations`` field (saved as their descriptions).
+UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.perturbations)"
+
+
+def _solar():
+    from .analytic import AU, C_LIGHT, L_SUN
+    return AU, C_LIGHT, L_SUN
+
+
+def solar_radiation_constant():
+    """F_⊙ = L_⊙ / (4π c), kg m s⁻²: radiation pressure times distance², N m² / m²."""
+    _, c, L = _solar()
+    return L / (4.0 * math.pi * c)
+
+
+def _check_body(body):
+    if body not in BODIES:
+        raise ValueError(f"body must be 'primary' or 'secondary' (got {show(body)})")
+    return body
+
+
+def _check_strength(strength):
+    return require_positive_scalar("strength", strength, 1e-12, 1e15)
+
+
+def body_radius(system, body, radius=None):
+    """The radius a perturbation uses for ``body`` of ``system``, m: ``radius`` when given,
+    else the body's volume-equivalent radius (a b c)^(1/3)."""
+    if radius is not None:
+        return float(radius)
+    b = getattr(system, body)
+    axes = getattr(b, "semi_axes", None)
+    if axes is None:
+        raise ValueError(f"the {body} is not an ellipsoid or sphere, so its radius is "
+                         "undefined: pass radius= (m) to the perturbation")
+    return float(np.prod(axes)) ** (1.0 / 3.0)
+
+
+def _heliocentric(system, a_au, e):
+    """(d in m, e_⊙) of the binary's heliocentric orbit: given, or catalogued."""
+    AU, _, _ = _solar()
+    if a_au is None:
+        from .catalog import heliocentric_orbit
+        orbit = heliocentric_orbit(getattr(system, "name", ""))
+        if orbit is None:
+            raise ValueError(f"no heliocentric orbit is catalogued for {system.name!r}: pass "
+                             "heliocentric_a_au (AU) and heliocentric_e to YORP / BYORP")
+        a_au, e = orbit
+    return a_au * AU, (0.0 if e is None else e)
+
+
+def _scales(system):
+    """(mass, length, time) units of a member: m1 + m2 (kg), a (m), 1/n (s)."""
+    return system.total_mass, system.a, 1.0 / system.mean_motion
+
+
+@dataclass(frozen=True)
+class Tides:
+    """The tide raised on ``body`` by the other body, constant time lag or constant Q
+    (Mignard 1979; Hut 1981; docs/physics.md §11.1).
+
+    Parameters
+    ----------
+    body : {"secondary", "primary"}
+        The body that deforms (and whose spin the tide brakes or drives).
+    k2 : float, optional
+        Love number, in (0, 10]. Default: the rubble-pile model of Goldreich & Sari (2009),
+        k2 = 1e-5 R[km] (:meth:`rubble_pile`); :meth:`jacobson_scheeres` gives
+        k2 = 2.5e-5 / R[km].
+    time_lag : float, optional
+        Constant time lag Δt, s (> 0). Give this or ``Q``, not both.
+    Q : float, optional
+        Constant tidal quality factor (> 0): the lag angle is 1/(2Q) whatever the tidal
+        frequency. Default when neither is given: Q = 100 (the paper's, docs/physics.md §9.4).
+    radius : float, optional
+        The body's radius, m; default its volume-equivalent radius.
+    strength : float
+        Factor on the force and torque (default 1): 1e5 makes 1e5 years of tides act in one.
+    """
+
+    body: str = "secondary"
+    k2: Optional[float] = None
+    time_lag: Optional[float] = None
+    Q: Optional[float] = None
+    radius: Optional[float] = None
+    strength: float = 1.0
+
+    kind = "tides"
+
+    def __post_init__(self):
+        _check_body(self.body)
+        if self.k2 is not None:
+            require_positive_scalar("k2", self.k2, 1e-12, 10.0)
+        if self.time_lag is not None and self.Q is not None:
+            raise ValueError("give the tide a time_lag (s) or a Q, not both")
+        if self.time_lag is not None:
+            require_positive_scalar("time_lag", self.time_lag, 1e-9, 1e9, "s")
+        if self.Q is not None:
+            require_positive_scalar("Q", self.Q, 1e-3, 1e12)
+        if self.radius is not None:
+            require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
+        _check_strength(self.strength)
+
+    @classmethod
+    def rubble_pile(cls, body="secondary", radius_m=None, system=None, **kw):
+        """Tides with the Goldreich & Sari (2009) rubble-pile k2 = 1e-5 R[km] of the body's
+        radius (``radius_m``, or that of ``body`` in ``system``)."""
+        R = radius_m if radius_m is not None else body_radius(system, body)
+        return cls(body=body, k2=1e-5 * R / 1e3, radius=radius_m, **kw)
+
+    @classmethod
+    def jacobson_scheeres(cls, body="secondary", radius_m=None, system=None, **kw):
+        """Tides with the Jacobson & Scheeres (2011) k2 = 2.5e-5 / R[km]."""
+        R = radius_m if radius_m is not None else body_radius(system, body)
+        return cls(body=body, k2=2.5e-5 / (R / 1e3), radius=radius_m, **kw)
+
+    def love_number(self, system):
+        """k2 used for ``system`` (the rubble-pile default when none was given)."""
+        return self.k2 if self.k2 is not None else 1e-5 * body_radius(system, self.body,
+                                                                        self.radius) / 1e3
+
+    def coefficient(self, system):
+        """κ = 3 k2 G M² R⁵ × strength, N m⁷ (force κ / r⁷ at zero lag), M the other body's
+        mass."""
+        from .systems import G
+        other = system.secondary if self.body == "primary" else system.primary
+        R = body_radius(system, self.body, self.radius)
+        return 3.0 * self.love_number(system) * G * other.mass ** 2 * R ** 5 * self.strength
+
+    def block(self, system):
+        M, L, T = _scales(system)
+        out = np.zeros(NPERT)
+        col = Q_TIDE1 if self.body == "primary" else Q_TIDE2
+        out[col] = self.coefficient(system) / (M * L ** 8 / T ** 2)
+        if self.time_lag is not None:
+            out[col + 1] = self.time_lag / T
+        else:
+            out[col + 2] = 0.5 / (self.Q if self.Q is not None else 100.0)
+        return out
+
+    @property
+    def slot(self):
+        return ("tides", self.body)
+
+
+@dataclass(frozen=True)
+class YORP:
+    """YORP torque on ``body`` about its spin (z) axis, the form Naidu & Margot (2015) use
+    (docs/physics.md §11.2):
+
+        T = f_Y R³ L_⊙ / (3 c d² sqrt(1 − e_⊙²))    (N m),
+
+    positive ``coefficient`` f_Y spins the body up, negative spins it down.
+
+    Parameters
+    ----------
+    body : {"secondary", "primary"}
+    coefficient : float
+        f_Y, signed, |f_Y| <= 1 (default 5e-4, the paper's).
+    heliocentric_a_au, heliocentric_e : float, optional
+        The binary's heliocentric orbit (AU, and e in [0, 1)); default the catalogued one.
+    radius : float, optional
+        The body's radius, m; default its volume-equivalent radius.
+    strength : float
+        Factor on the torque (default 1).
+    """
+
+    body: str = "secondary"
+    coefficient: float = 5e-4
+    heliocentric_a_au: Optional[float] = None
+    heliocentric_e: Optional[float] = None
+    radius: Optional[float] = None
+    strength: float = 1.0
+
+    kind = "yorp"
+
+    def __post_init__(self):
+        _check_body(self.body)
+        _check_signed("coefficient", self.coefficient, 1.0)
+        _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
+        if self.radius is not None:
+            require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
+        _check_strength(self.strength)
+
+    def torque(self, system):
+        """T × strength, N m (signed)."""
+        _, c, L = _solar()
+        d, e = _heliocentric(system, self.heliocentric_a_au, self.heliocentric_e)
+        R = body_radius(system, self.body, self.radius)
+        return (self.coefficient * R ** 3 * L / (3.0 * c * d ** 2 * math.sqrt(1.0 - e ** 2))
+                * self.strength)
+
+    def block(self, system):
+        M, L, T = _scales(system)
+        out = np.zeros(NPERT)
+        out[Q_YORP1 if self.body == "primary" else Q_YORP2] = self.torque(system) / (M * L ** 2 / T ** 2)
+        return out
+
+    @property
+    def slot(self):
+        return ("yorp", self.body)
+
+
+@dataclass(frozen=True)
+class BYORP:
+    """Binary YORP: a force on the secondary along the relative velocity, the
+    constant-coefficient form of McMahon & Scheeres (2010) and Jacobson & Scheeres (2011)
+    (docs/physics.md §11.3):
+
+        F_B = B F_⊙ R_s² / (d² sqrt(1 − e_⊙²)),     F_⊙ = L_⊙ / (4π c),
+
+    so the relative motion accelerates by F_B / m_s along V/|V|; on a circular orbit
+    da/dt = 2 F_B / (m_s n). Positive ``coefficient`` B expands the orbit.
+
+    Parameters
+    ----------
+    coefficient : float
+        B, signed, |B| <= 1 (default 1e-3, the order Jacobson & Scheeres 2011 use).
+    heliocentric_a_au, heliocentric_e : float, optional
+        The binary's heliocentric orbit; default the catalogued one.
+    radius : float, optional
+        The secondary's radius R_s, m; default its volume-equivalent radius.
+    strength : float
+        Factor on the force (default 1).
+    """
+
+    coefficient: float = 1e-3
+    heliocentric_a_au: Optional[float] = None
+    heliocentric_e: Optional[float] = None
+    radius: Optional[float] = None
+    strength: float = 1.0
+
+    kind = "byorp"
+    body = "secondary"
+
+    def __post_init__(self):
+        _check_signed("coefficient", self.coefficient, 1.0)
+        _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
+        if self.radius is not None:
+            require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
+        _check_strength(self.strength)
+
+    def force(self, system):
+        """F_B × strength, N (signed)."""
+        d, e = _heliocentric(system, self.heliocentric_a_au, self.heliocentric_e)
+        R = body_radius(system, "secondary", self.radius)
+        return (self.coefficient * solar_radiation_constant() * R ** 2
+                / (d ** 2 * math.sqrt(1.0 - e ** 2)) * self.strength)
+
+    def acceleration(self, system):
+        """F_B / m_s, m s⁻²: the relative motion's acceleration along V."""
+        return self.force(system) / system.secondary.mass
+
+    def block(self, system):
+        M, L, T = _scales(system)
+        out = np.zeros(NPERT)
+        out[Q_BYORP] = self.acceleration(system) / (L / T ** 2)
+        return out
+
+    @property
+    def slot(self):
+        return ("byorp", "secondary")
+
+
+KINDS = {"tides": Tides, "yorp": YORP, "byorp": BYORP}
+
+
+def _check_signed(name, value, limit):
+    require_real(name, value)
+    require_range(name, value, -limit, limit, low_open=False, high_open=False)
+
+
+def _check_heliocentric(a_au, e):
+    if a_au is not None:
+        require_positive_scalar("heliocentric_a_au", a_au, 0.05, 1e4, "AU")
+    if e is not None:
+        require_real("heliocentric_e", e)
+        require_range("heliocentric_e", e, 0.0, 1.0)
+    if (a_au is None) != (e is None):
+        raise ValueError("give both heliocentric_a_au (AU) and heliocentric_e, or neither")
+
+
+def check_perturbations(perturbations):
+    """``perturbations`` (None, one object, or a sequence of Tides / YORP / BYORP) as a
+    tuple; a TypeError names anything else, a ValueError a repeated kind on one body."""
+    if perturbations is None:
+        return ()
+    if isinstance(perturbations, tuple(KINDS.values())):
+        perturbations = [perturbations]
+    try:
+        items = tuple(perturbations)
+    except TypeError:
+        raise TypeError("perturbations must be a list of ti_spinorbit.Tides, YORP or BYORP "
+                        f"objects (got {show(perturbations)})") from None
+    seen = set()
+    for k, p in enumerate(items):
+        if not isinstance(p, tuple(KINDS.values())):
+            raise TypeError(f"perturbations[{k}] must be a Tides, YORP or BYORP object "
+                            f"(got {show(p)})")
+        if p.slot in seen:
+            raise ValueError(f"perturbations[{k}]: a second {p.kind} on the {p.body}; combine "
+                             "them into one (coefficients add)")
+        seen.add(p.slot)
+    return items
+
+
+def perturbation_rows(systems, perturbations):
+    """(N, NPERT) scaled blocks of the members' ``systems`` (one per member), or None
+    without perturbations."""
+    items = check_perturbations(perturbations)
+    if not items:
+        return None
+    rows = np.zeros((len(systems), NPERT))
+    cache = {}
+    for k, s in enumerate(systems):
+        key = id(s)
+        if key not in cache:
+            cache[key] = sum((p.block(s) for p in items), np.zeros(NPERT))
+        rows[k] = cache[key]
+    return rows
+
+
+def describe(perturbations):
+    """JSON-ready list of dicts (``kind`` plus the fields) for saved files."""
+    return [{"kind": p.kind, **asdict(p)} for p in check_perturbations(perturbations)]
+
+
+def from_description(items):
+    """The objects back from :func:`describe`'s list."""
+    out = []
+    for d in items or ():
+        d = dict(d)
+        kind = d.pop("kind")
+        if kind not in KINDS:
+            raise ValueError(f"unknown perturbation kind {kind!r} (known: {', '.join(KINDS)})")
+        out.append(KINDS[kind](**d))
+    return tuple(out)
