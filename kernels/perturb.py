@@ -1,5 +1,5 @@
 """Dissipative and radiative perturbations in the equations of motion (Taichi funcs):
-constant-time-lag (or constant-Q) tides, YORP and BYORP (docs/physics.md §11).
+constant-time-lag (or constant-Q) tides, YORP and BYORP (docs/physics.md §13).
 
 The host objects (``ti_spinorbit.perturbations``) turn SI parameters into a block of
 ``NPERT`` scaled numbers appended to each member's kernel parameter row (after the model's
@@ -24,7 +24,7 @@ body's angular velocity, all in one frame:
 
 the force on the relative motion (m_red dV/dt = F); the body receives the torque −R × F.
 This is the first-order expansion in Δt of the lagged bulge's quadrupole (derived in
-docs/physics.md §11.1). Constant Q replaces Δt by (1/2Q) / |w| with w = Ω_b × R̂ − (V −
+docs/physics.md §13.1). Constant Q replaces Δt by (1/2Q) / |w| with w = Ω_b × R̂ − (V −
 (R̂·V) R̂)/r the bulge's angular rate relative to the tide raiser, regularised as
 (1/2Q) / sqrt(|w|² + Q_RATE_FLOOR²) so that the torque turns smoothly through
 synchronism.

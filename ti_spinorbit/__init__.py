@@ -34,6 +34,7 @@ from .io import load, save
 from .xarray_io import to_xarray
 from .results import Result, Status
 from .initial import InitialState
+from .perturbations import BYORP, YORP, Tides
 from .warmup import warmup
 
 __version__ = "0.1.0"
@@ -43,5 +44,5 @@ __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_p
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
            "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray", "Result",
-           "Status", "warmup",
+           "Status", "warmup", "Tides", "YORP", "BYORP",
            "__version__"]

@@ -71,7 +71,7 @@ def drifts(diag_start, diag_end, exchange=None):
 
     ``exchange`` (N, 4), with perturbations: the work W and external angular momentum L_ext
     received by the end (``kernels/perturb.py``), taken off first, so that the drift is that
-    of E − W and L − L_ext, which the equations conserve (docs/physics.md §11.4)."""
+    of E − W and L − L_ext, which the equations conserve (docs/physics.md §13.4)."""
     e0, l0 = totals(diag_start)
     e1, l1 = totals(diag_end)
     if exchange is not None:

@@ -149,7 +149,7 @@ class Ensemble:
     perturbation_rows : (N, NPERT) array, optional
         Scaled tides / YORP / BYORP blocks (``ti_spinorbit.perturbations.perturbation_rows``):
         the kernels then integrate the perturbed equations and carry the work and external
-        angular momentum after the state (``kernels/perturb.py``; docs/physics.md §11).
+        angular momentum after the state (``kernels/perturb.py``; docs/physics.md §13).
     """
 
     def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,

@@ -4,7 +4,7 @@
 an ensemble gets the sum of their contributions, converted with its own system's units
 (length a, time 1/n, mass m1 + m2), as a block of ``kernels.perturb.NPERT`` numbers after its
 parameter row. The equations, and how the diagnostics account for the energy and angular
-momentum the perturbations exchange, are in docs/physics.md §11 and ``kernels/perturb.py``.
+momentum the perturbations exchange, are in docs/physics.md §13 and ``kernels/perturb.py``.
 
 Decisions:
 
@@ -99,7 +99,7 @@ def _scales(system):
 @dataclass(frozen=True)
 class Tides:
     """The tide raised on ``body`` by the other body, constant time lag or constant Q
-    (Mignard 1979; Hut 1981; docs/physics.md §11.1).
+    (Mignard 1979; Hut 1981; docs/physics.md §13.1).
 
     Parameters
     ----------
@@ -188,7 +188,7 @@ class Tides:
 @dataclass(frozen=True)
 class YORP:
     """YORP torque on ``body`` about its spin (z) axis, the form Naidu & Margot (2015) use
-    (docs/physics.md §11.2):
+    (docs/physics.md §13.2):
 
         T = f_Y R³ L_⊙ / (3 c d² sqrt(1 − e_⊙²))    (N m),
 
@@ -247,7 +247,7 @@ class YORP:
 class BYORP:
     """Binary YORP: a force on the secondary along the relative velocity, the
     constant-coefficient form of McMahon & Scheeres (2010) and Jacobson & Scheeres (2011)
-    (docs/physics.md §11.3):
+    (docs/physics.md §13.3):
 
         F_B = B F_⊙ R_s² / (d² sqrt(1 − e_⊙²)),     F_⊙ = L_⊙ / (4π c),
 

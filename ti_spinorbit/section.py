@@ -377,7 +377,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         model="planar" is refused). Recorded in the result.
     perturbations : list of Tides, YORP, BYORP, optional
         Dissipative and radiative forces in the equations (:mod:`ti_spinorbit.perturbations`,
-        docs/physics.md §11): tides on either body (constant time lag or constant Q), YORP
+        docs/physics.md §13): tides on either body (constant time lag or constant Q), YORP
         on either body, BYORP on the orbit, each with a ``strength`` factor. The accuracy
         verdict then holds E − W and L − L_ext to the limit (W the work done by the
         perturbations, L_ext the angular momentum they bring in). Recorded in the result.
@@ -727,7 +727,7 @@ def _sampled_drifts(cols, out: RunOutput, exchange=None):
     end of the run (scaled units, ``_derived_columns`` with an ensemble). A non-finite
     diagnostic in any recorded sample makes the member's drift NaN, so it can never pass.
     With perturbations (``exchange``, :func:`_padded_exchange`) the drifts are those of
-    E − W and L − L_ext (docs/physics.md §11.4)."""
+    E − W and L − L_ext (docs/physics.md §13.4)."""
     end_energy, end_angmom = accuracy.drifts(out.diag_start, out.diag_end, out.exchange)
     e0, l0 = accuracy.totals(out.diag_start)
     e0, l0 = e0[:, None], l0[:, None]
