@@ -37,6 +37,9 @@ from ._validate import require_positive_scalar, require_range, require_real, sho
 Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP, NPERT = 0, 3, 6, 7, 8, 9
 #: Accumulator columns after the state in a perturbed kernel (work, L_ext x, y, z).
 NACC = 4
+#: Floor of the bulge's relative angular rate in the constant-Q lag, units of the system's n
+#: (``kernels/perturb.py``; the analytic rates use it too).
+Q_RATE_FLOOR = 1e-3
 #: Solar radiation constant F_⊙ = L_⊙ / (4π c), kg m s⁻² (≈ 1.0e17; Jacobson & Scheeres 2011
 #: round it to 1e14 kg km s⁻²).
 BODIES = ("primary", "secondary")
