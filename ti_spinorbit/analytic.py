@@ -23,6 +23,10 @@ quadrature); frequencies and spin rates are in units of n, angles in radians, en
   tides (Murray & Dermott 1999 ch. 4–5; k2 of rubble piles from Goldreich & Sari 2009 or
   Jacobson & Scheeres 2011) and YORP (Naidu & Margot 2015), normalised by the separatrix
   energy E0 = n² ω0² C/4.
+* Secular rates of the perturbed equations (docs/physics.md §13.6–13.9): the constant-time-lag
+  tide's dω/dt, da/dt, de/dt (Hut 1981, in this package's normalisation κ = 3 k2 G M² R⁵), the
+  constant-Q limit, BYORP's da/dt and the tide–BYORP equilibrium (Jacobson & Scheeres 2011);
+  SI units.
 
 Reference paper: Naidu & Margot 2015, AJ 149:80.
 """
@@ -592,7 +596,7 @@ def decoupled_relaxed_libration(omega0, e, guess=None, steps=512):
 
 
 # ---- secular rates of the perturbed problem (docs/physics.md §13.6–13.9) ---------------------
-#: Hut (1981) eccentricity functions of e² (his eqs. A1–A5), f_k(0) = 1.
+# Hut (1981) eccentricity functions of e², f_k(0) = 1 (docs/physics.md §13.7).
 def hut_f1(e2):
     """f1(e²) = 1 + 31/2 e² + 255/8 e⁴ + 185/16 e⁶ + 25/64 e⁸ (Hut 1981)."""
     return 1.0 + e2 * (31 / 2 + e2 * (255 / 8 + e2 * (185 / 16 + e2 * 25 / 64)))
@@ -668,7 +672,7 @@ def tidal_despin_rate(system, tides, omega, e=0.0, a=None):
     deformed body's radius), C the body's moment about its spin (z) axis, n the mean motion
     sqrt(G (m1 + m2)/a³) and f2, f5 Hut's (1981) functions. On a circular orbit this is
     −3 k2 G M² R⁵ Δt (ω − n)/(a⁶ C). A constant-Q tide (circular orbits only) has
-    Δt = (1/2Q)/|ω − n| (regularised as in the kernels, :func:`_effective_lag`), i.e.
+    Δt = (1/2Q)/|ω − n| (with the kernels' floor on |ω − n|, docs/physics.md §13.8), i.e.
     dω/dt = −(3/2)(k2/Q) G M² R⁵ sign(ω − n)/(a⁶ C).
 
     Parameters
@@ -694,7 +698,7 @@ def tidal_despin_rate(system, tides, omega, e=0.0, a=None):
 
 def tidal_orbit_rates(system, tides, omega, e=0.0, a=None):
     """Orbit-averaged (da/dt m s⁻¹, de/dt s⁻¹) of the relative orbit under ``tides`` in the
-    weak-tide limit (Hut 1981, his eqs. 9–10, in this package's normalisation; derivation and
+    weak-tide limit (Hut 1981, in this package's normalisation; derivation and
     the mapping of Hut's constants in docs/physics.md §13.6–13.7):
 
         da/dt = −(2 κ Δt / (m_red a⁷)) (1 − e²)^{−15/2} [f1(e²) − (1 − e²)^{3/2} f2(e²) ω/n],
