@@ -368,6 +368,77 @@ def test_planar_and_3d_models_agree_on_a_planar_perturbed_run():
     assert planar.work[0, -1] != 0.0
 
 
+def _spheres_oracle(system, perturbations, row0, t):
+    """An independent integration (scipy DOP853, SI, inertial frame) of two spheres under
+    point-mass gravity and the perturbations of docs/physics.md §13: relative motion
+    dV/dt = −G M R/r³ + (F1 + F2)/m_red + a_B V/|V|, spins dω_b/dt = (−R × F_b + T_b ẑ_b)/C_b,
+    attitudes dS_b/dt = [ω_b]× S_b. Returns (R, V, S1, S2, ω1, ω2) at ``t``."""
+    from scipy.integrate import solve_ivp
+
+    tide2, tide1, yorp2, yorp1, byorp = perturbations
+    m1, m2 = system.primary.mass, system.secondary.mass
+    M, m_red = m1 + m2, m1 * m2 / (m1 + m2)
+    C1, C2 = system.primary.moments[2], system.secondary.moments[2]
+    k1, k2 = tide1.coefficient(system), tide2.coefficient(system)
+    T1, T2 = yorp1.torque(system), yorp2.torque(system)
+    a_B = byorp.acceleration(system)
+    lag_q, floor = 0.5 / tide1.Q, 1e-3 * system.mean_motion
+
+    def force(kappa, lag, R, V, Om):
+        r2, rv = R @ R, R @ V
+        return -(kappa / r2 ** 4) * (R + lag * (2 * rv / r2 * R + V - np.cross(Om, R)))
+
+    def hat(v):
+        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+    def rhs(_, y):
+        R, V, S1, S2 = y[0:3], y[3:6], y[6:15].reshape(3, 3), y[15:24].reshape(3, 3)
+        w1, w2 = y[24:27], y[27:30]
+        r = np.linalg.norm(R)
+        w = np.cross(w1, R) / r - (V - (R @ V) / r ** 2 * R) / r    # bulge rate, constant Q
+        F1 = force(k1, lag_q / math.sqrt(w @ w + floor ** 2), R, V, w1)
+        F2 = force(k2, tide2.time_lag, R, V, w2)
+        dV = -G * M * R / r ** 3 + (F1 + F2) / m_red + a_B * V / np.linalg.norm(V)
+        return np.concatenate([V, dV, (hat(w1) @ S1).ravel(), (hat(w2) @ S2).ravel(),
+                               (-np.cross(R, F1) + T1 * S1[:, 2]) / C1,
+                               (-np.cross(R, F2) + T2 * S2[:, 2]) / C2])
+
+    S1, S2 = row0[6:15].reshape(3, 3), row0[18:27].reshape(3, 3)
+    y0 = np.concatenate([row0[0:6], S1.ravel(), S2.ravel(), S1 @ row0[15:18], S2 @ row0[27:30]])
+    Y = solve_ivp(rhs, (t[0], t[-1]), y0, method="DOP853", rtol=1e-12, atol=1e-14, t_eval=t).y.T
+    return Y[:, 0:3], Y[:, 3:6], Y[:, 6:15], Y[:, 15:24], Y[:, 24:27], Y[:, 27:30]
+
+
+def test_3d_kernel_matches_an_independent_integration_with_tilted_spins():
+    """Every perturbation at once, on tilted spins and an inclined orbit: the 3-D kernel
+    against a plain SI integration of the same equations. Each perturbation moves the result
+    by 1e-6 or more (checked when this test was written by leaving each out of the oracle),
+    the two agree to 1e-9."""
+    system = spheres(0.15, primary_spin_period=4 * 3600.0)
+    perturbations = [tso.Tides("secondary", k2=1e-3, time_lag=60.0, strength=3e3),
+                     tso.Tides("primary", k2=1e-4, Q=3.0, strength=3e3),
+                     tso.YORP("secondary", coefficient=1e-3, strength=1e6, **HELIO),
+                     tso.YORP("primary", coefficient=-1e-3, strength=1e7, **HELIO),
+                     tso.BYORP(coefficient=1e-3, strength=1e3, **HELIO)]
+    start = system.tilted_start(20.0, 2.5, pitch=30.0, roll=10.0, spin_x=0.4, inclination=10.0,
+                                primary_tilt=25.0)
+    ts = tso.time_series(system, initial_states=[start], orbits=3, samples_per_orbit=8,
+                         perturbations=perturbations, model="3d", rtol=1e-12, states=True)
+    assert accuracy.usable(ts.status).all()
+    st = ts.states[0]
+    S1, S2 = st[:, 6:15].reshape(-1, 3, 3), st[:, 18:27].reshape(-1, 3, 3)
+    ours = (st[:, 0:3], st[:, 3:6], st[:, 6:15], st[:, 18:27],
+            np.einsum("nij,nj->ni", S1, st[:, 15:18]), np.einsum("nij,nj->ni", S2, st[:, 27:30]))
+    oracle = _spheres_oracle(system, perturbations, st[0], ts.t[0])
+    for name, a, b in zip(("R", "V", "S1", "S2", "omega1", "omega2"), ours, oracle):
+        assert np.abs(a - b).max() < 1e-9 * np.abs(b).max(), name
+    # the spins did move (by percent), and the secondary's stays tilted by ~40 degrees
+    assert np.linalg.norm(ours[5][-1] - ours[5][0]) > 0.01 * np.linalg.norm(ours[5][0])
+    assert np.linalg.norm(ours[4][-1] - ours[4][0]) > 0.01 * np.linalg.norm(ours[4][0])
+    tilt = np.degrees(np.arccos(ours[5][:, 2] / np.linalg.norm(ours[5], axis=1)))
+    assert tilt.min() > 30.0
+
+
 def test_a_perturbed_member_whose_accounting_fails_is_flagged_inaccurate():
     system = spheres(0.2)
     tide = tso.Tides(body="secondary", k2=1e-3, time_lag=60.0, strength=1e3)
