@@ -480,6 +480,12 @@ def test_host_layout_matches_the_kernels():
     (lambda: tso.BYORP(heliocentric_a_au=1.0, heliocentric_e=1.0), ValueError,
      "heliocentric_e must lie in [0.0, 1.0)"),
     (lambda: tso.BYORP(strength=1e20), ValueError, "strength must lie in [1e-12, 1e+15]"),
+    (lambda: tso.Tides.rubble_pile(), ValueError,
+     "Tides.rubble_pile needs radius_m (m) or system= (a BinarySystem) for the secondary's"),
+    (lambda: tso.Tides.jacobson_scheeres("primary", system="1991 VH"), TypeError,
+     "system must be a ti_spinorbit.BinarySystem (got '1991 VH')"),
+    (lambda: tso.Tides.rubble_pile(radius_m=-5.0), ValueError,
+     "radius_m must be a finite number > 0"),
     (lambda: tso.perturbations.check_perturbations([tso.Tides(), tso.Tides(k2=1e-3)]),
      ValueError, "perturbations[1]: a second tides on the secondary"),
     (lambda: tso.perturbations.check_perturbations([tso.Tides(), "yorp"]), TypeError,
@@ -497,3 +503,14 @@ def test_a_tide_on_each_body_is_accepted():
                                                    tso.YORP("primary"), tso.YORP("secondary")])
     assert [p.slot for p in items] == [("tides", "primary"), ("tides", "secondary"),
                                        ("yorp", "primary"), ("yorp", "secondary")]
+
+
+@pytest.mark.parametrize("model, k2", [("rubble_pile", lambda km: 1e-5 * km),
+                                       ("jacobson_scheeres", lambda km: 2.5e-5 / km)])
+def test_k2_models_use_the_given_radius_or_the_bodys(model, k2):
+    system = spheres()
+    by_radius = getattr(tso.Tides, model)("primary", radius_m=400.0, time_lag=10.0)
+    by_system = getattr(tso.Tides, model)("primary", system=system, time_lag=10.0)
+    assert by_radius.k2 == pytest.approx(k2(0.4), rel=1e-14)
+    assert by_system.k2 == pytest.approx(k2(0.4), rel=1e-12) and by_system.radius is None
+    assert by_radius.coefficient(system) == pytest.approx(by_system.coefficient(system), rel=1e-12)
