@@ -514,3 +514,17 @@ def test_k2_models_use_the_given_radius_or_the_bodys(model, k2):
     assert by_radius.k2 == pytest.approx(k2(0.4), rel=1e-14)
     assert by_system.k2 == pytest.approx(k2(0.4), rel=1e-12) and by_system.radius is None
     assert by_radius.coefficient(system) == pytest.approx(by_system.coefficient(system), rel=1e-12)
+
+
+@pytest.mark.parametrize("name, model, a_eq", [
+    ("1991 VH", "rubble_pile", 1704.0), ("1991 VH", "jacobson_scheeres", 2247.0),
+    ("2003 YT1", "rubble_pile", 1037.0), ("2003 YT1", "jacobson_scheeres", 1402.0),
+    ("2004 DC", "rubble_pile", 189.0), ("2004 DC", "jacobson_scheeres", 352.0),
+])
+def test_equilibria_of_the_papers_systems_are_those_in_the_physics_notes(name, model, a_eq):
+    """The table of docs/physics.md §13.9 (Q = 100, B = -1e-3, catalogued heliocentric orbits)."""
+    system = tso.catalog.system(name)
+    tide = getattr(tso.Tides, model)("primary", system=system, Q=100.0)
+    found = analytic.tide_byorp_equilibrium(system, tide, tso.BYORP(-1e-3))
+    assert found == pytest.approx(a_eq, abs=0.5)
+    assert found < system.a
