@@ -23,6 +23,10 @@ quadrature); frequencies and spin rates are in units of n, angles in radians, en
   tides (Murray & Dermott 1999 ch. 4–5; k2 of rubble piles from Goldreich & Sari 2009 or
   Jacobson & Scheeres 2011) and YORP (Naidu & Margot 2015), normalised by the separatrix
   energy E0 = n² ω0² C/4.
+* Secular rates of the perturbed equations (docs/physics.md §13.6–13.9): the constant-time-lag
+  tide's dω/dt, da/dt, de/dt (Hut 1981, in this package's normalisation κ = 3 k2 G M² R⁵), the
+  constant-Q limit, BYORP's da/dt and the tide–BYORP equilibrium (Jacobson & Scheeres 2011);
+  SI units.
 
 Reference paper: Naidu & Margot 2015, AJ 149:80.
 """
@@ -589,3 +593,193 @@ def decoupled_relaxed_libration(omega0, e, guess=None, steps=512):
     center = 0.5 * (low + high)
     amp = _decoupled_half_orbit(w0, e, np.array([center]), steps)[1][0]
     return float(center), float(amp)
+
+
+# ---- secular rates of the perturbed problem (docs/physics.md §13.6–13.9) ---------------------
+# Hut (1981) eccentricity functions of e², f_k(0) = 1 (docs/physics.md §13.7).
+def hut_f1(e2):
+    """f1(e²) = 1 + 31/2 e² + 255/8 e⁴ + 185/16 e⁶ + 25/64 e⁸ (Hut 1981)."""
+    return 1.0 + e2 * (31 / 2 + e2 * (255 / 8 + e2 * (185 / 16 + e2 * 25 / 64)))
+
+
+def hut_f2(e2):
+    """f2(e²) = 1 + 15/2 e² + 45/8 e⁴ + 5/16 e⁶ (Hut 1981)."""
+    return 1.0 + e2 * (15 / 2 + e2 * (45 / 8 + e2 * 5 / 16))
+
+
+def hut_f3(e2):
+    """f3(e²) = 1 + 15/4 e² + 15/8 e⁴ + 5/64 e⁶ (Hut 1981)."""
+    return 1.0 + e2 * (15 / 4 + e2 * (15 / 8 + e2 * 5 / 64))
+
+
+def hut_f4(e2):
+    """f4(e²) = 1 + 3/2 e² + 1/8 e⁴ (Hut 1981)."""
+    return 1.0 + e2 * (3 / 2 + e2 / 8)
+
+
+def hut_f5(e2):
+    """f5(e²) = 1 + 3 e² + 3/8 e⁴ (Hut 1981)."""
+    return 1.0 + e2 * (3.0 + e2 * 3 / 8)
+
+
+def _check_tides(tides):
+    from .perturbations import Tides
+    if not isinstance(tides, Tides):
+        raise TypeError(f"tides must be a ti_spinorbit.Tides object (got {type(tides).__name__})")
+    return tides
+
+
+def _tide_inputs(system, tides, omega, e, a):
+    """(κ N m⁷, m_red kg, C kg m², a m, n rad/s, e, ω rad/s) of a tide on its body, checked."""
+    from ._validate import require_scalar
+    _check_tides(tides)
+    omega = require_scalar("omega", omega, unit="rad/s")
+    e = require_scalar("e", e, 0.0, 1.0, high_open=True)
+    a = system.a if a is None else require_scalar("a", a, 0.0, math.inf, low_open=True, unit="m")
+    body = getattr(system, tides.body)
+    m1, m2 = system.primary.mass, system.secondary.mass
+    n = math.sqrt(G * (m1 + m2) / a ** 3)
+    # the spin axis is the body's z axis (kernels/perturb.py: Ω_b × R with Ω_b along z)
+    return tides.coefficient(system), m1 * m2 / (m1 + m2), float(body.moments[2]), a, n, e, omega
+
+
+def _effective_lag(system, tides, omega, n):
+    """The time lag the kernels use, s: Δt for a constant-time-lag tide; for constant Q,
+    (1/2Q)/sqrt((ω − n)² + (ε n0)²), ε = kernels.perturb.Q_RATE_FLOOR and n0 the system's
+    (initial) mean motion, the circular orbit's bulge rate ω − n regularised as in the
+    kernels."""
+    from .perturbations import Q_RATE_FLOOR
+    if tides.time_lag is not None:
+        return tides.time_lag
+    Q = tides.Q if tides.Q is not None else DEFAULT_Q
+    floor = Q_RATE_FLOOR * system.mean_motion
+    return 0.5 / Q / math.sqrt((omega - n) ** 2 + floor ** 2)
+
+
+def _circular_only(tides, e, what):
+    if tides.time_lag is None and e != 0.0:
+        raise ValueError(f"e must be 0 for the {what} of a constant-Q tide (its lag varies along "
+                         f"an eccentric orbit; got e = {e:g}); use a time_lag tide")
+
+
+def tidal_despin_rate(system, tides, omega, e=0.0, a=None):
+    """Orbit-averaged dω/dt of the body that ``tides`` deforms, rad s⁻², in the weak-tide limit
+    (the orbit is a fixed Kepler ellipse over one period; docs/physics.md §13.7):
+
+        dω/dt = −κ Δt / (C a⁶) (1 − e²)⁻⁶ [(1 − e²)^{3/2} f5(e²) ω − f2(e²) n],
+
+    κ = 3 k2 G M² R⁵ × strength (:meth:`Tides.coefficient`, M the other body's mass, R the
+    deformed body's radius), C the body's moment about its spin (z) axis, n the mean motion
+    sqrt(G (m1 + m2)/a³) and f2, f5 Hut's (1981) functions. On a circular orbit this is
+    −3 k2 G M² R⁵ Δt (ω − n)/(a⁶ C). A constant-Q tide (circular orbits only) has
+    Δt = (1/2Q)/|ω − n| (with the kernels' floor on |ω − n|, docs/physics.md §13.8), i.e.
+    dω/dt = −(3/2)(k2/Q) G M² R⁵ sign(ω − n)/(a⁶ C).
+
+    Parameters
+    ----------
+    system : BinarySystem
+        Masses, the deformed body's moment C and radius, and a unless given.
+    tides : Tides
+        Which body deforms, k2, Δt or Q, radius, strength.
+    omega : float
+        The body's spin rate about the orbit normal, rad/s.
+    e : float
+        Orbital eccentricity in [0, 1) (0 for a constant-Q tide).
+    a : float, optional
+        Semimajor axis, m (default the system's).
+    """
+    kappa, _, C, a, n, e, omega = _tide_inputs(system, tides, omega, e, a)
+    _circular_only(tides, e, "despin rate")
+    lag = _effective_lag(system, tides, omega, n)
+    e2 = e * e
+    s = 1.0 - e2
+    return -kappa * lag / (C * a ** 6) * s ** -6 * (s ** 1.5 * hut_f5(e2) * omega - hut_f2(e2) * n)
+
+
+def tidal_orbit_rates(system, tides, omega, e=0.0, a=None):
+    """Orbit-averaged (da/dt m s⁻¹, de/dt s⁻¹) of the relative orbit under ``tides`` in the
+    weak-tide limit (Hut 1981, in this package's normalisation; derivation and
+    the mapping of Hut's constants in docs/physics.md §13.6–13.7):
+
+        da/dt = −(2 κ Δt / (m_red a⁷)) (1 − e²)^{−15/2} [f1(e²) − (1 − e²)^{3/2} f2(e²) ω/n],
+        de/dt = −(9 κ Δt e / (m_red a⁸)) (1 − e²)^{−13/2} [f3(e²) − (11/18)(1 − e²)^{3/2} f4(e²) ω/n],
+
+    m_red = m1 m2/(m1 + m2), κ and the rest as in :func:`tidal_despin_rate`. A constant-Q tide
+    (circular orbits only, de/dt = 0) gives
+
+        da/dt = 3 (k2/Q) (M/m_b) sqrt(G (m1 + m2)) R⁵ a^{−11/2} sign(ω − n) × strength,
+
+    M the other body's mass and m_b the deformed body's (regularised near ω = n as in the
+    kernels). Parameters as for :func:`tidal_despin_rate`."""
+    kappa, m_red, _, a, n, e, omega = _tide_inputs(system, tides, omega, e, a)
+    _circular_only(tides, e, "orbit rates")
+    lag = _effective_lag(system, tides, omega, n)
+    e2 = e * e
+    s = 1.0 - e2
+    x = omega / n
+    da = -2.0 * kappa * lag / (m_red * a ** 7) * s ** -7.5 * (hut_f1(e2) - s ** 1.5 * hut_f2(e2) * x)
+    de = -9.0 * kappa * lag * e / (m_red * a ** 8) * s ** -6.5 * (
+        hut_f3(e2) - 11.0 / 18.0 * s ** 1.5 * hut_f4(e2) * x)
+    return da, de
+
+
+def byorp_da_dt(system, byorp, a=None):
+    """da/dt of a circular orbit under ``byorp``, m s⁻¹ (McMahon & Scheeres 2010; Jacobson &
+    Scheeres 2011; docs/physics.md §13.8):
+
+        da/dt = 2 F_B / (m_s n),
+
+    F_B = :meth:`BYORP.force` (N, strength included), m_s the secondary's mass and
+    n = sqrt(G (m1 + m2)/a³); a is the system's unless given (m). F_B does not depend on a,
+    so da/dt grows as a^{3/2}."""
+    from ._validate import require_scalar
+    from .perturbations import BYORP
+    if not isinstance(byorp, BYORP):
+        raise TypeError(f"byorp must be a ti_spinorbit.BYORP object (got {type(byorp).__name__})")
+    a = system.a if a is None else require_scalar("a", a, 0.0, math.inf, low_open=True, unit="m")
+    n = math.sqrt(G * system.total_mass / a ** 3)
+    return 2.0 * byorp.force(system) / (system.secondary.mass * n)
+
+
+def tide_byorp_equilibrium(system, tides, byorp):
+    """Semimajor axis, m, where the constant-Q tide raised on the primary (expanding the orbit
+    of a primary spinning faster than n) balances a contracting BYORP (Jacobson & Scheeres
+    2011; docs/physics.md §13.9):
+
+        3 (k2/Q) (m_s/m_p) sqrt(G M) R_p⁵ a^{−11/2} × s_T = −2 F_B a^{3/2} / (m_s sqrt(G M))
+        ⇒  a_eq⁷ = 3 (k2/Q) s_T G M m_s² R_p⁵ / (2 m_p |F_B|),
+
+    M = m_p + m_s, s_T the tide's strength and F_B = :meth:`BYORP.force` (strength included),
+    so scaling both by one factor leaves a_eq unchanged. The equilibrium is stable: inside it
+    the tide wins, outside BYORP.
+
+    Parameters
+    ----------
+    system : BinarySystem
+        Masses and the primary's radius.
+    tides : Tides
+        A constant-Q tide (``Q=``, or neither Q nor time_lag: Q = 100) on the primary.
+    byorp : BYORP
+        With a negative coefficient (a contracting BYORP), else there is no equilibrium.
+    """
+    from .perturbations import BYORP
+    _check_tides(tides)
+    if not isinstance(byorp, BYORP):
+        raise TypeError(f"byorp must be a ti_spinorbit.BYORP object (got {type(byorp).__name__})")
+    if tides.body != "primary":
+        raise ValueError(f"tides.body must be 'primary' for the tide-BYORP equilibrium (got "
+                         f"{tides.body!r})")
+    if tides.time_lag is not None:
+        raise ValueError("tides must be a constant-Q tide (Q=, not time_lag=) for the "
+                         "tide-BYORP equilibrium of Jacobson & Scheeres (2011)")
+    F = byorp.force(system)
+    if not F < 0:
+        raise ValueError(f"byorp.coefficient must be < 0 (a contracting BYORP) for a tide-BYORP "
+                         f"equilibrium (got {byorp.coefficient:g})")
+    Q = tides.Q if tides.Q is not None else DEFAULT_Q
+    mp, ms = system.primary.mass, system.secondary.mass
+    from .perturbations import body_radius
+    Rp = body_radius(system, "primary", tides.radius)
+    k2 = tides.love_number(system)
+    a7 = 3.0 * (k2 / Q) * tides.strength * G * (mp + ms) * ms ** 2 * Rp ** 5 / (2.0 * mp * abs(F))
+    return a7 ** (1.0 / 7.0)

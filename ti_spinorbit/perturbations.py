@@ -37,6 +37,9 @@ from ._validate import require_positive_scalar, require_range, require_real, sho
 Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP, NPERT = 0, 3, 6, 7, 8, 9
 #: Accumulator columns after the state in a perturbed kernel (work, L_ext x, y, z).
 NACC = 4
+#: Floor of the bulge's relative angular rate in the constant-Q lag, units of the system's n
+#: (``kernels/perturb.py``; the analytic rates use it too).
+Q_RATE_FLOOR = 1e-3
 #: Solar radiation constant F_⊙ = L_⊙ / (4π c), kg m s⁻² (≈ 1.0e17; Jacobson & Scheeres 2011
 #: round it to 1e14 kg km s⁻²).
 BODIES = ("primary", "secondary")
@@ -96,6 +99,21 @@ def _scales(system):
     return system.total_mass, system.a, 1.0 / system.mean_motion
 
 
+def _constructor_radius(name, body, radius_m, system):
+    """The radius (m) a k2 model of ``Tides.<name>`` uses: ``radius_m``, else ``body``'s
+    in ``system``; one-line errors when neither is usable."""
+    _check_body(body)
+    if radius_m is not None:
+        return require_positive_scalar("radius_m", radius_m, 1e-3, 1e10, "m")
+    if system is None:
+        raise ValueError(f"Tides.{name} needs radius_m (m) or system= (a BinarySystem) for the "
+                         f"{body}'s radius")
+    from .systems import BinarySystem
+    if not isinstance(system, BinarySystem):
+        raise TypeError(f"system must be a ti_spinorbit.BinarySystem (got {show(system)})")
+    return body_radius(system, body)
+
+
 @dataclass(frozen=True)
 class Tides:
     """The tide raised on ``body`` by the other body, constant time lag or constant Q
@@ -147,13 +165,13 @@ class Tides:
     def rubble_pile(cls, body="secondary", radius_m=None, system=None, **kw):
         """Tides with the Goldreich & Sari (2009) rubble-pile k2 = 1e-5 R[km] of the body's
         radius (``radius_m``, or that of ``body`` in ``system``)."""
-        R = radius_m if radius_m is not None else body_radius(system, body)
+        R = _constructor_radius("rubble_pile", body, radius_m, system)
         return cls(body=body, k2=1e-5 * R / 1e3, radius=radius_m, **kw)
 
     @classmethod
     def jacobson_scheeres(cls, body="secondary", radius_m=None, system=None, **kw):
         """Tides with the Jacobson & Scheeres (2011) k2 = 2.5e-5 / R[km]."""
-        R = radius_m if radius_m is not None else body_radius(system, body)
+        R = _constructor_radius("jacobson_scheeres", body, radius_m, system)
         return cls(body=body, k2=2.5e-5 / (R / 1e3), radius=radius_m, **kw)
 
     def love_number(self, system):
