@@ -236,7 +236,7 @@ class YORP:
 
     def __post_init__(self):
         _check_body(self.body)
-        _check_signed("coefficient", self.coefficient, 1.0)
+        _check_signed("YORP coefficient (f_Y)", self.coefficient, 1.0)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         if self.radius is not None:
             require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
@@ -294,7 +294,7 @@ class BYORP:
     body = "secondary"
 
     def __post_init__(self):
-        _check_signed("coefficient", self.coefficient, 1.0)
+        _check_signed("BYORP coefficient (B)", self.coefficient, 1.0)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         if self.radius is not None:
             require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
