@@ -79,6 +79,15 @@ def test_saved_and_loaded_with_the_perturbations(fixture, request, tmp_path):
         assert_same(back.section, result.section)
 
 
+def test_results_show_their_perturbations(section, cmap):
+    assert repr(section).splitlines()[-1] == ("  perturbations tides on the secondary ×1e+06, "
+                                              "yorp on the secondary ×1e+06, byorp ×1e+06")
+    assert "perturbations" in cmap._repr_html_()
+    assert "perturbations" not in repr(cmap.section.__class__(**{
+        **{f.name: getattr(cmap.section, f.name) for f in dataclasses.fields(cmap.section)},
+        "perturbations": ()}))
+
+
 def test_time_series_work_and_external_angular_momentum(series, tmp_path):
     n, width = series.t.shape
     assert series.work.shape == (n, width) and series.external_angmom.shape == (n, width, 3)

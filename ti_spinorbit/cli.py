@@ -121,13 +121,15 @@ EXAMPLES_BY_COMMAND = {
     "energy": """\
   ti-spinorbit energy                          # the paper's energy-check case ("test")
   ti-spinorbit energy --orbits 20 --rtol 1e-13 --max-drift 1e-10 --out energy.png
-  ti-spinorbit energy --system "1991 VH" --thetadot 1.0 --orbits 50""",
+  ti-spinorbit energy --system "1991 VH" --thetadot 1.0 --orbits 50
+  ti-spinorbit energy --system "1991 VH" --thetadot 0.8 --orbits 20 --tide secondary --time-lag 600 --strength 1e6""",
     "benchmark": """\
   ti-spinorbit benchmark --members 1024 --orbits 20
   ti-spinorbit benchmark --arch cuda --members 65536 --orbits 20 --out bench_cuda.json""",
     "warmup": """\
   ti-spinorbit warmup                                  # every variant (minutes, once)
-  ti-spinorbit warmup --models planar --indicators off # what 'section' needs""",
+  ti-spinorbit warmup --models planar --indicators off # what 'section' needs
+  ti-spinorbit warmup --models planar --perturbed      # also with tides, YORP, BYORP""",
     "figures": """\
   ti-spinorbit figures --quick --only 1 4 --out out/""",
 }
