@@ -451,3 +451,17 @@ def test_warmup_perturbed(capsys):
     assert lines[0].startswith("planar/plain/sections/order4/cash-karp: ")
     assert lines[1].startswith("planar/plain/sections/order4/perturbed/cash-karp: ")
     assert lines[-1].startswith("2 kernel variants ready (")
+
+
+@pytest.mark.parametrize("argv", [
+    ["map", "--grid", "2", "2", "--orbits", "3", "--rtol", "1e-10"],
+    ["overlap", "--system", "2004 DC", "--elongations", "1.03", "1.03", "0.01", "--orbits", "3",
+     "--max-orbits", "3"],
+    ["libration", "--orbits", "3", "--candidates", "0.2", "1.3", "9", "--max-orbits", "3"],
+])
+def test_every_integrating_command_saves_its_perturbations(argv, tmp_path, capsys):
+    out = str(tmp_path / "r.png")
+    assert cli.main([*argv, "--tide", "secondary", "--Q", "50", "--strength", "1e5",
+                     "--allow-inaccurate", "--out", out]) == 0
+    assert capsys.readouterr().out.startswith("perturbations: tide on the secondary (k2 ")
+    assert tso.load(tmp_path / "r.npz").perturbations == (tso.Tides(Q=50.0, strength=1e5),)
