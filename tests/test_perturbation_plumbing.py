@@ -63,6 +63,14 @@ def test_section_with_indicators_and_perturbations(section, vh):
     assert not np.array_equal(section.megno, plain.megno)       # the equations changed
 
 
+@pytest.mark.parametrize("kw", [dict(model="3d"), dict(indicator_space="full")])
+def test_indicators_with_perturbations_in_3d(vh, kw):
+    got = tso.surface_of_section(vh, 0.0, STARTS, indicators=True, perturbations=ALL,
+                                 orbits=3, rtol=1e-10, **kw)
+    assert got.perturbations == ALL and list(got.status_names) == ["done", "done"]
+    assert np.all(np.isfinite(got.megno)) and np.all(np.isfinite(got.lyapunov))
+
+
 @pytest.mark.parametrize("fixture", ["section", "series", "cmap"])
 def test_saved_and_loaded_with_the_perturbations(fixture, request, tmp_path):
     result = request.getfixturevalue(fixture)
