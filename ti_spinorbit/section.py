@@ -598,7 +598,7 @@ class TimeSeriesResult(Result, _display.Readable):
         t = self.t[member][ok]
         energy = self.energy[member][ok]
         angmom = sum(getattr(self, f"angmom_{k}")[member][ok] for k in ("orbit", "primary", "secondary"))
-        if self.work is not None:        # perturbed: E − W and L − L_ext are conserved (§13.4)
+        if getattr(self, "work", None) is not None:   # perturbed: E − W, L − L_ext conserved (§13.4)
             energy = energy - self.work[member][ok]
             angmom = angmom - self.external_angmom[member][ok]
         e0 = energy[0]
