@@ -368,3 +368,100 @@ def test_warmup_refuses_an_unknown_method(capsys):
     assert cli.main(["warmup", "--methods", "rk4"]) == cli.EXIT_ERROR
     assert capsys.readouterr().err == ("ti-spinorbit warmup: error: --methods must be among "
                                        "cash-karp, dop853 (got 'rk4')\n")
+
+
+# ---- tides, YORP and BYORP (issue 15) ---------------------------------------------------
+
+@pytest.mark.parametrize("argv, stem", [
+    (["section", "--tide", "secondary", "--k2", "1e-5", "--time-lag", "600", "--strength",
+      "1e6"], "sos_1991VH_tide-secondary_k21e-5_dt600_str1e6"),
+    (["energy", "--tide", "primary", "--Q", "100"], "energy_test_tide-primary_Q100"),
+    (["map", "--yorp", "5e-4", "--yorp-body", "primary", "--byorp", "1e-3", "--heliocentric",
+      "1.1", "0.2"], "map_1991VH_yorp0.0005_yorp-primary_byorp0.001_helio1.1-0.2"),
+    (["libration", "--tide", "secondary", "--strength", "1"], "libration_Didymos_tide-secondary"),
+])
+def test_default_names_carry_the_perturbations(argv, stem):
+    args = cli._parser().parse_args(argv)
+    prefix = {"section": "sos"}.get(argv[0], argv[0])
+    assert cli.default_stem(args, prefix, args.system) == stem
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--k2", "1e-5"], "--k2 needs --tide primary|secondary (the body that deforms)"),
+    (["--time-lag", "600"], "--time-lag needs --tide primary|secondary"),
+    (["--tide", "secondary", "--time-lag", "600", "--Q", "10"],
+     "--time-lag and --Q exclude each other"),
+    (["--tide", "secondary", "--k2", "0"], "--k2 must lie in [1e-12, 10] (got 0)"),
+    (["--tide", "secondary", "--time-lag", "-1"], "--time-lag must lie in [1e-09, 1e+09] (got -1)"),
+    (["--tide", "secondary", "--Q", "0"], "--Q must lie in [0.001, 1e+12] (got 0)"),
+    (["--yorp", "2"], "--yorp must lie in [-1, 1] (got 2)"),
+    (["--byorp", "-1.5"], "--byorp must lie in [-1, 1] (got -1.5)"),
+    (["--tide", "secondary", "--strength", "0"], "--strength must lie in [1e-12, 1e+15] (got 0)"),
+    (["--strength", "10"], "--strength needs --tide, --yorp or --byorp"),
+    (["--yorp-body", "primary"], "--yorp-body needs --yorp F_Y"),
+    (["--heliocentric", "1", "0.1"], "--heliocentric needs --yorp or --byorp"),
+    (["--yorp", "1e-3", "--heliocentric", "0.01", "0.1"],
+     "--heliocentric A_AU must lie in [0.05, 10000] (got 0.01)"),
+    (["--byorp", "1e-3", "--heliocentric", "1", "1"],
+     "--heliocentric E must lie in [0, 1) (got 1)"),
+    (["--system", "test", "--yorp", "1e-3"],
+     "--yorp: no heliocentric orbit is catalogued for 'test': pass --heliocentric A_AU E"),
+    (["--tide", "both"], "argument --tide: invalid choice: 'both'"),
+])
+def test_bad_perturbation_flags_one_line_exit_2(flags, message, tmp_path, capsys):
+    out = str(tmp_path / "x.png")
+    assert cli.main(["section", *flags, "--out", out]) == cli.EXIT_ERROR
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+    assert not os.path.exists(out)
+
+
+def test_section_with_a_tide_prints_and_saves_it(tmp_path, capsys):
+    out = str(tmp_path / "s.png")
+    assert cli.main(["section", "--thetadot", "0.83", "--orbits", "3", "--rtol", "1e-10",
+                     "--tide", "secondary", "--k2", "1e-5", "--time-lag", "600", "--strength",
+                     "1e6", "--byorp", "1e-3", "--out", out]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == ("perturbations: tide on the secondary (k2 1e-05, time lag 600 s); BYORP "
+                        "(B 0.001); strength 1e+06 (docs/physics.md §13; drifts are those of "
+                        "E - W and L - L_ext)")
+    saved = tso.load(tmp_path / "s.npz")
+    assert saved.perturbations == (tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6),
+                                   tso.BYORP(coefficient=1e-3, strength=1e6))
+
+
+def test_energy_with_a_tide_prints_the_work(tmp_path, capsys):
+    out = str(tmp_path / "e.png")
+    assert cli.main(["energy", "--system", "1991 VH", "--thetadot", "0.8", "--orbits", "2",
+                     "--rtol", "1e-11", "--max-drift", "1e-6", "--tide", "secondary",
+                     "--time-lag", "600", "--strength", "1e6", "--out", out]) == 0
+    text = capsys.readouterr().out
+    assert "perturbations: tide on the secondary (k2 " in text and "(rubble pile)" in text
+    work = [line for line in text.splitlines() if "work done by the perturbations" in line]
+    ts = tso.load(tmp_path / "e.npz")
+    assert ts.work[0, -1] < 0                                  # the tide dissipates
+    assert work == [f"  work done by the perturbations W = {ts.work[0, -1]:.6e} J by the end "
+                    "(< 0: dissipated); external angular momentum |L_ext| = 0.000e+00 kg m^2/s"]
+
+
+def test_warmup_perturbed(capsys):
+    assert cli.main(["warmup", "--models", "planar", "--indicators", "off", "--sampling", "off",
+                     "--perturbed"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("planar/plain/sections/order4/cash-karp: ")
+    assert lines[1].startswith("planar/plain/sections/order4/perturbed/cash-karp: ")
+    assert lines[-1].startswith("2 kernel variants ready (")
+
+
+@pytest.mark.parametrize("argv", [
+    ["map", "--grid", "2", "2", "--orbits", "3", "--rtol", "1e-10"],
+    ["overlap", "--system", "2004 DC", "--elongations", "1.03", "1.03", "0.01", "--orbits", "3",
+     "--max-orbits", "3"],
+    ["libration", "--orbits", "3", "--candidates", "0.2", "1.3", "9", "--max-orbits", "3"],
+])
+def test_every_integrating_command_saves_its_perturbations(argv, tmp_path, capsys):
+    out = str(tmp_path / "r.png")
+    assert cli.main([*argv, "--tide", "secondary", "--Q", "50", "--strength", "1e5",
+                     "--allow-inaccurate", "--out", out]) == 0
+    assert capsys.readouterr().out.startswith("perturbations: tide on the secondary (k2 ")
+    assert tso.load(tmp_path / "r.npz").perturbations == (tso.Tides(Q=50.0, strength=1e5),)

@@ -35,6 +35,7 @@ from .section import INDICATOR_SPACE, SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
 from .attitude import CLASS_UNIT as ATTITUDE_CLASS
+from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
                       renamed_keywords, unit)
 
@@ -158,6 +159,8 @@ class ChaosMap(Result, _display.Readable):
     max_tilt: np.ndarray = unit('deg', default=None)
     # attitude class per start from its crossings (attitude.classify_crossings)
     attitude_class: np.ndarray = unit(ATTITUDE_CLASS, default=None)
+    # tides / YORP / BYORP in the equations of every member (docs/physics.md §13)
+    perturbations: tuple = unit(PERTURBATIONS, default=())
 
     mean_spin = alias("mean_thetadot")      # old name (read-only)
 
@@ -197,7 +200,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
               chunk_size=None, model="auto", checkpoint=None, resume=False,
               overwrite_checkpoint=False, max_drift=None,
               include_inaccurate=False, coordinates="inertial", fraction_orbits=None,
-              indicator_space="planar", tilt=None, **section_kwargs) -> ChaosMap:
+              indicator_space="planar", tilt=None, perturbations=None,
+              **section_kwargs) -> ChaosMap:
     """MEGNO, Lyapunov exponent and classification over a grid of starts, in one launch.
 
     Parameters
@@ -253,6 +257,13 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         [-90, 90] (``BinarySystem.tilted_start``; inertial coordinates, single process):
         the map's ``max_tilt`` then shows how far each pole strays (``plot(quantity=
         "max_tilt")``). Without it every start is planar and stays so.
+    perturbations : list of Tides, YORP, BYORP, optional
+        Tides, YORP and BYORP in the equations of every member, each with its ``strength``
+        factor (:mod:`ti_spinorbit.perturbations`, docs/physics.md §13); the shorter lengths
+        of ``fraction_orbits`` run with them too. The accuracy verdict then holds E − W and
+        L − L_ext (the energy and angular momentum they exchange taken off); MEGNO measures
+        the divergence of the perturbed flow. Recorded in the map (``perturbations``, and in
+        ``section``).
     **section_kwargs
         Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
@@ -278,6 +289,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
                                indicator_space == "full" or tilt is not None) else model))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     section_kwargs["indicator_space"] = indicator_space
+    perturbations = check_perturbations(perturbations)
+    section_kwargs["perturbations"] = perturbations
     if tilt is not None:     # explicit tilted starts instead of the (θ_p, θ̇_p) grid
         section_kwargs["initial_states"] = [
             system.tilted_start(float(a), float(b), roll=tilt[0], pitch=tilt[1])
@@ -328,7 +341,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         coordinates=coordinates, indicator_space=indicator_space, tilt=tilt,
         max_tilt=section.max_tilt.reshape(shape),
         attitude_class=None if attitude_class is None else attitude_class.reshape(shape),
-        **evidence)
+        perturbations=perturbations, **evidence)
 
 
 def _check_tilt(tilt, client, coordinates):
@@ -427,6 +440,8 @@ class ParameterMap(Result, _display.Readable):
     fraction_monotone: np.ndarray = unit('bool', default=None)
     fraction_message: str = unit('text', default="")
     indicator_space: str = unit(INDICATOR_SPACE, default="planar")   # docs/physics.md §10.4
+    # tides / YORP / BYORP in the equations of every member (docs/physics.md §13)
+    perturbations: tuple = unit(PERTURBATIONS, default=())
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -449,7 +464,7 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
                   progress=None, client=None, chunk_size=None, model="auto", checkpoint=None,
                   resume=False, overwrite_checkpoint=False, max_drift=None,
                   include_inaccurate=False, coordinates="inertial", fraction_orbits=None,
-                  **section_kwargs) -> ParameterMap:
+                  perturbations=None, **section_kwargs) -> ParameterMap:
     """Chaotic fraction of a set of starts at every (a/b, e), all members in one launch.
 
     Parameters
@@ -473,6 +488,12 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         As for :func:`chaos_map` ("apsidal" needs every e ≥ 1e-3, docs/physics.md §6.7; the
         fraction against orbits per grid point). ``indicator_space="full"`` passes through
         ``section_kwargs`` (docs/physics.md §10.4) and is recorded in the map.
+    perturbations : list of Tides, YORP, BYORP, optional
+        Tides, YORP and BYORP in the equations of every member (docs/physics.md §13). The
+        same objects apply at every (a/b, e): they hold SI parameters (k2, time lag or Q,
+        f_Y, B, strength) and are turned into each grid system's scaled block with that
+        system's own radius, masses, a and n, so a tide with the default (volume-equivalent)
+        radius follows the secondary's shape across the a/b axis. Recorded in the map.
 
     Returns
     -------
@@ -492,6 +513,8 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
+    perturbations = check_perturbations(perturbations)
+    section_kwargs["perturbations"] = perturbations
     if isinstance(system, str):
         name = system
         factory = lambda q, e: catalog.system(name, elongation=q, eccentricity=e)  # noqa: E731
@@ -556,4 +579,5 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         inaccurate=np.sum(status == _inaccurate_code(), axis=-1),
         include_inaccurate=bool(include_inaccurate), coordinates=coordinates,
         method=section.method, fraction_lengths=lengths, fraction_by_length=by_length, fraction_monotone=monotone,
-        fraction_message=message, indicator_space=section.indicator_space)
+        fraction_message=message, indicator_space=section.indicator_space,
+        perturbations=perturbations)

@@ -82,7 +82,16 @@ FLAG_RANGES = {
     "tilt": ("--tilt", -360.0, 360.0, False, False),
     "spin_xy": ("--spin-xy", -MAX_SPIN, MAX_SPIN, False, False),
     "inclination": ("--inclination", -360.0, 360.0, False, False),
+    # tides, YORP, BYORP (the bounds of ti_spinorbit.perturbations)
+    "k2": ("--k2", 1e-12, 10.0, False, False),
+    "time_lag": ("--time-lag", 1e-9, 1e9, False, False),
+    "Q": ("--Q", 1e-3, 1e12, False, False),
+    "yorp": ("--yorp", -1.0, 1.0, False, False),
+    "byorp": ("--byorp", -1.0, 1.0, False, False),
+    "strength": ("--strength", 1e-12, 1e15, False, False),
 }
+#: --heliocentric A_AU E: the binary's heliocentric orbit for --yorp / --byorp.
+HELIOCENTRIC_A_RANGE = (0.05, 1e4)
 #: Figures and data files.
 FIGURE_EXTENSIONS = (".png", ".pdf", ".svg")
 #: Energy check: samples per primary rotation when --samples-per-orbit is not given (resolves
@@ -112,13 +121,15 @@ EXAMPLES_BY_COMMAND = {
     "energy": """\
   ti-spinorbit energy                          # the paper's energy-check case ("test")
   ti-spinorbit energy --orbits 20 --rtol 1e-13 --max-drift 1e-10 --out energy.png
-  ti-spinorbit energy --system "1991 VH" --thetadot 1.0 --orbits 50""",
+  ti-spinorbit energy --system "1991 VH" --thetadot 1.0 --orbits 50
+  ti-spinorbit energy --system "1991 VH" --thetadot 0.8 --orbits 20 --tide secondary --time-lag 600 --strength 1e6""",
     "benchmark": """\
   ti-spinorbit benchmark --members 1024 --orbits 20
   ti-spinorbit benchmark --arch cuda --members 65536 --orbits 20 --out bench_cuda.json""",
     "warmup": """\
   ti-spinorbit warmup                                  # every variant (minutes, once)
-  ti-spinorbit warmup --models planar --indicators off # what 'section' needs""",
+  ti-spinorbit warmup --models planar --indicators off # what 'section' needs
+  ti-spinorbit warmup --models planar --perturbed      # also with tides, YORP, BYORP""",
     "figures": """\
   ti-spinorbit figures --quick --only 1 4 --out out/""",
 }
@@ -231,6 +242,33 @@ def _parser():
         s.add_argument("--inclination", type=float, default=None,
                        help="inclination of the mutual orbit to the primary's equator, deg")
 
+    def perturbation_flags(s):
+        g = s.add_argument_group("tides, YORP and BYORP in the equations (docs/physics.md §13)")
+        g.add_argument("--tide", choices=("primary", "secondary"), default=None,
+                       help="constant-time-lag (--time-lag) or constant-Q (--Q, default Q = "
+                            "100) tide raised on this body by the other")
+        g.add_argument("--k2", type=float, default=None,
+                       help="Love number of the --tide body, in [1e-12, 10] (default: the "
+                            "rubble-pile k2 = 1e-5 R[km])")
+        g.add_argument("--time-lag", type=float, default=None, metavar="S",
+                       help="constant tidal time lag, s, in [1e-9, 1e9] (or --Q)")
+        g.add_argument("--Q", type=float, default=None,
+                       help="constant tidal quality factor, in [0.001, 1e12] (default 100)")
+        g.add_argument("--yorp", type=float, default=None, metavar="F_Y",
+                       help="YORP coefficient f_Y in [-1, 1] (the paper's 5e-4; > 0 spins up) "
+                            "on --yorp-body")
+        g.add_argument("--yorp-body", choices=("primary", "secondary"), default="secondary",
+                       help="the body --yorp acts on (default secondary)")
+        g.add_argument("--byorp", type=float, default=None, metavar="B",
+                       help="BYORP coefficient B in [-1, 1] (> 0 expands the orbit)")
+        g.add_argument("--strength", type=float, default=1.0,
+                       help="factor on every perturbation's force and torque, in [1e-12, "
+                            "1e15] (default 1; 1e6 makes a million years act in one)")
+        g.add_argument("--heliocentric", type=float, nargs=2, default=None,
+                       metavar=("A_AU", "E"),
+                       help="the binary's heliocentric orbit for --yorp/--byorp: a in AU in "
+                            "[0.05, 1e4] and e in [0, 1) (default: the catalogued one)")
+
     def system_flags(s, default="1991 VH", shape=True):
         s.add_argument("--system", default=default,
                        help=f"catalogued system name (default: {default}; see 'ti-spinorbit "
@@ -261,6 +299,7 @@ def _parser():
                    help="initial θ̇_p/n values (default: the paper's starts for this system)")
     tilt_flags(s)
     common(s, "PNG path (default sos_<system>.png)", orbits=500.0, rtol=1e-12, resume=True)
+    perturbation_flags(s)
     accuracy_flags(s)
     coordinates_flag(s)
 
@@ -274,6 +313,7 @@ def _parser():
                    help="shadow direction of MEGNO: planar-restricted (default) or the full "
                         "state, attitudes included (the 3-D model runs; docs/physics.md §10.4)")
     common(s, "PNG path (default map_<system>.png)", resume=True)
+    perturbation_flags(s)
     accuracy_flags(s)
     coordinates_flag(s)
 
@@ -287,6 +327,7 @@ def _parser():
                    help="cap of the length doubling (--orbits, 2x, 4x, ...) that checks the "
                         "decisions converge, in [--orbits, 1e7] (default 4 x --orbits)")
     common(s, "PNG path (default overlap_<system>.png)")
+    perturbation_flags(s)
     accuracy_flags(s)
     coordinates_flag(s)
 
@@ -304,6 +345,7 @@ def _parser():
                         "converge, in [--orbits, 1e7] (default 4 x --orbits)")
     common(s, "PNG path of the centre search, extent vs θ̇_p/n (default libration_<system>.png)",
            orbits=100.0, rtol=1e-12, model=False)
+    perturbation_flags(s)
     accuracy_flags(s)
     coordinates_flag(s)
 
@@ -322,6 +364,7 @@ def _parser():
                         "in (0, 1] (default 1e-9)")
     common(s, "PNG path of drift vs time (default energy_<system>.png)", orbits=5.0, rtol=1e-12,
            resume=True)
+    perturbation_flags(s)
 
     s = command("benchmark", "ensemble throughput in member-orbits/s on 1991 VH (JSON)")
     s.add_argument("--system", default="1991 VH", help="catalogued system (default 1991 VH)")
@@ -342,6 +385,9 @@ def _parser():
                         "(default both)")
     s.add_argument("--methods", nargs="+", default=["cash-karp"],
                    help="integration methods: cash-karp (default), dop853, or both")
+    s.add_argument("--perturbed", action="store_true",
+                   help="also compile the variants with tides, YORP and BYORP in the "
+                        "equations (--tide, --yorp, --byorp of the other commands)")
     s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,
                    help="Taichi arch (default cpu, or $TI_SPINORBIT_ARCH)")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
@@ -466,6 +512,7 @@ def check_args(args):
         if not (float(n).is_integer() and 5 <= n <= 10001):
             raise ValueError(f"--candidates N must be an integer in [5, 10001] (got {n:g})")
     _check_system_flags(args)
+    _check_perturbation_flags(args)
     if args.command == "warmup":
         from .compiling import METHODS
 
@@ -529,6 +576,91 @@ def _check_system_flags(args):
             message = f"{culprit}: {message}"
         raise ValueError(message) from None
     _check_derived(args, system)
+
+
+def _perturbations(args):
+    """The Tides / YORP / BYORP objects the flags ask for (a list, empty without them)."""
+    from .perturbations import BYORP, YORP, Tides
+
+    if not hasattr(args, "tide"):
+        return []
+    sun = {} if args.heliocentric is None else {"heliocentric_a_au": args.heliocentric[0],
+                                                "heliocentric_e": args.heliocentric[1]}
+    out = []
+    if args.tide is not None:
+        out.append(Tides(body=args.tide, k2=args.k2, time_lag=args.time_lag, Q=args.Q,
+                         strength=args.strength))
+    if args.yorp is not None:
+        out.append(YORP(body=args.yorp_body, coefficient=args.yorp, strength=args.strength,
+                        **sun))
+    if args.byorp is not None:
+        out.append(BYORP(coefficient=args.byorp, strength=args.strength, **sun))
+    return out
+
+
+def _check_perturbation_flags(args):
+    """Relations between the perturbation flags, and that the system can carry them (a
+    catalogued heliocentric orbit or --heliocentric for YORP / BYORP), before any work; the
+    ranges of the single values are in FLAG_RANGES."""
+    if not hasattr(args, "tide"):
+        return
+    if args.tide is None:
+        for dest, flag in (("k2", "--k2"), ("time_lag", "--time-lag"), ("Q", "--Q")):
+            if getattr(args, dest) is not None:
+                raise ValueError(f"{flag} needs --tide primary|secondary (the body that deforms)")
+    if args.time_lag is not None and args.Q is not None:
+        raise ValueError("--time-lag and --Q exclude each other: the tide has a constant time "
+                         "lag or a constant Q, give one")
+    if args.yorp is None and args.yorp_body != "secondary":
+        raise ValueError("--yorp-body needs --yorp F_Y (the YORP coefficient, in [-1, 1])")
+    if args.heliocentric is not None:
+        a_au, e = args.heliocentric
+        _check_range("--heliocentric A_AU", a_au, *HELIOCENTRIC_A_RANGE)
+        _check_range("--heliocentric E", e, 0.0, 1.0, high_open=True)
+        if args.yorp is None and args.byorp is None:
+            raise ValueError("--heliocentric needs --yorp or --byorp (only they use the "
+                             "heliocentric orbit)")
+    items = _perturbations(args)
+    if not items:
+        if args.strength != 1.0:
+            raise ValueError("--strength needs --tide, --yorp or --byorp (it scales them)")
+        return
+    if args.command == "overlap":
+        from . import catalog
+        system = catalog.system(args.system, eccentricity=args.eccentricity)
+    else:
+        system = _system(args)
+    for p in items:
+        flag = {"tides": "--tide", "yorp": "--yorp", "byorp": "--byorp"}[p.kind]
+        try:
+            p.block(system)
+        except ValueError as exc:
+            text = _one_line(exc).replace("pass heliocentric_a_au (AU) and heliocentric_e to "
+                                          "YORP / BYORP", "pass --heliocentric A_AU E")
+            raise ValueError(f"{flag}: {text}") from None
+
+
+def perturbation_summary(items, system=None):
+    """One line naming the perturbations of a run (their SI parameters and the strength),
+    "" without any."""
+    parts = []
+    for p in items:
+        if p.kind == "tides":
+            k2 = p.k2 if p.k2 is not None or system is None else p.love_number(system)
+            lag = f"time lag {p.time_lag:g} s" if p.time_lag is not None else \
+                f"Q {100.0 if p.Q is None else p.Q:g}"
+            rubble = " (rubble pile)" if p.k2 is None else ""
+            parts.append(f"tide on the {p.body} (k2 {k2:.3g}{rubble}, {lag})")
+        elif p.kind == "yorp":
+            parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g})")
+        else:
+            parts.append(f"BYORP (B {p.coefficient:g})")
+    if not parts:
+        return ""
+    strengths = sorted({p.strength for p in items})
+    scale = ", ".join(f"{x:g}" for x in strengths)
+    return (f"perturbations: {'; '.join(parts)}; strength {scale} (docs/physics.md §13; "
+            "drifts are those of E - W and L - L_ext)")
 
 
 def _check_derived(args, system):
@@ -643,14 +775,19 @@ def _system(args):
 #: g64x64 (--grid), tdr0.5-2 (--thetadot-range), ab1.01-1.1-0.01 (--elongations), cand0.2-1.3-45
 #: (--candidates), xtol1e-8, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
 #: (--max-orbits), rtol1e-13, tilt5-0-0, sxy0-0.1, inc10; --model, --coordinates, --method and
-#: --indicator-space by their value alone (3d, apsidal, dop853, full). --max-drift, --arch and output flags change no physics: not named.
+#: --indicator-space by their value alone (3d, apsidal, dop853, full); tides, YORP and BYORP:
+#: tide-secondary (--tide), k2 (--k2), dt600 (--time-lag), Q100 (--Q), yorp0.0005 (--yorp),
+#: yorp-primary (--yorp-body), byorp1e-3, str1e6 (--strength), helio1.1-0.2 (--heliocentric).
+#: --max-drift, --arch and output flags change no physics: not named.
 NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("elongations", "ab"), ("theta_p", "tp"), ("thetadot", "td"), ("grid", "g"),
              ("thetadot_range", "tdr"), ("candidates", "cand"), ("xtol", "xtol"),
              ("samples_per_orbit", "spo"), ("orbits", "o"), ("max_orbits", "maxo"),
              ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""),
              ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"),
-             ("indicator_space", ""))
+             ("indicator_space", ""), ("tide", "tide-"), ("k2", "k2"), ("time_lag", "dt"),
+             ("Q", "Q"), ("yorp", "yorp"), ("yorp_body", "yorp-"), ("byorp", "byorp"),
+             ("strength", "str"), ("heliocentric", "helio"))
 
 
 def default_stem(args, prefix, system_name):
@@ -741,6 +878,14 @@ def _run_flags(args, data):
     :func:`_paths` before any work)."""
     return {"model": args.model, "method": args.method, "checkpoint": _checkpoint_path(args, data),
             "resume": args.resume, "overwrite_checkpoint": args.overwrite_checkpoint}
+
+
+def _announce_perturbations(args, system):
+    """The perturbations of the flags (a list), their one-line summary printed first."""
+    items = _perturbations(args)
+    if items:
+        _print(args, perturbation_summary(items, system))
+    return items
 
 
 def _finish_checkpoint(args, data):
@@ -878,6 +1023,7 @@ def _cmd_section(args):
                          "apsidal coordinates are defined for planar starts)")
     out, data = _paths(args, "sos", system.name)
     _init(args)
+    perturbations = _announce_perturbations(args, system)
     if tilted:                     # explicit 3-D starts (docs/physics.md §6.8)
         roll, pitch, yaw = args.tilt or (0.0, 0.0, 0.0)
         sx, sy = args.spin_xy or (0.0, 0.0)
@@ -889,7 +1035,8 @@ def _cmd_section(args):
     with _progress(args) as bar:
         result = surface_of_section(system, orbits=args.orbits, **starts_kw,
                                     rtol=args.rtol, progress=bar, max_drift=args.max_drift,
-                                    coordinates=args.coordinates, **_run_flags(args, data))
+                                    coordinates=args.coordinates, perturbations=perturbations,
+                                    **_run_flags(args, data))
     out, data = _write(result, data, {"command": args.command_line},
                        lambda: plot_section(result), out)
     _print(args, f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "
@@ -916,12 +1063,14 @@ def _cmd_map(args):
     lo, hi = args.thetadot_range
     out, data = _paths(args, "map", system.name)
     _init(args)
+    perturbations = _announce_perturbations(args, system)
     theta = (np.arange(nt) + 0.5) * 180.0 / nt
     with _progress(args) as bar:
         cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
                          rtol=args.rtol, progress=bar, max_drift=args.max_drift,
                          include_inaccurate=args.allow_inaccurate, coordinates=args.coordinates,
-                         indicator_space=args.indicator_space, **_run_flags(args, data))
+                         indicator_space=args.indicator_space, perturbations=perturbations,
+                         **_run_flags(args, data))
     out, data = _write(cmap, data, {"command": args.command_line}, cmap.plot, out)
     counted = "all finished members" if args.allow_inaccurate else \
         f"{cmap.n_inaccurate} inaccurate left out"
@@ -943,13 +1092,15 @@ def _cmd_overlap(args):
     system = catalog.system(args.system, eccentricity=args.eccentricity)   # checks name and e
     out, data = _paths(args, "overlap", system.name)
     _init(args)
+    perturbations = _announce_perturbations(args, system)
     q = np.round(np.arange(start, stop + step / 2, step), 10)
     with _progress(args) as bar:
         scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
                                  orbits=args.orbits, rtol=args.rtol, progress=bar,
                                  model=args.model, method=args.method, max_drift=args.max_drift,
                                  include_inaccurate=args.allow_inaccurate,
-                                 max_orbits=args.max_orbits, coordinates=args.coordinates)
+                                 max_orbits=args.max_orbits, coordinates=args.coordinates,
+                                 perturbations=perturbations)
     out, data = _write(scan, data, {"command": args.command_line, "converged": scan.converged,
                                     "convergence": scan.message}, scan.plot, out)
     bound = "" if scan.converged else " (upper bound: not converged)"
@@ -982,6 +1133,7 @@ def _cmd_libration(args):
     out, data = _paths(args, "libration", system.name)
     kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol, max_drift=args.max_drift,
                   max_orbits=args.max_orbits, coordinates=args.coordinates, method=args.method)
+    kwargs["perturbations"] = _announce_perturbations(args, system)
     if args.candidates:
         lo, hi, n = args.candidates
         kwargs["candidates"] = np.linspace(lo, hi, int(n))
@@ -1055,9 +1207,10 @@ def _cmd_energy(args):
             system.orbital_period / abs(system.primary_spin_period)
         samples = max(MIN_SAMPLES_PER_ORBIT, m.ceil(SAMPLES_PER_PRIMARY_ROTATION * rotations))
     _init(args)
+    perturbations = _announce_perturbations(args, system)
     with _progress(args) as bar:
         ts = time_series(system, args.theta_p, thetadot, args.orbits, samples_per_orbit=samples,
-                         rtol=args.rtol, max_drift=args.max_drift,
+                         rtol=args.rtol, max_drift=args.max_drift, perturbations=perturbations,
                          **_with_progress(time_series, bar), **_run_flags(args, data))
     numbers, series = energy_check(ts)
     status = ts.status_names[0]
@@ -1072,6 +1225,7 @@ def _cmd_energy(args):
            f"  max relative angular-momentum drift {numbers['angmom_drift']:.3e}",
            "  largest exchange, |ΔE_i|/|E0|: orbit {exchange_orbit:.3e}, primary spin "
            "{exchange_primary:.3e}, secondary spin {exchange_secondary:.3e}".format(**numbers),
+           *([] if ts.work is None else [_work_line(ts)]),
            f"wrote {out} and {data}", *filter(None, [_finish_checkpoint(args, data)]))
     if not worst <= args.max_drift:          # also catches NaN
         print(f"ti-spinorbit energy: drift {worst:.3e} exceeds --max-drift {args.max_drift:g} "
@@ -1082,6 +1236,18 @@ def _cmd_energy(args):
               file=sys.stderr)
         return EXIT_CHECK_FAILED
     return EXIT_OK
+
+
+def _work_line(ts, member=0):
+    """The work the perturbations did on a time series member by its last sample, J, and the
+    angular momentum they brought in (the drifts above are those of E - W and L - L_ext)."""
+    import numpy as np
+
+    ok = np.isfinite(ts.t[member])
+    work = float(ts.work[member][ok][-1])
+    lext = float(np.linalg.norm(ts.external_angmom[member][ok][-1]))
+    return (f"  work done by the perturbations W = {work:.6e} J by the end (< 0: dissipated); "
+            f"external angular momentum |L_ext| = {lext:.3e} kg m^2/s")
 
 
 def _status_code(name):
@@ -1143,7 +1309,7 @@ def _cmd_warmup(args):
     started = time.perf_counter()
     done = warmup(models=args.models, indicators=[v == "on" for v in args.indicators],
                   sampling=[v == "on" for v in args.sampling], methods=args.methods,
-                  verbose=not args.quiet)
+                  verbose=not args.quiet, perturbed=(False, True) if args.perturbed else (False,))
     compiled = sum(d["how"] == "compiled" for d in done)
     _print(args, f"{len(done)} kernel variants ready ({compiled} compiled, "
                  f"{len(done) - compiled} already in the cache) in "

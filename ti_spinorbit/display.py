@@ -263,8 +263,17 @@ def summary(obj):
     """(title, lines): each line a list of (label, value) strings."""
     for cls in type(obj).__mro__:
         if cls.__name__ in _SUMMARIES:
-            return _SUMMARIES[cls.__name__](obj)
+            title, lines = _SUMMARIES[cls.__name__](obj)
+            if getattr(obj, "perturbations", None):     # tides / YORP / BYORP in the equations
+                lines = list(lines) + [[("perturbations", _perturbations(obj.perturbations))]]
+            return title, lines
     raise TypeError(f"no summary for {type(obj).__name__}")
+
+
+def _perturbations(items):
+    """"tides on the secondary ×1e+06, byorp ×1e+06": kind, body, strength."""
+    return ", ".join(f"{p.kind}" + ("" if p.kind == "byorp" else f" on the {p.body}")
+                     + ("" if p.strength == 1 else f" ×{p.strength:g}") for p in items)
 
 
 def text(obj):

@@ -98,7 +98,11 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         ``progress(fraction)`` on the client after every finished chunk.
     **kwargs
         Passed to ``surface_of_section`` (``rtol``, ``atol``, ``order``, ``window_orbits``,
-        ``escape_distance``, ``indicators``, ``coordinates``).
+        ``escape_distance``, ``indicators``, ``coordinates``, ``perturbations``).
+        ``perturbations`` (tides, YORP, BYORP; docs/physics.md §13) are checked here and sent
+        to every chunk as the same objects, so each member's block is built from its own
+        system exactly as in one launch: the result is again bit for bit the
+        single-process one, ``perturbations`` recorded.
 
     Returns
     -------
@@ -119,6 +123,8 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
     from .kernels.tableau import check_method
     check_method(call.arguments["method"])
+    from .perturbations import check_perturbations
+    kwargs["perturbations"] = check_perturbations(call.arguments["perturbations"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
                          "would share one file); failed chunks are retried instead")

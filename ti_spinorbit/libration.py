@@ -53,6 +53,7 @@ from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
+from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
 DEFAULT_CANDIDATES = np.linspace(0.2, 1.3, 45)
@@ -97,7 +98,7 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
                         rtol=1e-12, max_drift=None, include_inaccurate=False,
                         coordinates="inertial", model="auto", checkpoint=None, resume=False,
                         overwrite_checkpoint=False, progress=None,
-                        method="cash-karp"):
+                        method="cash-karp", perturbations=None):
     """Libration amplitude max |α| (deg) of starts at θ_p = 0, sampled densely.
 
     α is unwrapped with period 180° from α(0) = 0, so a trajectory librates when it stays
@@ -128,6 +129,10 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         As for :func:`~ti_spinorbit.section.surface_of_section` (:mod:`ti_spinorbit.progress`).
     method : {"cash-karp", "dop853"}
         Runge-Kutta pair (:func:`~ti_spinorbit.section.time_series`).
+    perturbations : list of Tides, YORP, BYORP, optional
+        Tides, YORP and BYORP in the equations (docs/physics.md §13), as for
+        :func:`~ti_spinorbit.section.time_series`: the amplitude is then max |α| of the
+        perturbed trajectory over the whole run (a tide damps the libration as it goes).
 
     Returns
     -------
@@ -141,7 +146,7 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
                          rtol=rtol, max_drift=max_drift, coordinates=coordinates, model=model,
                          checkpoint=checkpoint, resume=resume,
                          overwrite_checkpoint=overwrite_checkpoint, progress=report,
-                         method=method)
+                         method=method, perturbations=perturbations)
     amplitude = _amplitudes(ts, include_inaccurate)
     return float(amplitude[0]) if np.ndim(thetadot_p) == 0 and len(amplitude) == 1 else amplitude
 
@@ -212,6 +217,8 @@ class RelaxedLibration(Result, _display.Readable):
     #: the dense time series at the centre (the trajectory whose max |α| is ``amplitude``);
     #: None in files written before it was stored (``trajectory()`` computes it again)
     series: object = field(default=None, repr=False)
+    #: tides / YORP / BYORP in the equations of every launch (docs/physics.md §13)
+    perturbations: tuple = unit(PERTURBATIONS, default=())
 
     def trajectory(self):
         """The time series at the centre: ``series``, or (for files written without it) the
@@ -220,7 +227,8 @@ class RelaxedLibration(Result, _display.Readable):
         if self.series is None:
             self.series = time_series(self.system, 0.0, self.centre_thetadot_p, self.orbits,
                                       samples_per_orbit=self.samples_per_orbit, rtol=self.rtol,
-                                      coordinates=self.coordinates)
+                                      coordinates=self.coordinates, method=self.method,
+                                      perturbations=self.perturbations)
         return self.series
 
     def plot(self, ax=None, title=None, search=None):
@@ -289,7 +297,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                       max_extent=MAX_CENTER_EXTENT_DEG, progress=None,
                       max_drift=None, coordinates="inertial", converge=True, max_orbits=None,
                       centre_tol=None, amplitude_tol=0.01, model="auto", checkpoint=None,
-                      resume=False, overwrite_checkpoint=False,
+                      resume=False, overwrite_checkpoint=False, perturbations=None,
                       **section_kwargs) -> RelaxedLibration:
     """Find the centre of the synchronous island and measure the relaxed libration amplitude.
 
@@ -357,6 +365,12 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         A directory for the checkpoints of the search's launches (``DIR/launch-kkk``, one per
         launch: :class:`ti_spinorbit.checkpoint.Launches`), whether to continue from them, and
         whether to replace ones already there when not resuming.
+    perturbations : list of Tides, YORP, BYORP, optional
+        Tides, YORP and BYORP in the equations of every launch of the search and of its
+        convergence checks (docs/physics.md §13). With a dissipative tide the island's
+        centre is no longer a fixed point of the section, so the search finds the start whose
+        trace is narrowest over ``orbits``; keep the strength small enough that the centre
+        moves little in that time. Recorded in the result.
     **section_kwargs
         Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
@@ -418,7 +432,9 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                          f"(got {cap:g})")
     from .checkpoint import Launches
 
-    section_kwargs = dict(section_kwargs, coordinates=coordinates, model=model)  # every launch alike
+    perturbations = check_perturbations(perturbations)
+    section_kwargs = dict(section_kwargs, coordinates=coordinates, model=model,  # every launch alike
+                          perturbations=perturbations)
     search = dict(zoom_candidates=zoom_candidates, xtol=xtol, max_iterations=max_iterations,
                   samples_per_orbit=samples_per_orbit, coarse_arm_points=coarse_arm_points,
                   max_extent=max_extent, max_drift=max_drift, section_kwargs=section_kwargs,
@@ -510,6 +526,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     coordinates = section_kwargs.get("coordinates", "inertial")
     model = section_kwargs.get("model", "auto")
     method = section_kwargs.get("method", "cash-karp")
+    perturbations = section_kwargs.get("perturbations", ())
     x = DEFAULT_CANDIDATES.copy() if candidates is None else \
         np.asarray(candidates, dtype=np.float64).ravel()
     shrink = (zoom_candidates - 1) / 4.0           # window narrowing per zoom launch
@@ -545,6 +562,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
     librates = np.isfinite(libration_amplitude(system, x, orbits, rtol=rtol, max_drift=limit,
                                                samples_per_orbit=CLASSIFY_SAMPLES_PER_ORBIT,
                                                coordinates=coordinates, model=model, method=method,
+                                               perturbations=perturbations,
                                                **checkpoints.next()))
     launched(zooms_left(half_width, 0) + 2)
     extent[~librates | (extent >= LIBRATION_LIMIT_DEG)] = np.nan
@@ -595,7 +613,7 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
                       stacklevel=2)
     ts = time_series(system, 0.0, center, orbits, samples_per_orbit=samples_per_orbit, rtol=rtol,
                      max_drift=limit, coordinates=coordinates, model=model, method=method,
-                     **checkpoints.next())
+                     perturbations=perturbations, **checkpoints.next())
     amplitude = float(_amplitudes(ts, include_inaccurate=True)[0])   # kept, flagged below
     launched(0)
     if not np.isfinite(amplitude):
@@ -615,4 +633,5 @@ def _search(system, orbits, rtol, candidates, zoom_candidates, xtol, max_iterati
         orbits=float(orbits), rtol=float(rtol), samples_per_orbit=samples_per_orbit, xtol=xtol,
         seconds=start.seconds(), system=system, status=status,
         energy_drift=float(ts.energy_drift[0]), angmom_drift=float(ts.angmom_drift[0]),
-        max_drift=limit, coordinates=coordinates, series=ts, method=method)
+        max_drift=limit, coordinates=coordinates, series=ts, method=method,
+        perturbations=perturbations)

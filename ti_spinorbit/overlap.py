@@ -55,6 +55,7 @@ from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
+from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
@@ -135,6 +136,8 @@ class OverlapScan(Result, _display.Readable):
     member_orbits: float = unit('member x orbital periods', default=float("nan"))
     #: integrator tolerance of every trajectory (NaN in files written before it was stored)
     rtol: float = unit('1', default=float("nan"))
+    #: tides / YORP / BYORP in the equations of every trajectory (docs/physics.md §13)
+    perturbations: tuple = unit(PERTURBATIONS, default=())
 
     def __post_init__(self):
         if not np.isfinite(self.rtol) and self.sections is not None:
@@ -210,7 +213,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                       chunk_size=None, model="auto", max_drift=None,
                       include_inaccurate=False, coordinates="inertial", max_orbits=None,
                       checkpoint=None, resume=False, overwrite_checkpoint=False,
-                      **section_kwargs) -> OverlapScan:
+                      perturbations=None, **section_kwargs) -> OverlapScan:
     """Scan the elongation a/b and decide, for each, whether the 1:1 and 3:2 resonances
     overlap (see the module docstring for the rule).
 
@@ -261,6 +264,12 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
         ``DIR/launch-kkk``: :class:`ti_spinorbit.checkpoint.Launches`), whether to continue
         from them, and whether to replace ones already there when not resuming (single
         process only).
+    perturbations : list of Tides, YORP, BYORP, optional
+        Tides, YORP and BYORP in the equations of every trajectory of every length, built
+        for each elongation's own system from the same SI objects (docs/physics.md §13).
+        A dissipative tide lets trajectories drift across the section, so a connection can
+        then also mean a tidal drift between the islands' levels: compare with the scan
+        without them. Recorded in the scan (``perturbations``).
     **section_kwargs
         Passed to every :func:`~ti_spinorbit.section.surface_of_section` call.
 
@@ -296,6 +305,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
         raise TypeError(f"system must be a catalogue name or a callable "
                         f"(elongation) -> BinarySystem (got {type(system).__name__})")
     make, name = _factory(system, eccentricity)
+    perturbations = check_perturbations(perturbations)
     from .checkpoint import Launches
     launches = Launches(checkpoint, resume, overwrite_checkpoint)
     if elongations is not None and (np.ndim(elongations) != 1 or np.size(elongations) == 0):
@@ -322,7 +332,8 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     sep_rates = np.linspace(0.8, 1.8, int(separatrix_starts))
     per = len(centre_rates) + len(sep_rates)
     run = dict(chunk_size=chunk_size, rtol=rtol, indicators=indicators,
-               model=model, max_drift=max_drift, coordinates=coordinates, **section_kwargs)
+               model=model, max_drift=max_drift, coordinates=coordinates,
+               perturbations=perturbations, **section_kwargs)
     lengths = _lengths(orbits, max_orbits)
     t0 = compiling.Stopwatch()           # compile time left out of seconds
     decisions = [None] * q.size
@@ -399,7 +410,8 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                        converged_orbits=converged_at if converged else float("nan"),
                        max_orbits=float(lengths[-1]), message=message,
                        megno_first_overlap=megno_first, member_orbits=member_orbits,
-                       coordinates=coordinates, method=first_sec.method)
+                       coordinates=coordinates, method=first_sec.method,
+                       perturbations=perturbations)
     scan._runs = runs
     return scan
 

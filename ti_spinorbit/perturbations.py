@@ -86,7 +86,10 @@ def _heliocentric(system, a_au, e):
     AU, _, _ = _solar()
     if a_au is None:
         from .catalog import heliocentric_orbit
-        orbit = heliocentric_orbit(getattr(system, "name", ""))
+        try:
+            orbit = heliocentric_orbit(getattr(system, "name", ""))
+        except (TypeError, ValueError):      # a system of your own: not in the catalogue
+            orbit = None
         if orbit is None:
             raise ValueError(f"no heliocentric orbit is catalogued for {system.name!r}: pass "
                              "heliocentric_a_au (AU) and heliocentric_e to YORP / BYORP")

@@ -587,7 +587,8 @@ class TimeSeriesResult(Result, _display.Readable):
     def conservation(self, member=0):
         """Conservation numbers of one member: the largest relative drift of the total energy
         and of the total angular-momentum vector over its samples, and the largest change of
-        each energy part relative to |E0| (the orbit/spin exchange).
+        each energy part relative to |E0| (the orbit/spin exchange). With perturbations the
+        totals are E − W and L − L_ext (``work``, ``external_angmom``; docs/physics.md §13.4).
 
         Returns (numbers, series): ``numbers`` a dict of floats ("energy_drift",
         "angmom_drift", "exchange_orbit", "exchange_primary", "exchange_secondary") and
@@ -596,8 +597,11 @@ class TimeSeriesResult(Result, _display.Readable):
         ok = np.isfinite(self.t[member])
         t = self.t[member][ok]
         energy = self.energy[member][ok]
-        e0 = energy[0]
         angmom = sum(getattr(self, f"angmom_{k}")[member][ok] for k in ("orbit", "primary", "secondary"))
+        if getattr(self, "work", None) is not None:   # perturbed: E − W, L − L_ext conserved (§13.4)
+            energy = energy - self.work[member][ok]
+            angmom = angmom - self.external_angmom[member][ok]
+        e0 = energy[0]
         l0 = np.linalg.norm(angmom[0])
         de = (energy - e0) / abs(e0)
         dl = np.linalg.norm(angmom - angmom[0], axis=1) / l0

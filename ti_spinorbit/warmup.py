@@ -22,7 +22,7 @@ def _choices(name, values, allowed):
 
 
 def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), methods=("cash-karp",),
-           order=4, verbose=True, stream=None):
+           order=4, verbose=True, stream=None, perturbed=(False,)):
     """Compile kernel variants ahead of time, so that later runs (in this process, and in
     later processes through the disk cache) start without waiting.
 
@@ -40,6 +40,10 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     methods : sequence of str
         Integration methods among ``METHODS`` ("cash-karp", "dop853"); default the default
         method only (each method is a separate set of compiles).
+    perturbed : sequence of bool
+        Without and/or with tides, YORP and BYORP in the equations (``perturbations=``,
+        docs/physics.md §13; a separate kernel set). Default without only; ``(False, True)``
+        compiles both (``ti-spinorbit warmup --perturbed``).
     order : {0, 2, 3, 4}
         Potential order of the variants (default 4, every entry point's default).
     verbose : bool
@@ -65,20 +69,26 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     indicators = _choices("indicators", indicators, (False, True))
     sampling = _choices("sampling", sampling, (False, True))
     methods = _choices("methods", methods, METHODS)
+    perturbed = _choices("perturbed", perturbed, (False, True))
     order = require_order(order)
     out = sys.stdout if stream is None else stream
     runtime.ensure_init()
     system = catalog.system("1991 VH")
-    _, par, y0, _, _ = build_members(system, 0.0, 1.0, order=order)
+    members, par, y0, _, _ = build_members(system, 0.0, 1.0, order=order)
+    from .perturbations import Tides, perturbation_rows
+    rows = perturbation_rows(members, [Tides(k2=1e-5, time_lag=600.0)])   # any block will do
     done = []
-    for method, model, ind, samp in itertools.product(methods, models, indicators, sampling):
+    for method, model, ind, samp, pert in itertools.product(methods, models, indicators,
+                                                            sampling, perturbed):
         started = time.perf_counter()
         kw = {} if method == "cash-karp" else {"method": method}
+        if pert:
+            kw["perturbation_rows"] = rows
         ens = Ensemble(par, y0, order=order, model=model, **kw)
         before = len(compiling._SEEN), compiling._TOTAL[0]
         ens.run(2.0 * np.pi * 0.01, sample_dt=2.0 * np.pi / 64 if samp else None,
                 indicators=ind)
-        variant = variant_name(model, ind, samp, order, ens.odd, method)
+        variant = variant_name(model, ind, samp, order, ens.odd, method, pert)
         seconds = time.perf_counter() - started
         kernel = compiling._TOTAL[0] - before[1]
         how = "ready" if len(compiling._SEEN) == before[0] else compiling._HOW.get(variant, "compiled")

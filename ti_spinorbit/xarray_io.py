@@ -19,6 +19,12 @@ RelaxedLibration       (candidate) with coord launch (0: coarse bracket, then zo
 
 A nested section (``ChaosMap.section``, ``OverlapScan.sections``) is not merged in (its
 dimensions differ): convert it on its own, ``to_xarray(cmap.section)``.
+
+Tides, YORP and BYORP (``perturbations=``, docs/physics.md §13) travel as the attribute
+``perturbations``: JSON text of :func:`ti_spinorbit.perturbations.describe` (``"[]"``
+without them), read back with ``perturbations.from_description(json.loads(...))``. A
+perturbed time series also has ``work`` (J) and ``external_angmom`` (kg m² s⁻¹, with
+``component``) per sample.
 """
 
 import json
@@ -56,6 +62,9 @@ def _attrs(result, kind, metadata):
             attrs[name] = int(value)           # netCDF has no bool attribute
         elif isinstance(value, (int, float, str)):
             attrs[name] = value
+    if isinstance(getattr(result, "perturbations", None), tuple):
+        from .perturbations import describe
+        attrs["perturbations"] = json.dumps(describe(result.perturbations))
     systems = getattr(result, "systems", None)
     if systems is None and getattr(result, "system", None) is not None:
         systems = [result.system]
@@ -105,6 +114,10 @@ def _time_series(r, units):
     for k in ("energy_drift", "angmom_drift"):          # absent in files from before issue 10
         if getattr(r, k, None) is not None:
             data[k] = ("member", getattr(r, k))
+    if getattr(r, "work", None) is not None:             # with perturbations only
+        data["work"] = (("member", "sample"), r.work)
+    if getattr(r, "external_angmom", None) is not None:
+        data["external_angmom"] = (("member", "sample", "component"), r.external_angmom)
     coords = {"member": np.arange(n), "sample": np.arange(width), "component": ["x", "y", "z"],
               "system": ("member", [s.name for s in r.systems])}
     if r.initial_theta_p is not None:
