@@ -194,7 +194,7 @@ ENTRY_POINTS = {
                                                                  samples_per_orbit=16,
                                                                  rtol=1e-10, progress=p),
     "overlap_threshold": lambda vh, p: tso.overlap_threshold(
-        "1991 VH", elongations=[1.05], orbits=4, max_orbits=8, center_starts=2,
+        "1991 VH", elongations=[1.05], orbits=4, max_orbits=8, centre_starts=2,
         separatrix_starts=2, progress=p),
 }
 

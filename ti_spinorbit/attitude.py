@@ -38,7 +38,9 @@ _R, _V, _W2, _S = slice(0, 3), slice(3, 6), slice(9, 12), slice(12, 21)
 
 
 def _unit(v):
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+    """v / |v|; NaN, silently, for a zero vector (a non-spinning body has no spin axis)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
 def _split(y):
