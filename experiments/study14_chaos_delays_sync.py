@@ -9,7 +9,11 @@ synchronous rotation is measured directly, for 1991 VH, 2003 YT1 and 2004 DC:
   chaotic sea between the synchronous island and the next large island above it: 1991 VH
   1.3–2.1 (2:1 island at 2.31), 2003 YT1 1.1–2.6 (5:2 at 2.85), 2004 DC 1.2–4.0 (4:1 at 4.29))
   kept only if chaotic at t = 0: MEGNO ⟨Y⟩ > 4 after ``SCREEN_ORBITS`` orbits without tides
-  (``surface_of_section(..., indicators=True)``), as the chaos maps classify.
+  (``surface_of_section(..., indicators=True)``), as the chaos maps classify, and not
+  synchronous to begin with: without tides the long axis turns past the primary within
+  ``CIRCULATION_ORBITS`` orbits (chaotic starts whose α never circulates, "chaotic
+  librators" in the layer around the synchronous island, are dropped; their share is
+  printed).
 * Regular reference: the same starts (same θ_p, same initial spin) with the secondary made
   nearly spherical, a/b = 1.01 at the same mass, volume and c (``catalog.system(name,
   elongation=1.01)``): no chaotic zone (its 1:1 and 3:2 islands are separated by invariant
@@ -20,8 +24,9 @@ synchronous rotation is measured directly, for 1991 VH, 2003 YT1 and 2004 DC:
   chosen per system so that the decoupled e-folding time of θ̇ − n of the nominal secondary,
   τ = a⁶ C / (3 k2 G M_p² R⁵ Δt S) (docs/physics.md §13.1), is 50 orbits (``FULL``; runs of
   2000 orbits = 40 τ, 48 members per ensemble; quick mode 20 orbits, 150, 6); a second
-  run at 2 S (τ/2) tests the weak-tide regime: there capture times scale as 1/S, so
-  t_capture / τ (= t_capture × S up to a constant) must agree between the two strengths.
+  run at S/2 (2τ, run twice as long) tests the weak-tide regime: there capture times scale
+  as 1/S, so t_capture / τ (= t_capture × S up to a constant) must agree between the two
+  strengths.
 * Tides + YORP: the same tide plus ``YORP(body="secondary", coefficient=+5e-4)`` (the paper's
   f_Y, spinning up, against the tide), its strength set so that its spin acceleration equals
   the tide's at |θ̇ − n| = ``YORP_OFFSET`` n: it shifts the decoupled tidal equilibrium up by
@@ -69,12 +74,13 @@ YORP_OFFSET = 0.1         # YORP's spin acceleration = the tide's at |θ̇ − n
 FULL = {"members": 48, "tau": 50.0, "orbits": 2000}
 QUICK = {"members": 6, "tau": 20.0, "orbits": 150}
 SCREEN_ORBITS = 150
+CIRCULATION_ORBITS = 20   # a kept start's long axis turns past the primary within this
 MEGNO_CHAOTIC = 4.0
 WINDOW_FRACTION = 0.05
 SAMPLES_PER_ORBIT = 16    # unwraps 2α while |θ̇ − ḟ| < 4 n
 RTOL = 1e-10
 BOOTSTRAP = 2000
-BATCH = 16                # members per time_series call: bounds the sample memory
+BATCH = 8                 # members per time_series call: bounds the sample memory
 SEED = 14
 
 
@@ -102,6 +108,28 @@ def yorp_strength(system, tide_strength):
     C = system.secondary.mass * (a * a + b * b) / 5.0
     per_unit = tso.YORP(body="secondary", coefficient=YORP_COEFFICIENT).torque(system) / C
     return despin_rate(system, tide_strength) * YORP_OFFSET * system.mean_motion / per_unit
+
+
+def decoupled_despin(round_system, nominal, tau_orbits, thetadot_p):
+    """The decoupled estimate for the regular secondary (docs/physics.md §8.9, §13.1): the
+    orbit-averaged tide dω/dt = −γ' [Ω(e) ω − N(e) n] relaxes ω exponentially (rate γ' Ω(e),
+    γ' = γ C/C' for the round secondary's moment C') to the pseudo-synchronous N/Ω; the spin
+    reaches the synchronous island's separatrix 1 + ω0' sqrt|H(1, e)| (units of n) after
+    ln((ω_i − N/Ω) / (1 + w − N/Ω)) / (γ' Ω) if N/Ω lies below it, else never. Returns
+    (N/Ω, w, times in orbits per start, inf where never)."""
+    from ti_spinorbit import analytic
+
+    big_omega, big_n = analytic.tidal_torque_factors(round_system.e)
+    ps = big_n / big_omega
+    w = float(analytic.resonance_half_width(1, round_system.omega0, round_system.e))
+    ratio = despin_rate(round_system) / despin_rate(nominal)       # C / C'
+    rate = ratio * big_omega / tau_orbits                            # per orbit
+    top = 1.0 + w
+    if ps >= top:
+        return ps, w, np.full(len(thetadot_p), np.inf)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.log((np.asarray(thetadot_p) - ps) / (top - ps)) / rate
+    return ps, w, np.where(np.asarray(thetadot_p) > top, t, 0.0)
 
 
 def capture_time(t_orb, alpha_deg, window):
@@ -158,9 +186,9 @@ def run_ensemble(system, theta_p, thetadot_p, perturbations, orbits):
     return res
 
 
-def quantiles(tc, usable_mask, censor):
+def quantiles(tc, usable_mask):
     """Quartiles (25, 50, 75 %) of the capture times of the usable members, not-captured ones
-    counted as later than ``censor`` (inf: a quantile beyond the captured fraction)."""
+    counted as later than the run (inf: a quantile beyond the captured fraction)."""
     x = np.where(np.isfinite(tc), tc, np.inf)[usable_mask]
     if x.size == 0:
         return np.full(3, np.nan)
@@ -190,10 +218,18 @@ def chaotic_starts(system, band, members, rng, quick):
     orbits = 60 if quick else SCREEN_ORBITS
     sec = tso.surface_of_section(system, tp, td, orbits=orbits, rtol=RTOL, indicators=True)
     chaotic = usable(sec.status) & (sec.megno > MEGNO_CHAOTIC)
-    idx = np.flatnonzero(chaotic)[:members]
+    ts = tso.time_series(system, tp, td, orbits=CIRCULATION_ORBITS,
+                         samples_per_orbit=SAMPLES_PER_ORBIT, rtol=RTOL)
+    t = ts.t / system.orbital_period
+    turning = np.array([np.isnan(capture_time(t[k], ts.alpha[k], 0.0)) or
+                        capture_time(t[k], ts.alpha[k], 0.0) > 0 for k in range(n)])
+    keep = chaotic & turning & usable(ts.status)
+    idx = np.flatnonzero(keep)[:members]
     if idx.size < members:
-        raise RuntimeError(f"{system.name}: only {idx.size} of {n} candidate starts are chaotic")
-    return tp[idx], td[idx], sec.megno[idx], float(chaotic.mean())
+        raise RuntimeError(f"{system.name}: only {idx.size} of {n} candidate starts are chaotic "
+                           "and circulating")
+    shares = (float(chaotic.mean()), float((chaotic & ~turning).sum() / max(1, chaotic.sum())))
+    return tp[idx], td[idx], sec.megno[idx], shares
 
 
 def main():
@@ -206,14 +242,15 @@ def main():
     setup = QUICK if quick else FULL
     members, orbits, tau1 = setup["members"], setup["orbits"], setup["tau"]
     rng = np.random.default_rng(SEED)
-    variants = [("chaotic", "nominal", 1.0, False), ("chaotic, 2S", "nominal", 2.0, False),
+    variants = [("chaotic", "nominal", 1.0, False), ("chaotic, S/2", "nominal", 0.5, False),
                 ("chaotic + YORP", "nominal", 1.0, True), ("regular", "round", 1.0, False),
-                ("regular, 2S", "round", 2.0, False), ("regular + YORP", "round", 1.0, True)]
-    colors = {"chaotic": "tab:blue", "chaotic, 2S": "tab:cyan", "chaotic + YORP": "tab:purple",
-              "regular": "tab:red", "regular, 2S": "tab:orange", "regular + YORP": "tab:brown"}
+                ("regular, S/2", "round", 0.5, False), ("regular + YORP", "round", 1.0, True)]
+    colors = {"chaotic": "tab:blue", "chaotic, S/2": "tab:cyan", "chaotic + YORP": "tab:purple",
+              "regular": "tab:red", "regular, S/2": "tab:orange", "regular + YORP": "tab:brown"}
     fig, axes = plt.subplots(2, 3, figsize=(15, 8.2))
     numbers, arrays, parameters = {}, {}, {"members": members, "orbits": orbits,
-                                           "tau_orbits": [tau1, tau1 / 2], "rtol": RTOL,
+                                           "tau_orbits": [tau1, 2 * tau1],
+                                           "circulation_orbits": CIRCULATION_ORBITS, "rtol": RTOL,
                                            "time_lag_s": TIME_LAG, "bands": BANDS,
                                            "screen_orbits": 60 if quick else SCREEN_ORBITS,
                                            "megno_chaotic": MEGNO_CHAOTIC,
@@ -225,7 +262,8 @@ def main():
         nominal = tso.catalog.system(name)
         shapes = {"nominal": nominal, "round": tso.catalog.system(name, elongation=1.01)}
         S = strength_for(nominal, tau1)
-        tp, td, megno, share = chaotic_starts(nominal, BANDS[name], members, rng, quick)
+        tp, td, megno, (share, librating) = chaotic_starts(nominal, BANDS[name], members, rng,
+                                                           quick)
         key = name.replace(" ", "")
         arrays.update({f"{key}_theta_p": tp, f"{key}_thetadot_p": td, f"{key}_megno0": megno})
         a, b, _ = nominal.secondary.semi_axes
@@ -234,7 +272,13 @@ def main():
                  .torque(nominal) / C) / (despin_rate(nominal, S) * nominal.mean_motion)
         numbers[f"{name} strength S (tau = {tau1:g} orbits)"] = float(S)
         numbers[f"{name} chaotic share of candidates"] = share
+        numbers[f"{name} share of chaotic candidates not circulating (dropped)"] = librating
         numbers[f"{name} YORP/tide at equal strength (|thetadot - n| / n where equal)"] = float(equal)
+        ps, w, t_dec = decoupled_despin(shapes["round"], nominal, tau1, td)
+        numbers[f"{name} pseudo-synchronous spin N/Omega"] = float(ps)
+        numbers[f"{name} a/b = 1.01 synchronous half-width"] = w
+        numbers[f"{name} regular: decoupled estimate, median time to the island (orbits)"] = \
+            float(np.median(t_dec))
         results, boots = {}, {}
         ax_spin, ax_cdf = axes[0, col], axes[1, col]
         for label, shape, factor, yorp in variants:
@@ -243,11 +287,11 @@ def main():
             if yorp:
                 perts.append(tso.YORP(body="secondary", coefficient=YORP_COEFFICIENT,
                                       strength=yorp_strength(nominal, factor * S)))
-            res = run_ensemble(system, tp, td, perts, orbits)
+            run = int(round(orbits / factor))           # every run lasts 40 of its own τ
+            res = run_ensemble(system, tp, td, perts, run)
             results[label] = res
             tau = tau1 / factor
-            window = max(20.0, WINDOW_FRACTION * orbits)
-            q = quantiles(res["tc"], res["usable"], orbits - window)
+            q = quantiles(res["tc"], res["usable"])
             boots[label] = bootstrap_median(res["tc"], res["usable"], rng)
             lo, hi = interval(boots[label])
             frac = float(np.mean(np.isfinite(res["tc"][res["usable"]])))
@@ -262,11 +306,11 @@ def main():
             parameters["perturbations"][tag] = res["perturbations"]
             for k in ("tc", "usable", "final_spin", "dr"):
                 arrays[f"{key}_{label.replace(' ', '').replace(',', '_').replace('+', '_')}_{k}"] = res[k]
-            # cumulative captured fraction against t / τ (the weak-tide regime collapses 1 and 2S)
+            # cumulative captured fraction against t / τ (the weak-tide regime collapses S, S/2)
             ok = res["usable"]
             tcs = np.sort(res["tc"][ok][np.isfinite(res["tc"][ok])]) / tau
             y = np.arange(1, tcs.size + 1) / max(1, ok.sum())
-            ax_cdf.step(np.r_[0.0, tcs, orbits / tau], np.r_[0.0, y, y[-1] if y.size else 0.0],
+            ax_cdf.step(np.r_[0.0, tcs, run / tau], np.r_[0.0, y, y[-1] if y.size else 0.0],
                         where="post", color=colors[label],
                         ls="--" if label.startswith("regular") else "-",
                         label=f"{label} (median {_fmt_med(q[1], tau)})")
@@ -278,12 +322,12 @@ def main():
                              ls="-" if label == "chaotic" else "--",
                              label=f"{label} (a/b = {_ab(shapes['nominal' if label == 'chaotic' else 'round']):.2f})"
                              if k == 0 else None)
-        for base in ("", ", 2S", " + YORP"):
+        for base in ("", ", S/2", " + YORP"):
             c, r = boots["chaotic" + base], boots["regular" + base]
             with np.errstate(invalid="ignore", divide="ignore"):
                 ratio = c / r
-            med_c = quantiles(results["chaotic" + base]["tc"], results["chaotic" + base]["usable"], 0)[1]
-            med_r = quantiles(results["regular" + base]["tc"], results["regular" + base]["usable"], 0)[1]
+            med_c = quantiles(results["chaotic" + base]["tc"], results["chaotic" + base]["usable"])[1]
+            med_r = quantiles(results["regular" + base]["tc"], results["regular" + base]["usable"])[1]
             ratio = ratio[~np.isnan(ratio)]             # inf/inf: neither captured
             lo, hi = interval(ratio) if ratio.size else (np.nan, np.nan)
             with np.errstate(invalid="ignore"):     # inf/inf: neither captured, undetermined
