@@ -74,6 +74,9 @@ YORP_OFFSET = 0.1         # YORP's spin acceleration = the tide's at |θ̇ − n
 FULL = {"members": 48, "tau": 50.0, "orbits": 2000}
 QUICK = {"members": 6, "tau": 20.0, "orbits": 150}
 SCREEN_ORBITS = 150
+#: Systems also run at S/4 (160 τ orbits): where the regular reference synchronises, to follow
+#: the delay factor towards weak tides.
+QUARTER = ("1991 VH",)
 CIRCULATION_ORBITS = 20   # a kept start's long axis turns past the primary within this
 MEGNO_CHAOTIC = 4.0
 WINDOW_FRACTION = 0.05
@@ -245,8 +248,9 @@ def main():
     variants = [("chaotic", "nominal", 1.0, False), ("chaotic, S/2", "nominal", 0.5, False),
                 ("chaotic + YORP", "nominal", 1.0, True), ("regular", "round", 1.0, False),
                 ("regular, S/2", "round", 0.5, False), ("regular + YORP", "round", 1.0, True)]
-    colors = {"chaotic": "tab:blue", "chaotic, S/2": "tab:cyan", "chaotic + YORP": "tab:purple",
-              "regular": "tab:red", "regular, S/2": "tab:orange", "regular + YORP": "tab:brown"}
+    colors = {"chaotic": "tab:blue", "chaotic, S/2": "tab:cyan", "chaotic, S/4": "tab:green",
+              "chaotic + YORP": "tab:purple", "regular": "tab:red", "regular, S/2": "tab:orange",
+              "regular, S/4": "tab:olive", "regular + YORP": "tab:brown"}
     fig, axes = plt.subplots(2, 3, figsize=(15, 8.2))
     numbers, arrays, parameters = {}, {}, {"members": members, "orbits": orbits,
                                            "tau_orbits": [tau1, 2 * tau1],
@@ -281,7 +285,8 @@ def main():
             float(np.median(t_dec))
         results, boots = {}, {}
         ax_spin, ax_cdf = axes[0, col], axes[1, col]
-        for label, shape, factor, yorp in variants:
+        weakest = [("chaotic, S/4", "nominal", 0.25, False), ("regular, S/4", "round", 0.25, False)]
+        for label, shape, factor, yorp in variants + (weakest if name in QUARTER else []):
             system = shapes[shape]
             perts = [tso.Tides(body="secondary", time_lag=TIME_LAG, strength=factor * S)]
             if yorp:
@@ -301,6 +306,7 @@ def main():
             numbers[f"{tag}: t_c quartiles (orbits)"] = [float(v) for v in q]
             numbers[f"{tag}: median 68% interval (orbits)"] = [float(lo), float(hi)]
             numbers[f"{tag}: median t_c / tau"] = float(q[1] / tau)
+            numbers[f"{tag}: median t_c x strength (orbits)"] = float(q[1] * factor * S)
             numbers[f"{tag}: final spin median"] = float(np.median(res["final_spin"]))
             numbers[f"{tag}: orbit-averaged distance change median"] = float(np.median(res["dr"]))
             parameters["perturbations"][tag] = res["perturbations"]
@@ -316,13 +322,13 @@ def main():
                         label=f"{label} (median {_fmt_med(q[1], tau)})")
         for label in ("chaotic", "regular"):      # a few spin histories at strength S
             hist = results[label]["spin_history"]
-            for k in range(min(3, len(hist))):
+            for k in range(min(2, len(hist))):
                 t = (np.arange(hist[k].size) + 0.5) / tau1
-                ax_spin.plot(t, hist[k], lw=0.6, color=colors[label],
+                ax_spin.plot(t, hist[k], lw=0.5, alpha=0.85, color=colors[label],
                              ls="-" if label == "chaotic" else "--",
                              label=f"{label} (a/b = {_ab(shapes['nominal' if label == 'chaotic' else 'round']):.2f})"
                              if k == 0 else None)
-        for base in ("", ", S/2", " + YORP"):
+        for base in ("", ", S/2", " + YORP") + ((", S/4",) if name in QUARTER else ()):
             c, r = boots["chaotic" + base], boots["regular" + base]
             with np.errstate(invalid="ignore", divide="ignore"):
                 ratio = c / r
@@ -334,6 +340,10 @@ def main():
                 factor = float(med_c / med_r)
             numbers[f"{name} delay factor chaotic/regular{base} (median ratio, 68%)"] = [
                 factor, float(lo), float(hi)]
+        ax_spin.axhline(ps, color="0.3", ls=":", lw=0.8,
+                        label=rf"pseudo-synchronous $N/\Omega$ = {ps:.3f}")
+        ax_spin.axhline(1.0 + w, color="tab:red", ls="-.", lw=0.6,
+                        label=f"top of the a/b = 1.01 synchronous island, {1 + w:.3f}")
         tc = results["chaotic"]["tc"]
         late = np.nanquantile(tc, 0.75) / tau1 if np.isfinite(tc).any() else orbits / tau1
         ax_spin.set_xlim(0, min(orbits / tau1, max(4.0, 1.5 * late)))
@@ -341,7 +351,7 @@ def main():
         ax_spin.set_ylabel(r"orbit-averaged $\dot\theta/n$")
         ax_spin.set_title(rf"{name}: $\tau$ = {tau1:g} orbits, S = {S:.3g}, e = {nominal.e:g}",
                           fontsize=8)
-        ax_spin.legend(fontsize=6, loc="upper right")
+        ax_spin.legend(fontsize=6, loc="upper right", framealpha=0.9)
         ax_cdf.set_xscale("log")
         ax_cdf.set_xlim(0.05, orbits / tau1 * 2)
         ax_cdf.set_ylim(0, 1.02)
