@@ -76,14 +76,14 @@ QUICK = {"members": 6, "tau": 20.0, "orbits": 150}
 SCREEN_ORBITS = 150
 #: Systems also run at S/4 (160 τ orbits): where the regular reference synchronises, to follow
 #: the delay factor towards weak tides.
-QUARTER = ("1991 VH",)
+QUARTER = ("1991 VH", "2003 YT1")
 CIRCULATION_ORBITS = 20   # a kept start's long axis turns past the primary within this
 MEGNO_CHAOTIC = 4.0
 WINDOW_FRACTION = 0.05
 SAMPLES_PER_ORBIT = 16    # unwraps 2α while |θ̇ − ḟ| < 4 n
 RTOL = 1e-10
 BOOTSTRAP = 2000
-BATCH = 8                 # members per time_series call: bounds the sample memory
+BATCH_SAMPLES = 262144    # samples per time_series call (members x samples): bounds memory
 SEED = 14
 
 
@@ -167,8 +167,9 @@ def run_ensemble(system, theta_p, thetadot_p, perturbations, orbits):
     spo, P = SAMPLES_PER_ORBIT, system.orbital_period
     out = {k: [] for k in ("tc", "usable", "final_spin", "dr", "spin_history")}
     seconds, described = 0.0, None
-    for lo in range(0, len(theta_p), BATCH):
-        sl = slice(lo, lo + BATCH)
+    batch = max(1, BATCH_SAMPLES // (orbits * spo))
+    for lo in range(0, len(theta_p), batch):
+        sl = slice(lo, lo + batch)
         ts = tso.time_series(system, theta_p[sl], thetadot_p[sl], orbits=orbits,
                              samples_per_orbit=spo, rtol=RTOL, perturbations=perturbations)
         seconds += ts.seconds
@@ -244,14 +245,13 @@ def main():
     quick = args.quick
     setup = QUICK if quick else FULL
     members, orbits, tau1 = setup["members"], setup["orbits"], setup["tau"]
-    rng = np.random.default_rng(SEED)
     variants = [("chaotic", "nominal", 1.0, False), ("chaotic, S/2", "nominal", 0.5, False),
                 ("chaotic + YORP", "nominal", 1.0, True), ("regular", "round", 1.0, False),
                 ("regular, S/2", "round", 0.5, False), ("regular + YORP", "round", 1.0, True)]
     colors = {"chaotic": "tab:blue", "chaotic, S/2": "tab:cyan", "chaotic, S/4": "tab:green",
               "chaotic + YORP": "tab:purple", "regular": "tab:red", "regular, S/2": "tab:orange",
               "regular, S/4": "tab:olive", "regular + YORP": "tab:brown"}
-    fig, axes = plt.subplots(2, 3, figsize=(15, 8.2))
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
     numbers, arrays, parameters = {}, {}, {"members": members, "orbits": orbits,
                                            "tau_orbits": [tau1, 2 * tau1],
                                            "circulation_orbits": CIRCULATION_ORBITS, "rtol": RTOL,
@@ -266,6 +266,7 @@ def main():
         nominal = tso.catalog.system(name)
         shapes = {"nominal": nominal, "round": tso.catalog.system(name, elongation=1.01)}
         S = strength_for(nominal, tau1)
+        rng = np.random.default_rng([SEED, col])   # per system: starts independent of variants
         tp, td, megno, (share, librating) = chaotic_starts(nominal, BANDS[name], members, rng,
                                                            quick)
         key = name.replace(" ", "")
@@ -351,7 +352,7 @@ def main():
         ax_spin.set_ylabel(r"orbit-averaged $\dot\theta/n$")
         ax_spin.set_title(rf"{name}: $\tau$ = {tau1:g} orbits, S = {S:.3g}, e = {nominal.e:g}",
                           fontsize=8)
-        ax_spin.legend(fontsize=6, loc="upper right", framealpha=0.9)
+        ax_spin.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
         ax_cdf.set_xscale("log")
         ax_cdf.set_xlim(0.05, orbits / tau1 * 2)
         ax_cdf.set_ylim(0, 1.02)
