@@ -92,6 +92,7 @@ RTOL = 1e-10
 BOOTSTRAP = 2000
 BATCH_SAMPLES = 262144    # samples per time_series call (members x samples): bounds memory
 SEED = 14
+PLOT_MEAN = 5             # orbits averaged in the spin panels (the figure's size; t_c uses 1)
 
 
 def despin_rate(system, strength=1.0):
@@ -258,7 +259,7 @@ def main():
     colors = {"chaotic": "tab:blue", "chaotic, S/2": "tab:cyan", "chaotic, S/4": "tab:green",
               "chaotic + YORP": "tab:purple", "regular": "tab:red", "regular, S/2": "tab:orange",
               "regular, S/4": "tab:olive", "regular + YORP": "tab:brown"}
-    fig, axes = plt.subplots(2, 3, figsize=(15, 9.6))
+    fig, axes = plt.subplots(2, 3, figsize=(13.5, 8.8))
     numbers, arrays, parameters = {}, {}, {"members": members, "orbits": orbits,
                                            "tau_orbits": [tau1, 2 * tau1],
                                            "circulation_orbits": CIRCULATION_ORBITS, "rtol": RTOL,
@@ -331,8 +332,9 @@ def main():
         for label in ("chaotic", "regular"):      # a few spin histories at strength S
             hist = results[label]["spin_history"]
             for k in range(min(2, len(hist))):
-                t = (np.arange(hist[k].size) + 0.5) / tau1
-                ax_spin.plot(t, hist[k], lw=0.5, alpha=0.85, color=colors[label],
+                smooth = np.convolve(hist[k], np.ones(PLOT_MEAN) / PLOT_MEAN, mode="valid")
+                t = (np.arange(smooth.size) + 0.5 * PLOT_MEAN) / tau1
+                ax_spin.plot(t, smooth, lw=0.5, color=colors[label],
                              ls="-" if label == "chaotic" else "--",
                              label=f"{label} (a/b = {_ab(shapes['nominal' if label == 'chaotic' else 'round']):.2f})"
                              if k == 0 else None)
@@ -356,7 +358,7 @@ def main():
         late = np.nanquantile(tc, 0.75) / tau1 if np.isfinite(tc).any() else orbits / tau1
         ax_spin.set_xlim(0, min(orbits / tau1, max(4.0, 1.5 * late)))
         ax_spin.set_xlabel(r"$t/\tau$")
-        ax_spin.set_ylabel(r"orbit-averaged $\dot\theta/n$")
+        ax_spin.set_ylabel(rf"$\dot\theta/n$, {PLOT_MEAN}-orbit mean")
         ax_spin.set_title(rf"{name}: $\tau$ = {tau1:g} orbits, S = {S:.3g}, e = {nominal.e:g}",
                           fontsize=8)
         ax_spin.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
