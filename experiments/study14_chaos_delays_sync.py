@@ -286,7 +286,8 @@ def main():
         numbers[f"{name} strength S (tau = {tau1:g} orbits)"] = float(S)
         numbers[f"{name} chaotic share of candidates"] = share
         numbers[f"{name} share of chaotic candidates not circulating (dropped)"] = librating
-        numbers[f"{name} YORP/tide at equal strength (|thetadot - n| / n where equal)"] = float(equal)
+        numbers[f"{name} YORP/tide at equal strength (|thetadot - n| / n where equal)"] = \
+            float(equal)
         ps, w, t_dec = decoupled_despin(shapes["round"], nominal, tau1, td)
         numbers[f"{name} pseudo-synchronous spin N/Omega"] = float(ps)
         numbers[f"{name} a/b = 1.01 synchronous half-width"] = w
@@ -319,8 +320,9 @@ def main():
             numbers[f"{tag}: final spin median"] = float(np.median(res["final_spin"]))
             numbers[f"{tag}: orbit-averaged distance change median"] = float(np.median(res["dr"]))
             parameters["perturbations"][tag] = res["perturbations"]
+            slug = label.replace(" ", "").replace(",", "_").replace("+", "_")
             for k in ("tc", "usable", "final_spin", "dr"):
-                arrays[f"{key}_{label.replace(' ', '').replace(',', '_').replace('+', '_')}_{k}"] = res[k]
+                arrays[f"{key}_{slug}_{k}"] = res[k]
             # cumulative captured fraction against t / τ (the weak-tide regime collapses S, S/2)
             ok = res["usable"]
             tcs = np.sort(res["tc"][ok][np.isfinite(res["tc"][ok])]) / tau
@@ -329,21 +331,22 @@ def main():
                         where="post", color=colors[label],
                         ls="--" if label.startswith("regular") else "-",
                         label=f"{label} (median {_fmt_med(q[1], tau)})")
-        for label in ("chaotic", "regular"):      # a few spin histories at strength S
+        for label, shape in (("chaotic", "nominal"), ("regular", "round")):   # at strength S
             hist = results[label]["spin_history"]
             for k in range(min(2, len(hist))):
                 smooth = np.convolve(hist[k], np.ones(PLOT_MEAN) / PLOT_MEAN, mode="valid")
                 t = (np.arange(smooth.size) + 0.5 * PLOT_MEAN) / tau1
                 ax_spin.plot(t, smooth, lw=0.5, color=colors[label],
                              ls="-" if label == "chaotic" else "--",
-                             label=f"{label} (a/b = {_ab(shapes['nominal' if label == 'chaotic' else 'round']):.2f})"
+                             label=f"{label} (a/b = {_ab(shapes[shape]):.2f})"
                              if k == 0 else None)
         for base in ("", ", S/2", " + YORP") + ((", S/4",) if name in QUARTER else ()):
             c, r = boots["chaotic" + base], boots["regular" + base]
             with np.errstate(invalid="ignore", divide="ignore"):
                 ratio = c / r
-            med_c = quantiles(results["chaotic" + base]["tc"], results["chaotic" + base]["usable"])[1]
-            med_r = quantiles(results["regular" + base]["tc"], results["regular" + base]["usable"])[1]
+            chaotic, regular = results["chaotic" + base], results["regular" + base]
+            med_c = quantiles(chaotic["tc"], chaotic["usable"])[1]
+            med_r = quantiles(regular["tc"], regular["usable"])[1]
             ratio = ratio[~np.isnan(ratio)]             # inf/inf: neither captured
             lo, hi = interval(ratio) if ratio.size else (np.nan, np.nan)
             with np.errstate(invalid="ignore"):     # inf/inf: neither captured, undetermined
@@ -383,7 +386,7 @@ def _ab(system):
 
 
 def _fmt_med(value, tau):
-    return f"> run" if not np.isfinite(value) else rf"{value / tau:.2f}$\tau$"
+    return "> run" if not np.isfinite(value) else rf"{value / tau:.2f}$\tau$"
 
 
 if __name__ == "__main__":
