@@ -32,6 +32,7 @@ PAPER = {
     "study11": "§7",              # robustness to the secondary's c (text)
     "study12": "§7.1–7.3",        # 2:1 capture, 2003 YT1 libration, no 2004 DC island (text)
     "study13": "§3",              # energy and angular-momentum drift per year (text)
+    "study14": "§8",              # does chaos delay synchronisation? tides in the equations
 }
 
 
