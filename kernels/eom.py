@@ -112,19 +112,12 @@ def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template
     S = get33(y, Y_S)
     om1, om2 = angular_velocities(p, i, y)
     q = NPAR
-    F = vec3(0.0, 0.0, 0.0)
-    N1 = vec3(0.0, 0.0, p[i, q + perturb.Q_YORP1])          # YORP about the primary's z
-    N2 = p[i, q + perturb.Q_YORP2] * vec3(S[0, 2], S[1, 2], S[2, 2])   # the secondary's z
-    if p[i, q + perturb.Q_TIDE1] != 0.0:
-        f1 = perturb.tide_force(p[i, q + perturb.Q_TIDE1], p[i, q + perturb.Q_TIDE1 + 1],
-                                p[i, q + perturb.Q_TIDE1 + 2], R, V, om1)
-        F += f1
-        N1 -= R.cross(f1)
-    if p[i, q + perturb.Q_TIDE2] != 0.0:
-        f2 = perturb.tide_force(p[i, q + perturb.Q_TIDE2], p[i, q + perturb.Q_TIDE2 + 1],
-                                p[i, q + perturb.Q_TIDE2 + 2], R, V, om2)
-        F += f2
-        N2 -= R.cross(f2)
+    f1 = perturb.tide_of(p, i, q + perturb.Q_TIDE1, R, V, om1)
+    f2 = perturb.tide_of(p, i, q + perturb.Q_TIDE2, R, V, om2)
+    F = f1 + f2
+    # YORP about each body's z axis; each body takes its own tide's torque
+    N1 = vec3(0.0, 0.0, p[i, q + perturb.Q_YORP1]) - R.cross(f1)
+    N2 = p[i, q + perturb.Q_YORP2] * vec3(S[0, 2], S[1, 2], S[2, 2]) - R.cross(f2)
     m = p[i, P_MRED]
     F += (m * p[i, q + perturb.Q_BYORP] / V.norm()) * V
     dy = state_perturbed(0.0)

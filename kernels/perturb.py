@@ -76,3 +76,24 @@ def tide_polar(kappa, dt, lag, r, vr, ell, omega):
     inv_r8 = inv_r * inv_r * inv_r * inv_r
     inv_r8 = inv_r8 * inv_r8
     return -kappa * inv_r8 * (r + 3.0 * d * vr), kappa * inv_r8 * d * r * (omega - theta_dot)
+
+
+@ti.func
+def tide_of(p: ti.template(), i, col: ti.template(), R, V, Om):
+    """The 3-D tidal force of the tide whose block columns start at ``col`` (κ, Δt, 1/2Q)
+    in member i's row; zero (and nothing evaluated) when κ = 0."""
+    F = ti.Vector([0.0, 0.0, 0.0], ti.f64)
+    if p[i, col] != 0.0:
+        F = tide_force(p[i, col], p[i, col + 1], p[i, col + 2], R, V, Om)
+    return F
+
+
+@ti.func
+def tide_polar_of(p: ti.template(), i, col: ti.template(), r, vr, ell, omega):
+    """:func:`tide_polar` of the tide whose block columns start at ``col``; (0, 0) when
+    κ = 0."""
+    fr = 0.0
+    ft = 0.0
+    if p[i, col] != 0.0:
+        fr, ft = tide_polar(p[i, col], p[i, col + 1], p[i, col + 2], r, vr, ell, omega)
+    return fr, ft

@@ -199,22 +199,12 @@ def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template
     ell = y[Y_L]
     om1 = pv[P_F1] * y[Y_W1]
     om2 = pv[P_F2] * y[Y_W2]
-    Fr = 0.0
-    Ft = 0.0
-    N1 = p[i, q + perturb.Q_YORP1]
-    N2 = p[i, q + perturb.Q_YORP2]
-    if p[i, q + perturb.Q_TIDE1] != 0.0:
-        fr, ft = perturb.tide_polar(p[i, q + perturb.Q_TIDE1], p[i, q + perturb.Q_TIDE1 + 1],
-                                    p[i, q + perturb.Q_TIDE1 + 2], r, vr, ell, om1)
-        Fr += fr
-        Ft += ft
-        N1 -= r * ft
-    if p[i, q + perturb.Q_TIDE2] != 0.0:
-        fr, ft = perturb.tide_polar(p[i, q + perturb.Q_TIDE2], p[i, q + perturb.Q_TIDE2 + 1],
-                                    p[i, q + perturb.Q_TIDE2 + 2], r, vr, ell, om2)
-        Fr += fr
-        Ft += ft
-        N2 -= r * ft
+    fr1, ft1 = perturb.tide_polar_of(p, i, q + perturb.Q_TIDE1, r, vr, ell, om1)
+    fr2, ft2 = perturb.tide_polar_of(p, i, q + perturb.Q_TIDE2, r, vr, ell, om2)
+    Fr = fr1 + fr2
+    Ft = ft1 + ft2
+    N1 = p[i, q + perturb.Q_YORP1] - r * ft1        # each body takes its own tide's torque
+    N2 = p[i, q + perturb.Q_YORP2] - r * ft2
     vt = ell / r
     speed = ti.sqrt(vr * vr + vt * vt)
     fb = p[i, q + perturb.Q_BYORP] / (pv[P_INV_M] * speed)   # m a_B / |V|

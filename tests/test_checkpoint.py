@@ -26,9 +26,11 @@ def assert_same_section(a, b):
             np.testing.assert_array_equal(x, y, err_msg=f.name)
 
 
-def killed_run(tmp_path, ckpt, kill_after, kind="section", extra=""):
+def killed_run(tmp_path, ckpt, kill_after, kind="section", extra="", starts=STARTS, args=ARGS):
     """Run in a subprocess that SIGKILLs itself from the progress callback after
-    ``kill_after`` windows (the checkpoint of that window is already written)."""
+    ``kill_after`` windows (the checkpoint of that window is already written): a section or
+    (``kind`` "series") a time series of 1991 VH from ``starts`` with ``args``, and the
+    keyword text ``extra``."""
     script = textwrap.dedent(f"""
         import os, signal
         import ti_spinorbit as tso
@@ -39,8 +41,8 @@ def killed_run(tmp_path, ckpt, kill_after, kind="section", extra=""):
                 os.kill(os.getpid(), signal.SIGKILL)
         vh = tso.catalog.system("1991 VH")
         tso.{"surface_of_section" if kind == "section" else "time_series"}(
-            vh, 0.0, {STARTS!r}, progress=progress, checkpoint={str(ckpt)!r}, {extra}
-            **{ARGS!r})
+            vh, 0.0, {list(starts)!r}, progress=progress, checkpoint={str(ckpt)!r}, {extra}
+            **{dict(args)!r})
         raise SystemExit("not killed")
     """)
     p = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,

@@ -4,9 +4,6 @@ path. Tiny runs: a few members, a few orbits, tolerances where the drift limits 
 
 import dataclasses
 import json
-import subprocess
-import sys
-import textwrap
 import warnings
 
 import numpy as np
@@ -14,6 +11,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import perturbations as tsp
+from test_checkpoint import killed_run   # the same kill-and-resume harness
 
 #: A tide 1e6 times its real strength and YORP 1e6 times on the secondary of 1991 VH, BYORP:
 #: effects visible in a few orbits (1991 VH's heliocentric orbit is catalogued).
@@ -200,33 +198,13 @@ def test_warmup_compiles_the_perturbed_variant():
 
 # ---- checkpoints -------------------------------------------------------------------------
 
-def _killed_run(tmp_path, ckpt, kill_after):
-    """A perturbed time series in a subprocess that SIGKILLs itself after ``kill_after``
-    windows (as tests/test_checkpoint.py)."""
-    script = textwrap.dedent(f"""
-        import os, signal
-        import ti_spinorbit as tso
-        calls = [0]
-        def progress(fraction):
-            calls[0] += 1
-            if calls[0] == {kill_after}:
-                os.kill(os.getpid(), signal.SIGKILL)
-        tso.time_series("1991 VH", 0.0, {STARTS!r}, orbits=12, rtol=1e-10, window_orbits=4,
-                        samples_per_orbit=8, progress=progress, checkpoint={str(ckpt)!r},
-                        perturbations=[tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6),
-                                       tso.BYORP(coefficient=1e-3, strength=1e6)])
-        raise SystemExit("not killed")
-    """)
-    p = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True,
-                       text=True, timeout=600)
-    assert p.returncode == -9, p.stderr
-
-
 def test_resumed_perturbed_run_equals_an_uninterrupted_one(tmp_path, vh):
     ckpt = tmp_path / "ts.ckpt"
-    _killed_run(tmp_path, ckpt, kill_after=2)
-    P = [TIDE, tso.BYORP(coefficient=1e-3, strength=1e6)]
-    kw = dict(orbits=12, rtol=1e-10, window_orbits=4, samples_per_orbit=8, perturbations=P)
+    kw = dict(orbits=12, rtol=1e-10, window_orbits=4, samples_per_orbit=8)
+    killed_run(tmp_path, ckpt, kill_after=2, kind="series", starts=STARTS, args=kw,
+               extra="perturbations=[tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6), "
+                     "tso.BYORP(coefficient=1e-3, strength=1e6)],")
+    kw["perturbations"] = [TIDE, tso.BYORP(coefficient=1e-3, strength=1e6)]
     resumed = tso.time_series(vh, 0.0, STARTS, checkpoint=ckpt, resume=True, **kw)
     whole = tso.time_series(vh, 0.0, STARTS, **kw)
     assert_same(resumed, whole)

@@ -64,8 +64,11 @@ def _check_body(body):
     return body
 
 
-def _check_strength(strength):
-    return require_positive_scalar("strength", strength, 1e-12, 1e15)
+def _check_radius_and_strength(p):
+    """The fields every perturbation has: an optional radius (m) and the strength factor."""
+    if p.radius is not None:
+        require_positive_scalar("radius", p.radius, 1e-3, 1e10, "m")
+    require_positive_scalar("strength", p.strength, 1e-12, 1e15)
 
 
 def body_radius(system, body, radius=None):
@@ -160,9 +163,7 @@ class Tides:
             require_positive_scalar("time_lag", self.time_lag, 1e-9, 1e9, "s")
         if self.Q is not None:
             require_positive_scalar("Q", self.Q, 1e-3, 1e12)
-        if self.radius is not None:
-            require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
-        _check_strength(self.strength)
+        _check_radius_and_strength(self)
 
     @classmethod
     def rubble_pile(cls, body="secondary", radius_m=None, system=None, **kw):
@@ -241,9 +242,7 @@ class YORP:
         _check_body(self.body)
         _check_signed("YORP coefficient (f_Y)", self.coefficient, 1.0)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
-        if self.radius is not None:
-            require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
-        _check_strength(self.strength)
+        _check_radius_and_strength(self)
 
     def torque(self, system):
         """T × strength, N m (signed)."""
@@ -299,9 +298,7 @@ class BYORP:
     def __post_init__(self):
         _check_signed("BYORP coefficient (B)", self.coefficient, 1.0)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
-        if self.radius is not None:
-            require_positive_scalar("radius", self.radius, 1e-3, 1e10, "m")
-        _check_strength(self.strength)
+        _check_radius_and_strength(self)
 
     def force(self, system):
         """F_B × strength, N (signed)."""
