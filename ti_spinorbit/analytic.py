@@ -36,14 +36,9 @@ import math
 import numpy as np
 
 from ._validate import require_count, require_finite, require_positive, require_range
+from .constants import AU, C_LIGHT, L_SUN  # noqa: F401  (public here since 0.1)
 from .systems import G
 
-#: Nominal solar luminosity, W (IAU 2015 Resolution B3).
-L_SUN = 3.828e26
-#: Speed of light, m/s.
-C_LIGHT = 299792458.0
-#: Astronomical unit, m (IAU 2012).
-AU = 1.495978707e11
 
 #: Chaotic-layer coefficient as quoted by Naidu & Margot 2015 from Wisdom, Peale & Mignard 1984.
 CHAOTIC_LAYER_COEFFICIENT_QUOTED = 14.0 * math.pi

@@ -30,6 +30,7 @@ from typing import Optional
 
 import numpy as np
 
+from .constants import AU, C_LIGHT, L_SUN
 from ._validate import require_positive_scalar, require_range, require_real, show
 
 #: Layout of the kernels' perturbation block (``kernels/perturb.py``; kept here so this
@@ -48,7 +49,6 @@ UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.perturbat
 
 
 def _solar():
-    from .analytic import AU, C_LIGHT, L_SUN
     return AU, C_LIGHT, L_SUN
 
 

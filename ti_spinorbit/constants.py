@@ -1,0 +1,10 @@
+"""Physical constants shared by the energy budgets (``analytic``) and the radiation forces
+(``perturbations``), SI units. Kept apart so that both can use them without importing each
+other."""
+
+#: Nominal solar luminosity, W (IAU 2015 Resolution B3).
+L_SUN = 3.828e26
+#: Speed of light, m/s (exact, SI).
+C_LIGHT = 299792458.0
+#: Astronomical unit, m (IAU 2012 Resolution B2).
+AU = 1.495978707e11
