@@ -36,7 +36,8 @@ import math
 import numpy as np
 
 from ._validate import require_count, require_finite, require_positive, require_range
-from .constants import AU, C_LIGHT, L_SUN  # noqa: F401  (public here since 0.1)
+from .constants import (AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q,  # noqa: F401  (public here)
+                        L_SUN)
 from .systems import G
 
 
@@ -46,10 +47,6 @@ CHAOTIC_LAYER_COEFFICIENT_QUOTED = 14.0 * math.pi
 #: (docs/physics.md §8.6).
 CHAOTIC_LAYER_COEFFICIENT_MELNIKOV = 28.0 * math.pi
 
-#: Default tidal quality factor (docs/physics.md §9.4).
-DEFAULT_Q = 100.0
-#: Default YORP efficiency f_Y (docs/physics.md §9.4).
-DEFAULT_F_YORP = 5e-4
 
 #: Rubble-pile Love numbers k2(R_s) with R_s in km.
 K2_MODELS = {

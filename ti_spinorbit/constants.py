@@ -1,6 +1,6 @@
-"""Physical constants shared by the energy budgets (``analytic``) and the radiation forces
-(``perturbations``), SI units. Kept apart so that both can use them without importing each
-other."""
+"""Physical constants and the paper's default dissipation parameters, shared by the energy
+budgets (``analytic``) and the forces in the equations (``perturbations``), SI units. Kept
+apart so that both can use them without importing each other."""
 
 #: Nominal solar luminosity, W (IAU 2015 Resolution B3).
 L_SUN = 3.828e26
@@ -8,3 +8,8 @@ L_SUN = 3.828e26
 C_LIGHT = 299792458.0
 #: Astronomical unit, m (IAU 2012 Resolution B2).
 AU = 1.495978707e11
+
+#: Default tidal quality factor (Naidu & Margot 2015; docs/physics.md §9.4).
+DEFAULT_Q = 100.0
+#: Default YORP efficiency f_Y (Naidu & Margot 2015; docs/physics.md §9.4).
+DEFAULT_F_YORP = 5e-4

@@ -30,7 +30,7 @@ from typing import Optional
 
 import numpy as np
 
-from .constants import AU, C_LIGHT, L_SUN
+from .constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, L_SUN
 from ._validate import require_positive_scalar, require_range, require_real, show
 
 #: Layout of the kernels' perturbation block (``kernels/perturb.py``; kept here so this
@@ -199,7 +199,7 @@ class Tides:
         if self.time_lag is not None:
             out[col + 1] = self.time_lag / T
         else:
-            out[col + 2] = 0.5 / (self.Q if self.Q is not None else 100.0)
+            out[col + 2] = 0.5 / (self.Q if self.Q is not None else DEFAULT_Q)
         return out
 
     @property
@@ -230,7 +230,7 @@ class YORP:
     """
 
     body: str = "secondary"
-    coefficient: float = 5e-4
+    coefficient: float = DEFAULT_F_YORP
     heliocentric_a_au: Optional[float] = None
     heliocentric_e: Optional[float] = None
     radius: Optional[float] = None
