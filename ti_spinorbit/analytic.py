@@ -37,7 +37,7 @@ import numpy as np
 
 from ._validate import require_count, require_finite, require_positive, require_range
 from .constants import (AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q,  # noqa: F401  (public here)
-                        L_SUN)
+                        K2_MODELS, L_SUN)
 from .systems import G
 
 
@@ -48,11 +48,6 @@ CHAOTIC_LAYER_COEFFICIENT_QUOTED = 14.0 * math.pi
 CHAOTIC_LAYER_COEFFICIENT_MELNIKOV = 28.0 * math.pi
 
 
-#: Rubble-pile Love numbers k2(R_s) with R_s in km.
-K2_MODELS = {
-    "goldreich-sari": lambda radius_km: 1e-5 * radius_km,         # Goldreich & Sari 2009
-    "jacobson-scheeres": lambda radius_km: 2.5e-5 / radius_km,    # Jacobson & Scheeres 2011
-}
 
 # Cayley series H(p, e) = Σ c_k e^k (docs/physics.md §8.3, re-derived with sympy),
 # keyed by 2p so that half-integer p are exact dictionary keys.
@@ -391,9 +386,8 @@ def yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e, f_yorp=DEFA
     require_positive("heliocentric_a_au", heliocentric_a_au)
     require_range("heliocentric_e", heliocentric_e, 0.0, 1.0)
     require_positive("f_yorp", f_yorp)
-    d = heliocentric_a_au * AU
-    return (2.0 * math.pi * R**3 * L_SUN * f_yorp
-            / (3.0 * C_LIGHT * d**2 * math.sqrt(1.0 - heliocentric_e**2)))
+    from .perturbations import yorp_torque
+    return 2.0 * math.pi * yorp_torque(f_yorp, R, heliocentric_a_au * AU, heliocentric_e)
 
 
 def energy_budget(system, heliocentric_a_au, heliocentric_e, Q=DEFAULT_Q, f_yorp=DEFAULT_F_YORP,

@@ -13,3 +13,9 @@ AU = 1.495978707e11
 DEFAULT_Q = 100.0
 #: Default YORP efficiency f_Y (Naidu & Margot 2015; docs/physics.md §9.4).
 DEFAULT_F_YORP = 5e-4
+
+#: Rubble-pile Love numbers k2(R) with R the body's radius in km.
+K2_MODELS = {
+    "goldreich-sari": lambda radius_km: 1e-5 * radius_km,         # Goldreich & Sari 2009
+    "jacobson-scheeres": lambda radius_km: 2.5e-5 / radius_km,    # Jacobson & Scheeres 2011
+}

@@ -30,7 +30,7 @@ from typing import Optional
 
 import numpy as np
 
-from .constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, L_SUN
+from .constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, K2_MODELS, L_SUN
 from ._validate import require_positive_scalar, require_range, require_real, show
 
 #: Layout of the kernels' perturbation block (``kernels/perturb.py``; kept here so this
@@ -41,21 +41,23 @@ NACC = 4
 #: Floor of the bulge's relative angular rate in the constant-Q lag, units of the system's n
 #: (``kernels/perturb.py``; the analytic rates use it too).
 Q_RATE_FLOOR = 1e-3
-#: Solar radiation constant F_⊙ = L_⊙ / (4π c), kg m s⁻² (≈ 1.0e17; Jacobson & Scheeres 2011
-#: round it to 1e14 kg km s⁻²).
 BODIES = ("primary", "secondary")
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
 UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.perturbations)"
 
 
-def _solar():
-    return AU, C_LIGHT, L_SUN
-
-
 def solar_radiation_constant():
-    """F_⊙ = L_⊙ / (4π c), kg m s⁻²: radiation pressure times distance², N m² / m²."""
-    _, c, L = _solar()
-    return L / (4.0 * math.pi * c)
+    """F_⊙ = L_⊙ / (4π c), kg m s⁻² (≈ 1.0e17; Jacobson & Scheeres 2011 round it to
+    1e14 kg km s⁻²): radiation pressure times distance², N m² / m²."""
+    return L_SUN / (4.0 * math.pi * C_LIGHT)
+
+
+def yorp_torque(f_yorp, radius, distance, e):
+    """The YORP torque of Naidu & Margot (2015), f_Y R³ L_⊙ / (3 c d² sqrt(1 − e_⊙²)), N m,
+    for a body of ``radius`` (m) on a heliocentric orbit of semimajor axis ``distance`` (m)
+    and eccentricity ``e`` (docs/physics.md §13.2; its work over one turn is the paper's
+    δE_YORP, ``analytic.yorp_energy_per_orbit``). Inputs unchecked: the callers check them."""
+    return f_yorp * radius ** 3 * L_SUN / (3.0 * C_LIGHT * distance ** 2 * math.sqrt(1.0 - e ** 2))
 
 
 def _check_body(body):
@@ -86,7 +88,6 @@ def body_radius(system, body, radius=None):
 
 def _heliocentric(system, a_au, e):
     """(d in m, e_⊙) of the binary's heliocentric orbit: given, or catalogued."""
-    AU, _, _ = _solar()
     if a_au is None:
         from .catalog import heliocentric_orbit
         try:
@@ -170,18 +171,20 @@ class Tides:
         """Tides with the Goldreich & Sari (2009) rubble-pile k2 = 1e-5 R[km] of the body's
         radius (``radius_m``, or that of ``body`` in ``system``)."""
         R = _constructor_radius("rubble_pile", body, radius_m, system)
-        return cls(body=body, k2=1e-5 * R / 1e3, radius=radius_m, **kw)
+        return cls(body=body, k2=K2_MODELS["goldreich-sari"](R / 1e3), radius=radius_m, **kw)
 
     @classmethod
     def jacobson_scheeres(cls, body="secondary", radius_m=None, system=None, **kw):
         """Tides with the Jacobson & Scheeres (2011) k2 = 2.5e-5 / R[km]."""
         R = _constructor_radius("jacobson_scheeres", body, radius_m, system)
-        return cls(body=body, k2=2.5e-5 / (R / 1e3), radius=radius_m, **kw)
+        return cls(body=body, k2=K2_MODELS["jacobson-scheeres"](R / 1e3), radius=radius_m,
+                   **kw)
 
     def love_number(self, system):
         """k2 used for ``system`` (the rubble-pile default when none was given)."""
-        return self.k2 if self.k2 is not None else 1e-5 * body_radius(system, self.body,
-                                                                        self.radius) / 1e3
+        if self.k2 is not None:
+            return self.k2
+        return K2_MODELS["goldreich-sari"](body_radius(system, self.body, self.radius) / 1e3)
 
     def coefficient(self, system):
         """κ = 3 k2 G M² R⁵ × strength, N m⁷ (force κ / r⁷ at zero lag), M the other body's
@@ -246,11 +249,9 @@ class YORP:
 
     def torque(self, system):
         """T × strength, N m (signed)."""
-        _, c, L = _solar()
         d, e = _heliocentric(system, self.heliocentric_a_au, self.heliocentric_e)
-        R = body_radius(system, self.body, self.radius)
-        return (self.coefficient * R ** 3 * L / (3.0 * c * d ** 2 * math.sqrt(1.0 - e ** 2))
-                * self.strength)
+        return yorp_torque(self.coefficient, body_radius(system, self.body, self.radius), d,
+                           e) * self.strength
 
     def block(self, system):
         M, L, T = _scales(system)
