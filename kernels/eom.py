@@ -80,6 +80,14 @@ def angular_velocities(p: ti.template(), i, y):
 @ti.func
 def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
     """dy/dt of the scaled state of member i (G = 1)."""
+    dy, om1, om2 = _rhs_and_rates(p, i, y, order, odd)
+    return dy
+
+
+@ti.func
+def _rhs_and_rates(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """dy/dt and the two angular velocities Ω1, Ω2 it used (primary frame), so that the
+    perturbed RHS does not compute them again."""
     R = get3(y, Y_R)
     V = get3(y, Y_V)
     w1 = get3(y, Y_W1)
@@ -99,18 +107,17 @@ def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
             dy[Y_S + 3 * r + c] = col[r]
     for r in ti.static(range(3)):  # rows of S1: d r/dt = r × Ω1
         put3(dy, Y_S1 + 3 * r, get3(y, Y_S1 + 3 * r).cross(om1))
-    return dy
+    return dy, om1, om2
 
 
 @ti.func
 def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
     """dy/dt with the tides, YORP and BYORP of member i's perturbation block (columns from
     NPAR, ``kernels/perturb.py``), and the accumulators' rates: work and external torque."""
-    base = rhs(p, i, y, order, odd)
+    base, om1, om2 = _rhs_and_rates(p, i, y, order, odd)
     R = get3(y, Y_R)
     V = get3(y, Y_V)
     S = get33(y, Y_S)
-    om1, om2 = angular_velocities(p, i, y)
     q = NPAR
     f1 = perturb.tide_of(p, i, q + perturb.Q_TIDE1, R, V, om1)
     f2 = perturb.tide_of(p, i, q + perturb.Q_TIDE2, R, V, om2)
