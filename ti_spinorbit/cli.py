@@ -47,6 +47,7 @@ import sys
 
 from ._validate import MAX_DENSITY, MAX_SPIN, MIN_DENSITY  # bounds shared with the library
 from .section import MAX_ORBITS  # orbits limit shared with the library
+from . import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
 
 #: Exit statuses (README "Statuses, exit codes and accuracy").
 EXIT_OK, EXIT_CHECK_FAILED, EXIT_ERROR, EXIT_INACCURATE, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
@@ -83,15 +84,15 @@ FLAG_RANGES = {
     "spin_xy": ("--spin-xy", -MAX_SPIN, MAX_SPIN, False, False),
     "inclination": ("--inclination", -360.0, 360.0, False, False),
     # tides, YORP, BYORP (the bounds of ti_spinorbit.perturbations)
-    "k2": ("--k2", 1e-12, 10.0, False, False),
-    "time_lag": ("--time-lag", 1e-9, 1e9, False, False),
-    "Q": ("--Q", 1e-3, 1e12, False, False),
-    "yorp": ("--yorp", -1.0, 1.0, False, False),
-    "byorp": ("--byorp", -1.0, 1.0, False, False),
-    "strength": ("--strength", 1e-12, 1e15, False, False),
+    "k2": ("--k2", *_pert.K2_RANGE, False, False),
+    "time_lag": ("--time-lag", *_pert.TIME_LAG_RANGE, False, False),
+    "Q": ("--Q", *_pert.Q_RANGE, False, False),
+    "yorp": ("--yorp", -_pert.COEFFICIENT_LIMIT, _pert.COEFFICIENT_LIMIT, False, False),
+    "byorp": ("--byorp", -_pert.COEFFICIENT_LIMIT, _pert.COEFFICIENT_LIMIT, False, False),
+    "strength": ("--strength", *_pert.STRENGTH_RANGE, False, False),
 }
 #: --heliocentric A_AU E: the binary's heliocentric orbit for --yorp / --byorp.
-HELIOCENTRIC_A_RANGE = (0.05, 1e4)
+HELIOCENTRIC_A_RANGE = _pert.HELIOCENTRIC_A_RANGE
 #: Figures and data files.
 FIGURE_EXTENSIONS = (".png", ".pdf", ".svg")
 #: Energy check: samples per primary rotation when --samples-per-orbit is not given (resolves
@@ -648,7 +649,7 @@ def perturbation_summary(items, system=None):
         if p.kind == "tides":
             k2 = p.k2 if p.k2 is not None or system is None else p.love_number(system)
             lag = f"time lag {p.time_lag:g} s" if p.time_lag is not None else \
-                f"Q {100.0 if p.Q is None else p.Q:g}"
+                f"Q {_pert.DEFAULT_Q if p.Q is None else p.Q:g}"
             rubble = " (rubble pile)" if p.k2 is None else ""
             parts.append(f"tide on the {p.body} (k2 {k2:.3g}{rubble}, {lag})")
         elif p.kind == "yorp":

@@ -42,6 +42,14 @@ NACC = 4
 #: (``kernels/perturb.py``; the analytic rates use it too).
 Q_RATE_FLOOR = 1e-3
 BODIES = ("primary", "secondary")
+#: Allowed ranges (closed), shared with the command line's flags.
+K2_RANGE = (1e-12, 10.0)
+TIME_LAG_RANGE = (1e-9, 1e9)          # s
+Q_RANGE = (1e-3, 1e12)
+RADIUS_RANGE = (1e-3, 1e10)           # m
+STRENGTH_RANGE = (1e-12, 1e15)
+COEFFICIENT_LIMIT = 1.0               # |f_Y|, |B|
+HELIOCENTRIC_A_RANGE = (0.05, 1e4)    # AU
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
 UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.perturbations)"
 
@@ -69,8 +77,8 @@ def _check_body(body):
 def _check_radius_and_strength(p):
     """The fields every perturbation has: an optional radius (m) and the strength factor."""
     if p.radius is not None:
-        require_positive_scalar("radius", p.radius, 1e-3, 1e10, "m")
-    require_positive_scalar("strength", p.strength, 1e-12, 1e15)
+        require_positive_scalar("radius", p.radius, *RADIUS_RANGE, "m")
+    require_positive_scalar("strength", p.strength, *STRENGTH_RANGE)
 
 
 def body_radius(system, body, radius=None):
@@ -111,7 +119,7 @@ def _constructor_radius(name, body, radius_m, system):
     in ``system``; one-line errors when neither is usable."""
     _check_body(body)
     if radius_m is not None:
-        return require_positive_scalar("radius_m", radius_m, 1e-3, 1e10, "m")
+        return require_positive_scalar("radius_m", radius_m, *RADIUS_RANGE, "m")
     if system is None:
         raise ValueError(f"Tides.{name} needs radius_m (m) or system= (a BinarySystem) for the "
                          f"{body}'s radius")
@@ -157,13 +165,13 @@ class Tides:
     def __post_init__(self):
         _check_body(self.body)
         if self.k2 is not None:
-            require_positive_scalar("k2", self.k2, 1e-12, 10.0)
+            require_positive_scalar("k2", self.k2, *K2_RANGE)
         if self.time_lag is not None and self.Q is not None:
             raise ValueError("give the tide a time_lag (s) or a Q, not both")
         if self.time_lag is not None:
-            require_positive_scalar("time_lag", self.time_lag, 1e-9, 1e9, "s")
+            require_positive_scalar("time_lag", self.time_lag, *TIME_LAG_RANGE, "s")
         if self.Q is not None:
-            require_positive_scalar("Q", self.Q, 1e-3, 1e12)
+            require_positive_scalar("Q", self.Q, *Q_RANGE)
         _check_radius_and_strength(self)
 
     @classmethod
@@ -243,7 +251,7 @@ class YORP:
 
     def __post_init__(self):
         _check_body(self.body)
-        _check_signed("YORP coefficient (f_Y)", self.coefficient, 1.0)
+        _check_signed("YORP coefficient (f_Y)", self.coefficient, COEFFICIENT_LIMIT)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         _check_radius_and_strength(self)
 
@@ -297,7 +305,7 @@ class BYORP:
     body = "secondary"
 
     def __post_init__(self):
-        _check_signed("BYORP coefficient (B)", self.coefficient, 1.0)
+        _check_signed("BYORP coefficient (B)", self.coefficient, COEFFICIENT_LIMIT)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         _check_radius_and_strength(self)
 
@@ -333,7 +341,7 @@ def _check_signed(name, value, limit):
 
 def _check_heliocentric(a_au, e):
     if a_au is not None:
-        require_positive_scalar("heliocentric_a_au", a_au, 0.05, 1e4, "AU")
+        require_positive_scalar("heliocentric_a_au", a_au, *HELIOCENTRIC_A_RANGE, "AU")
     if e is not None:
         require_real("heliocentric_e", e)
         require_range("heliocentric_e", e, 0.0, 1.0)
