@@ -698,9 +698,14 @@ def _padded_exchange(out: RunOutput, shape):
     the sample columns; None without perturbations."""
     if out.sample_exchange is None:
         return None
-    x = np.full(tuple(shape) + (4,), np.nan)
-    for k, rec in enumerate(out.sample_exchange):
-        x[k, :len(rec)] = rec
+    return _stack_padded(out.sample_exchange, shape[1], 4)
+
+
+def _stack_padded(arrays, width, columns):
+    """Per-member (count, columns) arrays stacked into (N, width, columns), NaN-padded."""
+    x = np.full((len(arrays), width, columns), np.nan)
+    for k, a in enumerate(arrays):
+        x[k, :len(a)] = a
     return x
 
 
@@ -719,11 +724,8 @@ def _sample_rows(members, samples, width):
     """State rows (SI, docs/physics.md §6.8) at every sample, (N, width, 30), NaN-padded."""
     from .initial import physical_rows
 
-    rows = np.full((len(members), width, 30), np.nan)
-    for k, (m, rec) in enumerate(zip(members, samples)):
-        if len(rec):
-            rows[k, :len(rec)] = physical_rows(m, rec[:, 1:])
-    return rows
+    return _stack_padded([physical_rows(m, rec[:, 1:]) if len(rec) else np.zeros((0, 30))
+                          for m, rec in zip(members, samples)], width, 30)
 
 
 def _sampled_drifts(cols, out: RunOutput, exchange=None):
