@@ -183,7 +183,6 @@ class Ensemble:
             self.prows = np.ascontiguousarray(perturbation_rows, dtype=np.float64)
             if self.prows.shape != (len(self.par), NPERT) or not np.all(np.isfinite(self.prows)):
                 raise ValueError(f"perturbation_rows must be a finite (N, {NPERT}) array")
-        self.perturbed = self.prows is not None
         self.kpar = self._kernel_parameters()
         self.y = self._kernel_state(self.y)
         n = len(self.par)
@@ -194,6 +193,11 @@ class Ensemble:
                                                 METHODS[self.method].error_exponent))
         self.status = np.zeros(n, dtype=np.int32)
         self.counters = np.zeros((n, 3), dtype=np.int64)
+
+    @property
+    def perturbed(self):
+        """Whether the members carry tides, YORP or BYORP (``perturbation_rows`` given)."""
+        return self.prows is not None
 
     @property
     def kernels(self):
