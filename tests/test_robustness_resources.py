@@ -236,7 +236,7 @@ def test_read_only_home_runs_and_exits_true(tmp_path):
                        capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr[-2000:]
     notices = [line for line in p.stderr.splitlines() if "kernel cache folder" in line]
-    assert notices == [f"ti_spinorbit: kernel cache folder {blocker}/cache/taichi/ti_spinorbit-1 "
+    assert notices == [f"ti_spinorbit: kernel cache folder {blocker}/cache/taichi/ti_spinorbit-2 "
                        f"is not writable (Not a directory); compiling without a disk cache "
                        f"(set TI_OFFLINE_CACHE_FILE_PATH to a writable folder)"], p.stderr
     assert (tmp_path / "e.npz").exists()
@@ -265,7 +265,7 @@ def test_cache_folder_from_platformdirs_and_the_variable(monkeypatch, tmp_path):
     monkeypatch.delenv(runtime.CACHE_ENV, raising=False)
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     if sys.platform.startswith("linux"):
-        assert runtime.cache_folder() == str(tmp_path / "xdg" / "taichi" / "ti_spinorbit-1")
+        assert runtime.cache_folder() == str(tmp_path / "xdg" / "taichi" / "ti_spinorbit-2")
     monkeypatch.setenv(runtime.CACHE_ENV, str(tmp_path / "mine"))
     assert runtime.cache_folder() == str(tmp_path / "mine")
 

@@ -43,11 +43,12 @@ import numpy as np
 _LOG = logging.getLogger("ti_spinorbit")
 
 #: Seconds a cold compile of a variant takes when nothing was measured on this machine yet
-#: (2-core CPU, Taichi 1.7.4, issue 13: planar ≈ 8 s, 3-D ≈ 50 s quiet, 110-136 s loaded);
-#: the shadow trajectory (indicators) and dense sampling add code, about +50 % and +20 %.
-DEFAULT_COMPILE_SECONDS = {"planar": 10.0, "3d": 60.0}
-INDICATORS_FACTOR = 1.5
-SAMPLING_FACTOR = 1.2
+#: (2-core CPU, Taichi 1.7.4 without its CFG pass, runtime.py: planar 0.6-1.6 s, 3-D
+#: 1.9-3.1 s); the shadow trajectory (indicators) adds about +40 %, dense sampling little.
+#: Estimates under ANNOUNCE_MIN_S are not announced.
+DEFAULT_COMPILE_SECONDS = {"planar": 2.0, "3d": 4.0}
+INDICATORS_FACTOR = 1.4
+SAMPLING_FACTOR = 1.0
 #: Announce only compiles expected to take at least this long (seconds).
 ANNOUNCE_MIN_S = 1.0
 #: The measurements, in the kernel cache folder (runtime.cache_folder()).

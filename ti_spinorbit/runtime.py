@@ -11,6 +11,13 @@ Decisions (docs/design.md, "Kernel design"):
   the perturbed 3-D state); Taichi's warning above 32 iterations would only alarm users.
 * The environment variable ``TI_SPINORBIT_ARCH`` (``cpu``, ``cuda``, ``vulkan``, ...)
   overrides the arch of the lazy default and of ``init()`` called without an arch.
+* ``cfg_optimization=False``: Taichi's own control-flow-graph pass (store forwarding and
+  dead-store elimination over the whole kernel) was most of the cold compile of our large
+  kernels (3-D DOP853 with indicators: 26 s -> 5 s; planar Cash-Karp 6.0 s -> 1.6 s), and
+  LLVM does the same work afterwards: run time and results are unchanged (measured,
+  experiments/README.md "Compile time"; the bit-identity tests pass with it).
+* Taichi 1.7's front end formats a source-position string for every AST node it visits,
+  cached kernel or not; ``_taichi_frontend`` memoises it (a third of the warm start).
 * ``TI_SKIP_VERSION_CHECK=ON`` is set before Taichi is imported (no network in CI).
 * In the ``ti-spinorbit`` command only, ``ENABLE_TAICHI_HEADER_PRINT=0`` is set too: ``import
   taichi`` prints a "[Taichi] version ..." line on stdout, and the command's stdout is its
@@ -49,7 +56,7 @@ _STATE = {"arch": None}
 ARCH_ENV = "TI_SPINORBIT_ARCH"
 #: Offline-cache folder under the user cache folder's taichi/ (bump when kernel settings
 #: change); see :func:`cache_folder`.
-CACHE_SUBDIR = "ti_spinorbit-1"
+CACHE_SUBDIR = "ti_spinorbit-2"
 CACHE_ENV = "TI_OFFLINE_CACHE_FILE_PATH"
 _KNOWN_ARCHS = ("cpu", "x64", "arm64", "cuda", "vulkan", "metal", "opengl", "gpu")
 
@@ -65,7 +72,7 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         of silently falling back to the CPU.
     offline_cache : bool
         Keep compiled kernels on disk (:func:`cache_folder`: the user cache folder's
-        ``taichi/ti_spinorbit-1``, ``~/.cache/taichi/ti_spinorbit-1`` on Linux, unless
+        ``taichi/ti_spinorbit-2``, ``~/.cache/taichi/ti_spinorbit-2`` on Linux, unless
         ``TI_OFFLINE_CACHE_FILE_PATH`` is set), so a fresh process starts in seconds. When
         that folder cannot be created or written (a read-only HOME), kernels are compiled
         in memory instead, with a one-line notice on stderr.
@@ -85,11 +92,13 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
 
     if _STATE["arch"] == name:
         return name
+    from . import _taichi_frontend
+    _taichi_frontend.install()   # warm start: Taichi re-traces every kernel, even cached ones
     ti_arch = {"cpu": ti.cpu, "x64": ti.x64, "arm64": ti.arm64, "cuda": ti.cuda,
                "vulkan": ti.vulkan, "metal": ti.metal, "opengl": ti.opengl, "gpu": ti.gpu}[name]
     kwargs = dict(arch=ti_arch, default_fp=ti.f64, default_ip=ti.i32, offline_cache=offline_cache,
                   fast_math=False, debug=debug, log_level=ti.WARN, enable_fallback=False,
-                  unrolling_limit=0)
+                  unrolling_limit=0, cfg_optimization=False)
     if cpu_max_num_threads:
         kwargs["cpu_max_num_threads"] = int(cpu_max_num_threads)
     if name in ("cpu", "x64", "arm64"):
@@ -139,8 +148,8 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
 
 def cache_folder():
     """Folder of the offline kernel cache: ``TI_OFFLINE_CACHE_FILE_PATH`` when set, else
-    ``<user cache dir>/taichi/ti_spinorbit-1`` (``platformdirs.user_cache_dir``:
-    ``~/.cache/taichi/ti_spinorbit-1`` on Linux, honouring ``XDG_CACHE_HOME``)."""
+    ``<user cache dir>/taichi/ti_spinorbit-2`` (``platformdirs.user_cache_dir``:
+    ``~/.cache/taichi/ti_spinorbit-2`` on Linux, honouring ``XDG_CACHE_HOME``)."""
     path = os.environ.get(CACHE_ENV)
     if path:
         return path
