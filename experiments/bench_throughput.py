@@ -155,7 +155,7 @@ RTOLS = (1e-10, 1e-12, 1e-15)
 MODELS = ("planar", "3d")
 WINDOWS = (4, 16, 64)
 SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "numba",
-            "accuracy", "latency")
+            "accuracy", "latency", "compile")
 #: Integration methods (``Ensemble(method=...)``); the default one is never passed by keyword.
 DEFAULT_METHOD = "cash-karp"
 METHODS = ("cash-karp", "dop853")
@@ -168,6 +168,14 @@ TARGET13_TIGHT = 4.0              # x today's Cash-Karp rate at rtol 1e-15
 NUMBA_RTOLS = (1e-12, 1e-15)      # the baseline's tolerances (issue 13 §1)
 ACCURACY_REFERENCE_RTOL = 1e-16   # numba DOP853, the tight reference of the accuracy section
 TARGET_SPEEDUP = 300.0            # over the scipy baseline
+# issue 13 §2: cold compile of every variant (model x method x indicators, each in a fresh
+# process with an empty kernel cache: integrator, right-hand side and diagnostics kernels)
+# <= 25 s and <= 2x "the planar one" (the planar default: Cash-Karp without indicators, what
+# the README's first command compiles); warm start (fresh process, warm cache, import to the
+# first result of a one-orbit section) <= 1 s for each model.
+TARGET13_COMPILE_S = 25.0
+TARGET13_COMPILE_RATIO = 2.0
+TARGET13_WARM_S = 1.0
 TARGET_FIRST_RESULT_S = 3.0       # fresh process, warm offline cache
 SCIPY_MIN_RTOL = 100 * np.finfo(float).eps   # scipy's RK solvers raise smaller rtol to this
 FLOPS_PER_CYCLE = 16              # f64, AVX2 + FMA: 2 FMA units × 4 lanes × 2 flops
@@ -226,9 +234,18 @@ t0 = time.perf_counter()
 import ti_spinorbit as tso
 imported = time.perf_counter() - t0
 r = tso.surface_of_section(tso.catalog.system({system!r}, elongation={elongation!r}), 90.0,
-                           [1.5], orbits=1)
+                           [1.5], orbits=1, model={model!r})
 print(json.dumps({{"import_s": imported, "in_process_s": time.perf_counter() - t0,
                   "integrate_s": r.seconds, "crossings": int(r.count[0])}}))
+"""
+# One kernel variant compiled (or loaded) in a fresh process: tso.warmup's own bookkeeping.
+CHILD_COMPILE = """
+import json, sys
+import ti_spinorbit as tso
+model, method, indicators = sys.argv[1], sys.argv[2], sys.argv[3] == "on"
+done = tso.warmup(models=[model], indicators=[indicators], sampling=[False], methods=[method],
+                  verbose=False)
+print(json.dumps(done[0]))
 """
 
 
@@ -802,19 +819,47 @@ def bench_accuracy(models, methods, rtols, members, orbits, numba_rtols=()):
     return rows
 
 
-def bench_first_result(arch, repeat, cold):
-    """Fresh processes: with ``cold``, a run with a new empty kernel cache and then
-    ``repeat`` runs with it warm; else ``repeat`` runs with the default cache folder."""
-    code = CHILD_FIRST_RESULT.format(system=SYSTEM, elongation=ELONGATION)
+def bench_first_result(arch, repeat, cold, models=("planar",)):
+    """Fresh processes, per model: with ``cold``, a run with a new empty kernel cache and
+    then ``repeat`` runs with it warm; else ``repeat`` runs with the default cache folder."""
     runs = []
-    with tempfile.TemporaryDirectory(prefix="ti_spinorbit_cache_") as cache:
-        env = child_env(arch, TI_OFFLINE_CACHE_FILE_PATH=cache) if cold else child_env(arch)
-        labels = (["cold cache"] if cold else []) + ["warm cache"] * repeat
-        for label in labels:
-            wall, inside = run_child(code, env=env)
-            runs.append({"run": label, "new_cache_folder": cold, "wall_s": wall, **inside})
-            print(f"  fresh process, {label}: {wall:8.3f} s", flush=True)
+    for model in models:
+        code = CHILD_FIRST_RESULT.format(system=SYSTEM, elongation=ELONGATION, model=model)
+        with tempfile.TemporaryDirectory(prefix="ti_spinorbit_cache_") as cache:
+            env = child_env(arch, TI_OFFLINE_CACHE_FILE_PATH=cache) if cold else child_env(arch)
+            labels = (["cold cache"] if cold else []) + ["warm cache"] * max(repeat, 3)
+            for label in labels:
+                wall, inside = run_child(code, env=env)
+                runs.append({"model": model, "run": label, "new_cache_folder": cold,
+                             "wall_s": wall, **inside})
+                print(f"  fresh process, {model}, {label}: {wall:8.3f} s", flush=True)
     return runs
+
+
+def bench_compile(arch, models, methods, repeat):
+    """Cold compile of every variant (model x method x indicators, sampling off): each in a
+    fresh process with a new empty kernel cache (``repeat`` times, the fastest kept), then
+    its load from that cache in another fresh process. Kernel seconds are tso.warmup's
+    (integrator, right-hand side and diagnostics kernels; imports and ti.init excluded)."""
+    rows = []
+    for model in models:
+        for method in methods:
+            for indicators in ("off", "on"):
+                cold, warm = [], []
+                for _ in range(repeat):
+                    with tempfile.TemporaryDirectory(prefix="ti_spinorbit_cache_") as cache:
+                        env = child_env(arch, TI_OFFLINE_CACHE_FILE_PATH=cache)
+                        cold.append(run_child(CHILD_COMPILE, (model, method, indicators), env))
+                        warm.append(run_child(CHILD_COMPILE, (model, method, indicators), env))
+                c = min(cold, key=lambda wi: wi[1]["kernel_seconds"])
+                w = min(warm, key=lambda wi: wi[1]["kernel_seconds"])
+                rows.append({"model": model, "method": method, "indicators": indicators,
+                             "variant": c[1]["variant"], "compile_s": c[1]["kernel_seconds"],
+                             "cold_process_s": c[0], "load_s": w[1]["kernel_seconds"],
+                             "warm_process_s": w[0], "how_warm": w[1]["how"]})
+                print(f"  compile {c[1]['variant']}: {c[1]['kernel_seconds']:.2f} s cold, "
+                      f"{w[1]['kernel_seconds']:.2f} s from the cache", flush=True)
+    return rows
 
 
 def fastest(points, model, rtol, n, methods, key="member_orbits_per_s"):
@@ -859,7 +904,39 @@ def targets13(points, numba_rows, accuracy_rows, models, methods, n, cores, cpu)
         if row:
             add(f">= {TARGET13_3D:.0f} member-orbits/s, 3-D, fastest method ({method}), N = {n}, "
                 "rtol 1e-12", row["member_orbits_per_s"], TARGET13_3D)
-    # accuracy at equal rtol: each method's median final-state error over Cash-Karp's
+    return out + _accuracy_targets(accuracy_rows, methods)
+
+
+def targets13_compile(compile_rows, first_runs):
+    """Issue 13 §2 targets: cold compile per variant and warm start per model."""
+    out = []
+    ref = [r for r in compile_rows if (r["model"], r["method"], r["indicators"])
+           == ("planar", DEFAULT_METHOD, "off")]
+    for r in compile_rows:
+        what = f"{r['model']}, {r['method']}, indicators {r['indicators']}"
+        out.append({"target": f"issue 13: cold compile <= {TARGET13_COMPILE_S:.0f} s, {what}",
+                    "value": r["compile_s"], "ratio": r["compile_s"] / TARGET13_COMPILE_S,
+                    "met": r["compile_s"] <= TARGET13_COMPILE_S})
+        if ref:
+            ratio = r["compile_s"] / ref[0]["compile_s"]
+            out.append({"target": f"issue 13: cold compile <= {TARGET13_COMPILE_RATIO:g}x the "
+                                  f"planar default's ({ref[0]['compile_s']:.2f} s), {what}",
+                        "value": ratio, "ratio": ratio / TARGET13_COMPILE_RATIO,
+                        "met": ratio <= TARGET13_COMPILE_RATIO})
+    for model in dict.fromkeys(f["model"] for f in first_runs):
+        warm = [f["wall_s"] for f in first_runs if f["model"] == model and f["run"] == "warm cache"]
+        if warm:
+            best = min(warm)
+            out.append({"target": f"issue 13: warm start <= {TARGET13_WARM_S:g} s, fresh process "
+                                  f"to the first result of a one-orbit {model} section (best "
+                                  f"of {len(warm)})", "value": best,
+                        "ratio": best / TARGET13_WARM_S, "met": best <= TARGET13_WARM_S})
+    return out
+
+
+def _accuracy_targets(accuracy_rows, methods):
+    """Accuracy at equal rtol: each method's median final-state error over Cash-Karp's."""
+    out = []
     for a in accuracy_rows:
         if a["method"] == DEFAULT_METHOD or a["method"] not in methods:
             continue
@@ -1018,6 +1095,9 @@ TABLES = {
               ("RHS/orb", "rhs_per_orbit", ".1f"), ("ns/RHS", "ns_per_rhs", ".1f")],
     "accuracy": [MODEL, METHOD, RTOL, ("members", "members", "d"), ORBITS,
                  ("median err", "median_error", ".2e"), ("max err", "max_error", ".2e")],
+    "compile": [MODEL, METHOD, ("indicators", "indicators", "s"),
+                ("cold compile s", "compile_s", ".2f"), ("process s", "cold_process_s", ".2f"),
+                ("cache load s", "load_s", ".2f"), ("process s ", "warm_process_s", ".2f")],
 }
 
 
@@ -1054,7 +1134,10 @@ def print_report(result):
                  "planar, members one after the other on ONE core, atol = rtol, Hairer's "
                  "RMS error norm; orbits per CPU-second = per core",
         "accuracy": "final-state error at equal rtol: max |dy| over the scaled 3-D state "
-                    "against a tight reference, median and max over members"}
+                    "against a tight reference, median and max over members",
+        "compile": "each kernel variant in a fresh process with a new empty kernel cache "
+                   "(cold), then loaded from it in another fresh process; kernel seconds "
+                   "(integrator, right-hand side, diagnostics) and the whole process"}
     for name, columns in TABLES.items():
         if s.get(name):
             print(f"\n[{name}] {captions[name]}")
@@ -1080,7 +1163,7 @@ def print_report(result):
         print("\n[latency] first result from a fresh process (1 member, 1 orbit)")
         for f in s["latency"]:
             where = "new cache folder" if f["new_cache_folder"] else "default cache folder"
-            print(f"  {f['run']:<10} ({where}): wall {f['wall_s']:6.2f} s  (import "
+            print(f"  {f['model']:<6} {f['run']:<10} ({where}): wall {f['wall_s']:6.2f} s  (import "
                   f"{f['import_s']:.2f} s, in process {f['in_process_s']:.2f} s)")
     if s.get("equal_accuracy"):
         print("\n[equal accuracy] informational: each method against the numba baseline at the "
@@ -1248,7 +1331,10 @@ def main():
         s["equal_accuracy"] = equal_accuracy(points, s.get("numba", []), s["accuracy"], methods,
                                              n_split, cpu)
     if "latency" in sections:
-        s["latency"] = bench_first_result(args.arch, args.repeat, settings["cold_latency"])
+        s["latency"] = bench_first_result(args.arch, args.repeat, settings["cold_latency"],
+                                          args.models)
+    if "compile" in sections:
+        s["compile"] = bench_compile(args.arch, args.models, methods, args.repeat)
     parameters = {"system": SYSTEM, "elongation": ELONGATION, "theta_p_range": THETA_P_RANGE,
                   "thetadot_range": THETADOT_RANGE, "escape_distance": ESCAPE_DISTANCE,
                   "starts": "R2 sequence, plastic number", "rtols": args.rtols,
@@ -1263,7 +1349,8 @@ def main():
               "targets": targets(points, s.get("baseline", []), s.get("latency", []),
                                  args.models, n_split)
               + targets13(points, s.get("numba", []), s.get("accuracy", []), args.models,
-                          methods, n_split, machine["cpus_usable"], cpu),
+                          methods, n_split, machine["cpus_usable"], cpu)
+              + targets13_compile(s.get("compile", []), s.get("latency", [])),
               "total_seconds": time.perf_counter() - started}
     print_report(result)
     path = os.path.join(args.out, "bench_throughput.json")
