@@ -215,6 +215,11 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 y = _load(y_nd, i)
                 yc = _load(yc_nd, i)            # Kahan compensation of y
                 f0 = _load(f_nd, i)             # dy/dt at (t, y): first stage of the next step
+                # NaN: not evaluated yet (a fresh run): the first pass evaluates it, at the one
+                # RHS call site (stage 0), instead of a separate kernel to trace and compile
+                first_stage_pending = 0
+                if not (f0[0] == f0[0]):
+                    first_stage_pending = 1
                 t = t_nd[i]
                 tc = tc_nd[i]                   # Kahan compensation of t
                 h = h_nd[i]                     # step proposal
@@ -228,8 +233,9 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 calls = 0
                 after_reject = 0
                 K = kmat(0.0)
-                for c in ti.static(range(NK)):
-                    K[0, c] = f0[c]
+                if first_stage_pending == 0:
+                    for c in ti.static(range(NK)):
+                        K[0, c] = f0[c]
                 # shadow trajectory (chaos indicators): same steps, its own stages in K2
                 y_s = state(0.0)
                 ys_try = state(0.0)
@@ -240,8 +246,9 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 ybar_int = 0.0
                 if ti.static(indicators):
                     y_s = _load(shadow_nd, i)
-                    for c in ti.static(range(NK)):
-                        K2[0, c] = shadow_f_nd[i, c]
+                    if first_stage_pending == 0:
+                        for c in ti.static(range(NK)):
+                            K2[0, c] = shadow_f_nd[i, c]
                     ell = ind[i, 0]
                     s_weighted = ind[i, 1]
                     ybar_int = ind[i, 2]
@@ -266,7 +273,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                     if new_attempt == 1:         # a new trial step from (t, y) with proposal h
                         hs, hit_end, hit_sample = _trial_size(h, t, ts, next_sample[i],
                                                               sampling)
-                        stage = 1
+                        stage = 1 - first_stage_pending
                         new_attempt = 0
                     copies = 1
                     if ti.static(indicators):
@@ -276,14 +283,19 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                     for copy in range(copies):                  # runtime loop: one call site
                         pt = y_try
                         if copy == 0:
-                            if stage < _STAGES:
+                            if stage == 0:
+                                pt = y
+                            elif stage < _STAGES:
                                 pt = stage_point(y, K, hs, stage)
                         else:
                             pt = ys_try
-                            if stage < _STAGES:
+                            if stage == 0:
+                                pt = y_s
+                            elif stage < _STAGES:
                                 pt = stage_point(y_s, K2, hs, stage)
                         fc = rhs(par, i, pt, order, odd)          # the only RHS call site
-                        calls += 1
+                        if stage > 0 or copy == 0:    # (the shadow's start is not counted)
+                            calls += 1
                         if copy == 0:
                             fy = fc
                         elif stage < _STAGES:
@@ -293,6 +305,9 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                     do_accept = 0
                     if stage < _STAGES:
                         put_stage(K, stage, fy)
+                        if stage == 0:
+                            f0 = fy
+                            first_stage_pending = 0
                         stage += 1
                         if stage == _STAGES:
                             dy, err, err3 = combine(K, hs)

@@ -409,21 +409,18 @@ class Ensemble:
                          indicator_space="planar"):
         """The :class:`RunState` of a run from the start (y, t, h, status, counters are this
         ensemble's own arrays)."""
-        from .kernels import ensemble as K
-
         kern = self.kernels
         n = self.n
-        f = np.zeros_like(self.y)
-        kern.evaluate_rhs(self.kpar, self.y, f, self.order, self.odd)
-        self.counters[:, K.C_RHS] += 1
+        # NaN first stages: the integrator evaluates them itself on its first pass (counted
+        # there, the shadow's not), so a first run traces and compiles one kernel fewer
+        f = np.full_like(self.y, np.nan)
         if indicators:
             ys = self.y[:, :self.equations.nstate]
             direction = self.equations.full_direction(ys) if indicator_space == "full" \
                 else self.equations.shadow_direction()
             shadow = self.y.copy()         # accumulators: the same as the member's
             shadow[:, :self.equations.nstate] = ys + separation * direction
-            shadow_f = np.zeros_like(shadow)
-            kern.evaluate_rhs(self.kpar, shadow, shadow_f, self.order, self.odd)
+            shadow_f = np.full_like(shadow, np.nan)
             ind = np.zeros((n, 3))
         else:  # unused by the kernel variant without indicators
             shadow = shadow_f = np.zeros((1, kern.NSTATE))
