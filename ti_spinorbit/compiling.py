@@ -43,11 +43,11 @@ import numpy as np
 _LOG = logging.getLogger("ti_spinorbit")
 
 #: Seconds a cold compile of a variant takes when nothing was measured on this machine yet
-#: (2-core CPU, Taichi 1.7.4 without its CFG pass, runtime.py: planar 0.6-1.6 s, 3-D
-#: 1.9-3.1 s); the shadow trajectory (indicators) adds about +40 %, dense sampling little.
-#: Estimates under ANNOUNCE_MIN_S are not announced.
-DEFAULT_COMPILE_SECONDS = {"planar": 2.0, "3d": 4.0}
-INDICATORS_FACTOR = 1.4
+#: (2-core CPU, Taichi 1.7.4 with the settings of runtime.py, fresh process: planar 0.9-1.1
+#: s, 3-D 1.6-3.1 s); the shadow trajectory (indicators) adds about +30 %, dense sampling
+#: little. Estimates under ANNOUNCE_MIN_S are not announced.
+DEFAULT_COMPILE_SECONDS = {"planar": 1.0, "3d": 2.0}
+INDICATORS_FACTOR = 1.3
 SAMPLING_FACTOR = 1.0
 #: Announce only compiles expected to take at least this long (seconds).
 ANNOUNCE_MIN_S = 1.0

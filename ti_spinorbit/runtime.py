@@ -11,11 +11,13 @@ Decisions (docs/design.md, "Kernel design"):
   the perturbed 3-D state); Taichi's warning above 32 iterations would only alarm users.
 * The environment variable ``TI_SPINORBIT_ARCH`` (``cpu``, ``cuda``, ``vulkan``, ...)
   overrides the arch of the lazy default and of ``init()`` called without an arch.
-* ``cfg_optimization=False``: Taichi's own control-flow-graph pass (store forwarding and
-  dead-store elimination over the whole kernel) was most of the cold compile of our large
-  kernels (3-D DOP853 with indicators: 26 s -> 5 s; planar Cash-Karp 6.0 s -> 1.6 s), and
-  LLVM does the same work afterwards: run time and results are unchanged (measured,
-  experiments/README.md "Compile time"; the bit-identity tests pass with it).
+* ``cfg_optimization=False, opt_level=0``: Taichi's own control-flow-graph pass (store
+  forwarding and dead-store elimination over the whole kernel) and its whole-kernel common
+  subexpression elimination (``opt_level`` 0 turns off only that and the CFG pass; LLVM's
+  optimisation level is not affected) were most of the cold compile of our large kernels
+  (3-D DOP853 with indicators: 26 s -> 3.1 s; planar Cash-Karp 6.0 s -> 0.9 s). LLVM does
+  the same work afterwards: run time is unchanged and results are bit for bit the same
+  (docs/design.md "Taichi's CFG pass").
 * Taichi 1.7's front end formats a source-position string for every AST node it visits,
   cached kernel or not; ``_taichi_frontend`` memoises it (a third of the warm start).
 * ``TI_SKIP_VERSION_CHECK=ON`` is set before Taichi is imported (no network in CI).
@@ -98,7 +100,7 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
                "vulkan": ti.vulkan, "metal": ti.metal, "opengl": ti.opengl, "gpu": ti.gpu}[name]
     kwargs = dict(arch=ti_arch, default_fp=ti.f64, default_ip=ti.i32, offline_cache=offline_cache,
                   fast_math=False, debug=debug, log_level=ti.WARN, enable_fallback=False,
-                  unrolling_limit=0, cfg_optimization=False)
+                  unrolling_limit=0, cfg_optimization=False, opt_level=0)
     if cpu_max_num_threads:
         kwargs["cpu_max_num_threads"] = int(cpu_max_num_threads)
     if name in ("cpu", "x64", "arm64"):
