@@ -23,7 +23,8 @@
   becomes the next step's first stage: 16 evaluations per accepted step. The published
   coefficients are exact numbers of the field Q(√6) (four nodes are irrational); they are
   stored as such (``Sqrt6Number``) and every order condition holds exactly
-  (tests/test_tableau.py). Only the 16 stages of the pair, not the interpolant's extra ones.
+  (tests/test_tableau.py). Only the 16 stages of the pair, not the interpolant's extra ones
+  (docs/physics.md §5.5).
 
 A tableau is plain Python floats so that the generic step in ``integrator.py`` unrolls it
 with ``ti.static`` (zero entries cost nothing). ``METHODS`` maps the public method names to
