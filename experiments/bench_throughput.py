@@ -1190,9 +1190,9 @@ def _extra(p):
     p.add_argument("--models", nargs="+", choices=MODELS, default=list(MODELS),
                    help="equations of motion (default: planar 3d)")
     p.add_argument("--methods", nargs="+", default=list(METHODS),
-                   help="integration methods, Ensemble(method=...) (default: cash-karp dop853 vern9; "
-                        "a method the installed package does not accept is skipped with a "
-                        "note)")
+                   help="integration methods, Ensemble(method=...) (default: cash-karp dop853 "
+                        "vern9; a method the installed package does not accept is skipped "
+                        "with a note)")
     p.add_argument("--seconds", type=float, default=None,
                    help="target duration of each throughput point (default 2; --quick 0.05)")
     p.add_argument("--flops-per-cycle", type=float, default=FLOPS_PER_CYCLE,

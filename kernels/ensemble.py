@@ -1,8 +1,8 @@
 """Ensemble kernels: every member advances with its own adaptive Runge-Kutta loop in one launch.
 
 The method (a ``tableau.Tableau``: Cash-Karp 4(5), the default, DOP853 or Verner 9(8)) and the
-step-size policy (a ``controller.Controller``) are arguments of the kernel factory :func:`make_kernels`;
-:func:`kernels_for` builds and caches one kernel set per (model, method).
+step-size policy (a ``controller.Controller``) are arguments of the kernel factory
+:func:`make_kernels`; :func:`kernels_for` builds and caches one kernel set per (model, method).
 
 One launch of :func:`advance` takes each running member from its current time until its
 first accepted step that reaches ``t_end[i]`` (a soft window end: steps are never shortened

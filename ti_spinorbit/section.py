@@ -360,7 +360,8 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     method : {"cash-karp", "dop853", "vern9"}
         Runge-Kutta pair (``Ensemble``): "cash-karp" (default, the paper's Cash-Karp 4(5)),
         "dop853" (Hairer's 8(5,3) pair: fewer steps, faster at tight tolerances) or "vern9"
-        (Verner's 9(8) pair: fewer steps still; same error norm held to rtol). Recorded in the result (``method``) and saved files.
+        (Verner's 9(8) pair: fewer steps still; same error norm held to rtol). Recorded in
+        the result (``method``) and saved files.
     initial_states : InitialState or sequence of them, optional
         Explicit 3-D starts (:class:`ti_spinorbit.InitialState`, SI units, inertial frame;
         e.g. ``system.tilted_start(θ_p, θ̇_p, roll=...)``) instead of θ_p and θ̇_p (leave
