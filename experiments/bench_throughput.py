@@ -12,7 +12,7 @@ distance 1000 a so no member stops early). Sections (``--sections``, default all
 throughput
     member-orbits per second for N × rtol × model × method (``--members``, ``--rtols``,
     ``--models``, ``--methods``; default N = 1, 16, 256, 1024, 4096, 16384, rtol 1e-10,
-    1e-12, 1e-15, models planar and 3d, methods cash-karp and dop853) on the arch of
+    1e-12, 1e-15, models planar and 3d, methods cash-karp, dop853 and vern9) on the arch of
     ``--arch`` (cpu by default; ``--arch cuda --members ... 65536`` for a GPU). The
     orbits of each point are chosen so that it takes about ``--seconds`` (default 2 s): a
     short pilot run measures the rate, then the timed run integrates ``seconds × rate / N``
@@ -100,7 +100,7 @@ over 0.5 orbit, no cold-cache run: every section in about 12 s (CI, not figures)
 load average at start and end is recorded, and other processes' load lowers every
 wall-clock figure).
 
-Methods: ``--methods cash-karp dop853 ...`` (``Ensemble(method=...)``; the default
+Methods: ``--methods cash-karp dop853 vern9 ...`` (``Ensemble(method=...)``; the default
 "cash-karp" is never passed by keyword, so the script runs on a package without the keyword;
 a method ``Ensemble`` does not accept yet is skipped with a one-line note). The split, flops,
 threads and window sections use Cash-Karp.
@@ -158,7 +158,7 @@ SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "nu
             "accuracy", "latency", "compile")
 #: Integration methods (``Ensemble(method=...)``); the default one is never passed by keyword.
 DEFAULT_METHOD = "cash-karp"
-METHODS = ("cash-karp", "dop853")
+METHODS = ("cash-karp", "dop853", "vern9")
 TARGET_RATE = {"planar": 20000.0, "3d": 2000.0}   # member-orbits/s, N = 4096, rtol 1e-12
 # issue 13 §1 (planar, 1991 VH a/b = 1.5, N >= 1024; "fastest" = the fastest method measured)
 TARGET13_PLANAR = 60000.0         # member-orbits/s on 2 cores, rtol 1e-12
@@ -1273,9 +1273,9 @@ def _extra(p):
     p.add_argument("--models", nargs="+", choices=MODELS, default=list(MODELS),
                    help="equations of motion (default: planar 3d)")
     p.add_argument("--methods", nargs="+", default=list(METHODS),
-                   help="integration methods, Ensemble(method=...) (default: cash-karp dop853; "
-                        "a method the installed package does not accept is skipped with a "
-                        "note)")
+                   help="integration methods, Ensemble(method=...) (default: cash-karp dop853 "
+                        "vern9; a method the installed package does not accept is skipped "
+                        "with a note)")
     p.add_argument("--seconds", type=float, default=None,
                    help="target duration of each throughput point (default 2; --quick 0.05)")
     p.add_argument("--flops-per-cycle", type=float, default=FLOPS_PER_CYCLE,

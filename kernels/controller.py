@@ -6,8 +6,8 @@ After a trial step of size ``hs`` whose error estimate is ``err`` (tolerance uni
     h = hs * clip(safety * err^(-exponent), min_factor, max_factor)
 
 with ``exponent = 1 / (q + 1)`` for an error estimate of order q (``Tableau.error_exponent``:
-1/5 for Cash-Karp, 1/8 for DOP853), as in scipy ``integrate/_ivp/rk.py`` and Hairer, Nørsett &
-Wanner, *Solving ODEs I*, §II.4 (eq. 4.13), and these refinements:
+1/5 for Cash-Karp, 1/8 for DOP853, 1/9 for Verner 9(8)), as in scipy ``integrate/_ivp/rk.py``
+and Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4 (eq. 4.13), and these refinements:
 
 * no growth (factor <= 1) on the step right after a rejection (scipy's ``step_rejected``);
 * a trial step whose error estimate is NaN or infinite (``NONFINITE_ERROR``) is retried at

@@ -1,8 +1,8 @@
 """Ensemble kernels: every member advances with its own adaptive Runge-Kutta loop in one launch.
 
-The method (a ``tableau.Tableau``: Cash-Karp 4(5), the default, or DOP853) and the step-size
-policy (a ``controller.Controller``) are arguments of the kernel factory :func:`make_kernels`;
-:func:`kernels_for` builds and caches one kernel set per (model, method).
+The method (a ``tableau.Tableau``: Cash-Karp 4(5), the default, DOP853 or Verner 9(8)) and the
+step-size policy (a ``controller.Controller``) are arguments of the kernel factory
+:func:`make_kernels`; :func:`kernels_for` builds and caches one kernel set per (model, method).
 
 One launch of :func:`advance` takes each running member from its current time until its
 first accepted step that reaches ``t_end[i]`` (a soft window end: steps are never shortened
@@ -106,7 +106,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     error_norm = make_error_norm(tableau, unroll_components)
     ctl = controller.funcs()
     _STAGES = tableau.stages
-    _EXPONENT = tableau.error_exponent   # 1/5 for Cash-Karp (error estimate O(h^5)), 1/8 DOP853
+    _EXPONENT = tableau.error_exponent   # 1/5 Cash-Karp (error O(h^5)), 1/8 DOP853, 1/9 Verner
 
     @ti.func
     def _trial_size(h, t, ts, t_sample, sampling: ti.template()):

@@ -367,7 +367,7 @@ def test_warmup_command(capsys):
 def test_warmup_refuses_an_unknown_method(capsys):
     assert cli.main(["warmup", "--methods", "rk4"]) == cli.EXIT_ERROR
     assert capsys.readouterr().err == ("ti-spinorbit warmup: error: --methods must be among "
-                                       "cash-karp, dop853 (got 'rk4')\n")
+                                       "cash-karp, dop853, vern9 (got 'rk4')\n")
 
 
 # ---- tides, YORP and BYORP (issue 15) ---------------------------------------------------

@@ -1,9 +1,10 @@
-"""``method=``: Cash-Karp 4(5) (default) and DOP853 8(5,3) in the ensemble kernels.
+"""``method=``: Cash-Karp 4(5) (default), DOP853 8(5,3) and Verner 9(8) in the ensemble
+kernels (the high-order pairs through the same tests, parametrised).
 
-* accuracy at equal rtol: DOP853's error against a tight reference (Cash-Karp at 1e-15) is
-  no larger than Cash-Karp's, with fewer right-hand-side evaluations;
+* accuracy at equal rtol: the error of DOP853 and of Verner's pair against a tight reference
+  (Cash-Karp at 1e-15) is no larger than Cash-Karp's, with fewer right-hand-side evaluations;
 * pericentre events, samples and chaos indicators agree between the methods;
-* conservation; the planar and 3-D models agree with DOP853;
+* conservation; the planar and 3-D models agree with each high-order pair;
 * the choice is validated, recorded in results, saved files and checkpoints (a checkpoint
   refuses to resume with another method), and reachable from the command line.
 """
@@ -20,6 +21,7 @@ from conftest import run_cli
 ORBITS = 5
 T_STOP = 2.0 * np.pi * ORBITS
 SPINS = (0.9, 1.3, 2.1, 0.5)
+HIGH_ORDER = ("dop853", "vern9")
 
 
 @pytest.fixture(scope="module")
@@ -38,36 +40,42 @@ def reference(members):
     return _run(members, "cash-karp", 1e-15)
 
 
-@pytest.mark.parametrize("rtol, call_ratio", [(1e-9, 0.9), (1e-12, 0.6)])
-def test_dop853_is_at_least_as_accurate_with_fewer_evaluations(members, reference, rtol,
-                                                               call_ratio):
-    """Measured (5 orbits, 4 members): at 1e-9 errors 7.4e-7 (CK) vs 1.5e-7 (DOP853) with
-    0.83x the RHS calls, at 1e-12 7.4e-10 vs 1.8e-10 with 0.41x."""
-    runs = {m: _run(members, m, rtol) for m in ("cash-karp", "dop853")}
+@pytest.mark.parametrize("method, rtol, call_ratio", [("dop853", 1e-9, 0.9),
+                                                      ("dop853", 1e-12, 0.6),
+                                                      ("vern9", 1e-9, 0.8),
+                                                      ("vern9", 1e-12, 0.4)])
+def test_high_order_is_at_least_as_accurate_with_fewer_evaluations(members, reference, method,
+                                                                   rtol, call_ratio):
+    """Measured (5 orbits, 4 members): at 1e-9 errors 7.4e-7 (CK), 1.5e-7 (DOP853), 1.0e-7
+    (Verner) with 0.83x and 0.71x CK's RHS calls; at 1e-12 7.4e-10, 1.8e-10, 9.7e-11 with
+    0.41x and 0.30x."""
+    runs = {m: _run(members, m, rtol) for m in ("cash-karp", method)}
     err = {m: np.max(np.abs(r.y - reference.y)) for m, r in runs.items()}
     calls = {m: r.counters[:, 2].sum() for m, r in runs.items()}
     assert all((r.status == 1).all() for r in runs.values())
-    assert err["dop853"] <= err["cash-karp"], err
-    assert err["dop853"] < 1e3 * rtol, err
-    assert calls["dop853"] < call_ratio * calls["cash-karp"], calls
+    assert err[method] <= err["cash-karp"], err
+    assert err[method] < 1e3 * rtol, err
+    assert calls[method] < call_ratio * calls["cash-karp"], calls
 
 
-def test_events_agree_between_methods(members, reference):
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_events_agree_between_methods(members, reference, method):
     """Pericentre times and states at rtol 1e-12 match the tight reference to 1e-8 (the
     state error grows along the run as above), with the same number of crossings."""
-    dop = _run(members, "dop853", 1e-12)
+    dop = _run(members, method, 1e-12)
     for ev, ref in zip(dop.events, reference.events):
         assert ev.shape == ref.shape and len(ev) >= ORBITS - 1
         assert np.max(np.abs(ev - ref)) < 1e-8
 
 
-def test_samples_and_indicators_work_with_dop853(members):
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_samples_and_indicators_work_with_high_order(members, method):
     """Sample times land exactly on the grid; MEGNO agrees with Cash-Karp's; the shadow does
     not change the main trajectory."""
     dt = 2.0 * np.pi / 8
     ck = _run(members, "cash-karp", 1e-11, sample_dt=dt, indicators=True)
-    dop = _run(members, "dop853", 1e-11, sample_dt=dt, indicators=True)
-    plain = _run(members, "dop853", 1e-11, sample_dt=dt)
+    dop = _run(members, method, 1e-11, sample_dt=dt, indicators=True)
+    plain = _run(members, method, 1e-11, sample_dt=dt)
     for s, s_ck in zip(dop.samples, ck.samples):
         assert np.array_equal(s[:, 0], s_ck[:, 0])              # the grid, exactly
         assert np.max(np.abs(s[:, 1:] - s_ck[:, 1:])) < 1e-7
@@ -76,18 +84,21 @@ def test_samples_and_indicators_work_with_dop853(members):
     assert np.allclose(dop.megno, ck.megno, atol=0.05), (dop.megno, ck.megno)
 
 
-def test_energy_is_conserved_with_dop853(members):
-    out = Ensemble(*members, rtol=1e-12, model="planar", method="dop853")
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_energy_is_conserved_with_high_order(members, method):
+    out = Ensemble(*members, rtol=1e-12, model="planar", method=method)
     run = out.run(T_STOP)
     e0 = run.diag_start[:, :3].sum(axis=1)
     e1 = run.diag_end[:, :3].sum(axis=1)
     assert np.max(np.abs((e1 - e0) / e0)) < 1e-10
 
 
-def test_planar_and_3d_agree_with_dop853(members):
-    """The 3-D kernel with DOP853 (one variant compiled: no sampling, no indicators)."""
-    planar = _run(tuple(a[:2] for a in members), "dop853", 1e-12)
-    spatial = _run(tuple(a[:2] for a in members), "dop853", 1e-12, model="3d")
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_planar_and_3d_agree_with_high_order(members, method):
+    """The 3-D kernel with each high-order pair (one variant compiled: no sampling, no
+    indicators; about 20 s cold for Verner's)."""
+    planar = _run(tuple(a[:2] for a in members), method, 1e-12)
+    spatial = _run(tuple(a[:2] for a in members), method, 1e-12, model="3d")
     assert (spatial.status == 1).all()
     assert np.max(np.abs(spatial.y - planar.y)) < 1e-8
     for a, b in zip(spatial.events, planar.events):
@@ -96,25 +107,30 @@ def test_planar_and_3d_agree_with_dop853(members):
 
 @pytest.mark.parametrize("method", ["rk45", "DOP853", None, 8])
 def test_unknown_method_is_refused(members, method):
-    with pytest.raises(ValueError, match=r"^method must be one of 'cash-karp', 'dop853' \(got"):
+    with pytest.raises(ValueError,
+                       match=r"^method must be one of 'cash-karp', 'dop853', 'vern9' \(got"):
         Ensemble(*members, method=method)
 
 
-def test_results_and_files_record_the_method(vh, tmp_path):
-    res = tso.surface_of_section(vh, 0.0, [1.3], orbits=2, rtol=1e-10, method="dop853")
-    assert res.method == "dop853"
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_results_and_files_record_the_method(vh, tmp_path, method):
+    res = tso.surface_of_section(vh, 0.0, [1.3], orbits=2, rtol=1e-10, method=method)
+    assert res.method == method
     path = tso.io.save(res, tmp_path / "s.npz")
-    assert tso.io.load(path).method == "dop853"
-    assert tso.io.read_metadata(path)["method"] == "dop853"
+    assert tso.io.load(path).method == method
+    assert tso.io.read_metadata(path)["method"] == method
     default = tso.surface_of_section(vh, 0.0, [1.3], orbits=2, rtol=1e-10)
     assert default.method == "cash-karp"
 
 
-def test_checkpoint_refuses_another_method(members, tmp_path):
+@pytest.mark.parametrize("written, resumed", [("cash-karp", "dop853"), ("cash-karp", "vern9"),
+                                              ("vern9", "dop853")])
+def test_checkpoint_refuses_another_method(members, tmp_path, written, resumed):
     ck = tmp_path / "ck"
-    Ensemble(*members, rtol=1e-10, model="planar").run(T_STOP, checkpoint=ck)
-    with pytest.raises(CheckpointError, match=r"method \(checkpoint 'cash-karp', now 'dop853'\)"):
-        Ensemble(*members, rtol=1e-10, model="planar", method="dop853").run(
+    Ensemble(*members, rtol=1e-10, model="planar", method=written).run(T_STOP, checkpoint=ck)
+    with pytest.raises(CheckpointError,
+                       match=rf"method \(checkpoint '{written}', now '{resumed}'\)"):
+        Ensemble(*members, rtol=1e-10, model="planar", method=resumed).run(
             T_STOP, checkpoint=ck, resume=True)
 
 
@@ -122,10 +138,11 @@ class _Stop(Exception):
     pass
 
 
-def test_dop853_resume_equals_uninterrupted(members, tmp_path):
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_high_order_resume_equals_uninterrupted(members, tmp_path, method):
     """Interrupted after two windows (the checkpoint is written before progress is called),
     resumed: the same bits as an uninterrupted run."""
-    whole = _run(members, "dop853", 1e-10, window_orbits=1)
+    whole = _run(members, method, 1e-10, window_orbits=1)
     calls = []
 
     def stop_after_two(fraction):
@@ -135,8 +152,8 @@ def test_dop853_resume_equals_uninterrupted(members, tmp_path):
 
     ck = tmp_path / "ck"
     with pytest.raises(_Stop):
-        _run(members, "dop853", 1e-10, window_orbits=1, checkpoint=ck, progress=stop_after_two)
-    resumed = _run(members, "dop853", 1e-10, window_orbits=1, checkpoint=ck, resume=True)
+        _run(members, method, 1e-10, window_orbits=1, checkpoint=ck, progress=stop_after_two)
+    resumed = _run(members, method, 1e-10, window_orbits=1, checkpoint=ck, resume=True)
     assert 0.0 < calls[-1] < 1.0
     for name in ("y", "t", "counters"):
         assert np.array_equal(getattr(resumed, name), getattr(whole, name)), name
@@ -144,21 +161,23 @@ def test_dop853_resume_equals_uninterrupted(members, tmp_path):
         assert np.array_equal(a, b)
 
 
-def test_entry_points_forward_the_method(vh):
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_entry_points_forward_the_method(vh, method):
     """chaos_map and libration_amplitude pass method= down to every launch."""
-    cmap = tso.chaos_map(vh, [0.0, 90.0], [1.3], orbits=2, method="dop853", fraction_orbits=())
-    assert cmap.method == "dop853" and cmap.section.method == "dop853"
+    cmap = tso.chaos_map(vh, [0.0, 90.0], [1.3], orbits=2, method=method, fraction_orbits=())
+    assert cmap.method == method and cmap.section.method == method
     amp = {m: tso.libration_amplitude(vh, [0.95], orbits=2, samples_per_orbit=32, rtol=1e-11,
-                                      method=m) for m in ("cash-karp", "dop853")}
-    assert np.all(np.isfinite(amp["dop853"]))
-    assert np.allclose(amp["dop853"], amp["cash-karp"], atol=1e-5), amp
+                                      method=m) for m in ("cash-karp", method)}
+    assert np.all(np.isfinite(amp[method]))
+    assert np.allclose(amp[method], amp["cash-karp"], atol=1e-5), amp
 
 
-def test_cli_method_flag(tmp_path):
+@pytest.mark.parametrize("method", HIGH_ORDER)
+def test_cli_method_flag(tmp_path, method):
     p = run_cli("section", "--system", "1991 VH", "--thetadot", "1.3", "--orbits", "2",
-                "--method", "dop853", "--quiet", "--out", str(tmp_path / "s.png"), cwd=tmp_path)
+                "--method", method, "--quiet", "--out", str(tmp_path / "s.png"), cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert tso.io.read_metadata(tmp_path / "s.npz")["method"] == "dop853"
+    assert tso.io.read_metadata(tmp_path / "s.npz")["method"] == method
     bad = run_cli("section", "--method", "rk4", cwd=tmp_path)
     assert bad.returncode == 2 and "--method: invalid choice: 'rk4'" in bad.stderr
 

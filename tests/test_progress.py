@@ -332,7 +332,8 @@ def test_warmup_compiles_each_variant_and_says_how(cold):
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"models": ["2d"]}, r"^models must be a non-empty selection of 'planar', '3d' \(got \['2d'\]\)"),
-    ({"methods": ["rk4"]}, r"^methods must be a non-empty selection of 'cash-karp', 'dop853'"),
+    ({"methods": ["rk4"]},
+     r"^methods must be a non-empty selection of 'cash-karp', 'dop853', 'vern9' \(got"),
     ({"indicators": []}, r"^indicators must be a non-empty selection of False, True"),
 ])
 def test_warmup_refuses_unknown_variants(kwargs, message):

@@ -191,8 +191,9 @@ def _parser():
                        help=f"relative tolerance in [{RTOL_RANGE[0]:g}, {RTOL_RANGE[1]:g}] "
                             f"(default {rtol:g})")
         s.add_argument("--method", choices=METHODS, default="cash-karp",
-                       help="Runge-Kutta pair: cash-karp (default, the paper's 4(5)) or dop853 "
-                            "(8(5,3): fewer steps, faster at tight tolerances)")
+                       help="Runge-Kutta pair: cash-karp (default, the paper's 4(5)), dop853 "
+                            "(8(5,3): fewer steps, faster at tight tolerances) or vern9 "
+                            "(Verner's 9(8): fewest steps, for the tightest tolerances)")
         s.add_argument("--arch", choices=_KNOWN_ARCHS, default=None,
                        help="Taichi arch: cpu (default, or $TI_SPINORBIT_ARCH), cuda, vulkan, "
                             "...; a missing GPU is an error, never a silent CPU fallback")
@@ -385,7 +386,7 @@ def _parser():
                    help="without (sections) and/or with dense sampling (energy, libration) "
                         "(default both)")
     s.add_argument("--methods", nargs="+", default=["cash-karp"],
-                   help="integration methods: cash-karp (default), dop853, or both")
+                   help="integration methods: cash-karp (default), dop853, vern9 (one or more)")
     s.add_argument("--perturbed", action="store_true",
                    help="also compile the variants with tides, YORP and BYORP in the "
                         "equations (--tide, --yorp, --byorp of the other commands)")

@@ -54,7 +54,7 @@ ANNOUNCE_MIN_S = 1.0
 #: The measurements, in the kernel cache folder (runtime.cache_folder()).
 RECORD_FILE = "compile_seconds.json"
 #: Methods warmup() accepts (the one place to extend when the kernels get more).
-METHODS = ("cash-karp", "dop853")   # kernels.tableau.METHODS (not imported: quiet import)
+METHODS = ("cash-karp", "dop853", "vern9")   # kernels.tableau.METHODS (not imported: quiet import)
 MODELS = ("planar", "3d")
 
 _SEEN = set()              # (runtime generation, arch, variant) compiled in this process

@@ -141,11 +141,12 @@ class Ensemble:
         (``kernels/planar.py``, about 3x cheaper per step), "3d" the general one; "auto"
         (default) takes the planar model when every member qualifies
         (``ti_spinorbit.planar.qualifies``). Inputs and outputs are 3-D states either way.
-    method : {"cash-karp", "dop853"}
+    method : {"cash-karp", "dop853", "vern9"}
         Runge-Kutta pair (``kernels/tableau.py``): "cash-karp" (default; Cash-Karp 4(5), the
-        paper's) or "dop853" (Hairer's 8(5,3) pair: fewer, longer steps; faster at tight
-        tolerances). Both hold the same error norm to ``rtol``; events, sampling, indicators,
-        checkpoints and both models work with either.
+        paper's), "dop853" (Hairer's 8(5,3) pair: fewer, longer steps; faster at tight
+        tolerances) or "vern9" (Verner's 9(8) pair, 16 stages: fewer steps still). All hold
+        the same error norm to ``rtol``; events, sampling, indicators, checkpoints and both
+        models work with each.
     perturbation_rows : (N, NPERT) array, optional
         Scaled tides / YORP / BYORP blocks (``ti_spinorbit.perturbations.perturbation_rows``):
         the kernels then integrate the perturbed equations and carry the work and external

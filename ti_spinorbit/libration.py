@@ -127,7 +127,7 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         As for :func:`~ti_spinorbit.section.time_series` (one launch).
     progress : bool or callable, optional
         As for :func:`~ti_spinorbit.section.surface_of_section` (:mod:`ti_spinorbit.progress`).
-    method : {"cash-karp", "dop853"}
+    method : {"cash-karp", "dop853", "vern9"}
         Runge-Kutta pair (:func:`~ti_spinorbit.section.time_series`).
     perturbations : list of Tides, YORP, BYORP, optional
         Tides, YORP and BYORP in the equations (docs/physics.md §13), as for

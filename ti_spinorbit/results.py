@@ -61,7 +61,7 @@ STATUS_NAMES = tuple(s.name.lower().replace("_", " ").replace("nonfinite", "non-
 
 # units shared by many fields
 SPIN = "mean motion n"                 # spin rates and frequencies in units of n
-METHOD = "name: Runge-Kutta pair ('cash-karp' or 'dop853')"
+METHOD = "name: Runge-Kutta pair ('cash-karp', 'dop853' or 'vern9')"
 STATUS = "status code (metadata status_codes)"
 CLASS = "label"
 RELATIVE = "1 (relative)"

@@ -357,10 +357,11 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         apsides, spin rate − ϖ̇; a start θ̇_p = 1.08 is then the paper's 1.08 (the integration
         starts at the inertial rate 1.08 + ϖ̇(0)). Needs e ≥ 1e-3
         (``coordinates.APSIDAL_MIN_ECCENTRICITY``); θ_p is the same in both.
-    method : {"cash-karp", "dop853"}
-        Runge-Kutta pair (``Ensemble``): "cash-karp" (default, the paper's Cash-Karp 4(5))
-        or "dop853" (Hairer's 8(5,3) pair: fewer steps, faster at tight tolerances; same
-        error norm held to rtol). Recorded in the result (``method``) and saved files.
+    method : {"cash-karp", "dop853", "vern9"}
+        Runge-Kutta pair (``Ensemble``): "cash-karp" (default, the paper's Cash-Karp 4(5)),
+        "dop853" (Hairer's 8(5,3) pair: fewer steps, faster at tight tolerances) or "vern9"
+        (Verner's 9(8) pair: fewer steps still; same error norm held to rtol). Recorded in
+        the result (``method``) and saved files.
     initial_states : InitialState or sequence of them, optional
         Explicit 3-D starts (:class:`ti_spinorbit.InitialState`, SI units, inertial frame;
         e.g. ``system.tilted_start(θ_p, θ̇_p, roll=...)``) instead of θ_p and θ̇_p (leave

@@ -38,7 +38,7 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     sampling : sequence of bool
         Without (sections) and/or with dense sampling (``time_series``, libration).
     methods : sequence of str
-        Integration methods among ``METHODS`` ("cash-karp", "dop853"); default the default
+        Integration methods among ``METHODS`` ("cash-karp", "dop853", "vern9"); default the default
         method only (each method is a separate set of compiles).
     perturbed : sequence of bool
         Without and/or with tides, YORP and BYORP in the equations (``perturbations=``,
