@@ -54,6 +54,13 @@ def make_primitives(tableau, n, unroll_components=True):
     12x30 matrix of SSA values carried through the state machine is what made LLVM slow; the
     3-D step is dominated by its right-hand side, so nothing is lost at run time). Per
     component the operations and their order are the same either way: bit-identical results.
+
+    K is taken by reference (``ti.template()``) by all three: a ``ti.func`` copies a matrix
+    argument passed by value, and in the runtime-loop form LLVM could not remove the copy, so
+    every stage evaluation copied the whole stage matrix (16 x 30 numbers for Verner's pair
+    on the 3-D model). Removing the copies made DOP853 and Verner 9(8) 17-25 % faster and
+    halved the 3-D compile, most of which was LLVM's SLP vectoriser working on those copies;
+    results are bit for bit the same (docs/design.md, "Taichi's CFG pass").
     """
     A = _padded_a(tableau)
     B, E = tableau.b, tableau.e
@@ -63,7 +70,7 @@ def make_primitives(tableau, n, unroll_components=True):
     unroll = bool(unroll_components)
 
     @ti.func
-    def stage_point(y, K, h, s):
+    def stage_point(y, K: ti.template(), h, s):
         ys = y
         for st in ti.static(range(1, stages)):
             if s == st:
@@ -98,7 +105,7 @@ def make_primitives(tableau, n, unroll_components=True):
                 K[s, c] = v[c]
 
     @ti.func
-    def combine(K, h):
+    def combine(K: ti.template(), h):
         dy = ti.Vector([0.0] * n, ti.f64)
         err = ti.Vector([0.0] * n, ti.f64)
         err3 = ti.Vector([0.0] * n, ti.f64)
