@@ -310,11 +310,11 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                             first_stage_pending = 0
                         stage += 1
                         if stage == _STAGES:
-                            dy, err, err3 = combine(K, hs)
+                            dy, err, err3 = combine(K, hs, True)
                             y_try = y + dy
                             if ti.static(indicators):
                                 if mode == _STEP:
-                                    dy_s, err_s, err3_s = combine(K2, hs)
+                                    dy_s, err_s, err3_s = combine(K2, hs, False)   # its step is never judged
                                     ys_try = y_s + dy_s
                             en = error_norm(y, y_try, err, err3, rtol, atol, NSTATE)
                             if mode == _STEP and en > 1.0:
