@@ -188,3 +188,27 @@ def test_warmup_knows_every_method():
     from ti_spinorbit.compiling import METHODS
     from ti_spinorbit.kernels.tableau import METHODS as kernel_methods
     assert tuple(METHODS) == tuple(kernel_methods)
+
+
+@pytest.mark.parametrize("method, stages", [("cash-karp", 6), ("dop853", 12), ("vern9", 16)])
+@pytest.mark.parametrize("indicators", [False, True])
+def test_first_stage_is_evaluated_inside_the_integrator(members, monkeypatch, method, stages,
+                                                        indicators):
+    """A fresh run's first stage comes from the integrator's own first pass (no separate
+    right-hand-side kernel), and is counted once, as before: one step that lands on a tiny
+    end time costs 1 (start) + (stages - 1) + 1 (the derivative at the end) evaluations, and
+    the shadow adds its stages and end point but not its start."""
+    from ti_spinorbit.kernels import ensemble as K
+
+    ens = Ensemble(*members, rtol=1e-10, model="planar", method=method)
+
+    def refuse(*args):
+        raise AssertionError("a fresh run launched evaluate_rhs")
+
+    monkeypatch.setattr(ens.kernels, "evaluate_rhs", refuse)
+    out = ens.run(1e-6, indicators=indicators)
+    assert (out.status == 1).all()
+    np.testing.assert_array_equal(out.counters[:, K.C_ACCEPTED], 1)
+    np.testing.assert_array_equal(out.counters[:, K.C_REJECTED], 0)
+    shadow = stages if indicators else 0
+    np.testing.assert_array_equal(out.counters[:, K.C_RHS], 1 + stages + shadow)
