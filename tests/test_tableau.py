@@ -215,18 +215,24 @@ T_END = 3.0                                   # about half an orbit, through per
 N_STEPS = np.array([24, 34, 48, 68, 96])
 
 
-def global_errors(run):
-    h = T_END / N_STEPS
-    y_end, _, _ = run(kepler_exact(0.0), h, N_STEPS)
+def global_errors(run, n_steps=N_STEPS):
+    h = T_END / n_steps
+    y_end, _, _ = run(kepler_exact(0.0), h, n_steps)
     exact = kepler_exact(T_END)
     return h, np.max(np.abs(y_end - exact), axis=1)
 
 
-def test_global_error_is_fifth_order(cash_karp_steps):
-    h, err = global_errors(cash_karp_steps)
-    assert np.all(err > 1e-12), err           # well above round-off: the fit sees truncation
+def global_slope(run, n_steps=N_STEPS, floor=1e-12):
+    """Slope of log error against log h over one Kepler orbit, after checking that every
+    error is above ``floor`` (round-off: the fit must see truncation) and falls with h."""
+    h, err = global_errors(run, n_steps)
+    assert np.all(err > floor), err
     assert np.all(np.diff(err) < 0), err
-    slope = np.polyfit(np.log(h), np.log(err), 1)[0]
+    return np.polyfit(np.log(h), np.log(err), 1)[0], err
+
+
+def test_global_error_is_fifth_order(cash_karp_steps):
+    slope, err = global_slope(cash_karp_steps)
     assert slope == pytest.approx(5.0, abs=0.3), (slope, err)
 
 
@@ -316,13 +322,7 @@ def dop853_steps():
 def test_dop853_global_error_is_eighth_order(dop853_steps):
     """Slope of log error against log h: 7.6 here (measured local slopes rise 7.2 -> 7.7
     towards 8 as h shrinks until round-off, at 1e-13, takes over), far from 5 or 7."""
-    n_steps = np.array([19, 24, 30, 38, 48])
-    h = T_END / n_steps
-    y_end, _, _ = dop853_steps(kepler_exact(0.0), h, n_steps)
-    err = np.max(np.abs(y_end - kepler_exact(T_END)), axis=1)
-    assert np.all(err > 3e-13), err
-    assert np.all(np.diff(err) < 0), err
-    slope = np.polyfit(np.log(h), np.log(err), 1)[0]
+    slope, err = global_slope(dop853_steps, np.array([19, 24, 30, 38, 48]), floor=3e-13)
     assert 7.4 < slope < 8.5, (slope, err)
 
 
@@ -420,13 +420,7 @@ def vern9_steps():
 def test_vern9_global_error_is_ninth_order(vern9_steps):
     """Slope of log error against log h: 9.06 here (local slopes 8.8-9.5), far from 8 or
     10; errors 9e-9 down to 3e-12, above round-off."""
-    n_steps = np.array([10, 12, 15, 19, 24])
-    h = T_END / n_steps
-    y_end, _, _ = vern9_steps(kepler_exact(0.0), h, n_steps)
-    err = np.max(np.abs(y_end - kepler_exact(T_END)), axis=1)
-    assert np.all(err > 1e-12), err
-    assert np.all(np.diff(err) < 0), err
-    slope = np.polyfit(np.log(h), np.log(err), 1)[0]
+    slope, err = global_slope(vern9_steps, np.array([10, 12, 15, 19, 24]))
     assert 8.6 < slope < 9.5, (slope, err)
 
 
