@@ -247,18 +247,22 @@ def test_slope_fit_tells_fourth_from_fifth_order():
     assert slope == pytest.approx(4.0, abs=0.3), (slope, err)
 
 
+def local_errors(run, h, t0=0.7):
+    """One step of each size h from the generic orbit point t0: the true local errors of the
+    propagated and of the embedded solution, and the size of the error estimate."""
+    y0 = kepler_exact(t0)
+    _, dy, err = run(y0, h, np.ones(len(h), dtype=np.int32))
+    exact = np.array([kepler_exact(t0 + hj) for hj in h]) - y0
+    return (np.max(np.abs(exact - dy), axis=1), np.max(np.abs(exact - (dy - err)), axis=1),
+            np.max(np.abs(err), axis=1))
+
+
 def test_local_error_estimate(cash_karp_steps):
     """One step from a generic point of the orbit: err = y5 − y4 scales like h^5, equals the
     true local error of the embedded 4th-order solution within 10 % (so it bounds it within a
     small factor), and the propagated 5th-order solution is locally O(h^6) and smaller still."""
-    t0 = 0.7
-    y0 = kepler_exact(t0)
     h = 0.1 * 2.0 ** (-np.arange(6) / 2)
-    _, dy, err = cash_karp_steps(y0, h, np.ones(len(h), dtype=np.int32))
-    exact = np.array([kepler_exact(t0 + hj) for hj in h]) - y0
-    true5 = np.max(np.abs(exact - dy), axis=1)
-    true4 = np.max(np.abs(exact - (dy - err)), axis=1)
-    est = np.max(np.abs(err), axis=1)
+    true5, true4, est = local_errors(cash_karp_steps, h)
     assert np.all(true5 > 1e-13), true5       # the smallest local error still above round-off
     slope = {name: np.polyfit(np.log(h), np.log(v), 1)[0]
              for name, v in (("est", est), ("true4", true4), ("true5", true5))}
@@ -429,14 +433,8 @@ def test_vern9_error_estimate_is_the_eighth_order_error(vern9_steps):
     embedded 8th-order solution within 3 % (measured 0.2-1.7 %), the propagated 9th-order
     solution's local error is below a tenth of it (measured 1.4-4 %), and the estimate's
     slope is 9.5 at these h (its h^10 term still counts; 10.3 for the 9th-order error)."""
-    t0 = 0.7
-    y0 = kepler_exact(t0)
     h = 0.5 * 2.0 ** (-np.arange(5) / 2)
-    _, dy, err = vern9_steps(y0, h, np.ones(len(h), dtype=np.int32))
-    exact = np.array([kepler_exact(t0 + hj) for hj in h]) - y0
-    true9 = np.max(np.abs(exact - dy), axis=1)
-    true8 = np.max(np.abs(exact - (dy - err)), axis=1)
-    est = np.max(np.abs(err), axis=1)
+    true9, true8, est = local_errors(vern9_steps, h)
     assert np.all(true9 > 1e-14), true9
     ratio = est / true8
     assert np.all((ratio > 0.97) & (ratio < 1.03)), ratio
