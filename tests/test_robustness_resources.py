@@ -77,6 +77,29 @@ def test_record_width_of_the_model_a_run_will_use(vh, model, systems, width):
     assert resources.record_width(vh if systems == "one" else [vh, vh], model) == width
 
 
+@pytest.mark.parametrize("model, width", [("planar", 15), ("3d", 35)])
+def test_perturbed_runs_count_their_accumulator_columns(vh, monkeypatch, model, width):
+    """With tides, YORP or BYORP the records carry the work and external-angular-momentum
+    accumulators (4 more columns), and the entry points' early check counts them: the width
+    it sizes with equals the kernels' own record width of the perturbed variant."""
+    from ti_spinorbit.kernels import ensemble as K
+
+    kernels = K.kernels_for(model, perturbed=True)
+    assert resources.record_width(vh, model, perturbed=True) == width == kernels.RECORD_WIDTH
+    widths = []
+    checked = resources.check_memory
+
+    def spy(*args, **kwargs):
+        widths.append(kwargs.get("width"))
+        return checked(*args, **kwargs)
+
+    monkeypatch.setattr(resources, "check_memory", spy)
+    tide = tso.Tides(k2=1e-5, time_lag=600.0)
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=0.1, model=model, perturbations=[tide])
+    tso.chaos_map(vh, [0.0], [1.0], orbits=0.1, model=model, perturbations=[tide])
+    assert len(widths) >= 2 and set(widths) == {width}   # the map checks its nested runs too
+
+
 # ---- 2. absurd sizes are refused before any member is built ---------------------------------
 
 def _no_members(*args, **kwargs):

@@ -283,13 +283,14 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     from .models import check_indicator_space
     indicator_space = check_indicator_space(indicator_space)
     tilt = _check_tilt(tilt, client, coordinates)
+    perturbations = check_perturbations(perturbations)
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
                            advice="use a coarser grid or fewer orbits",
                            width=resources.record_width(system, "3d" if (
-                               indicator_space == "full" or tilt is not None) else model))
+                               indicator_space == "full" or tilt is not None) else model,
+                               bool(perturbations)))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     section_kwargs["indicator_space"] = indicator_space
-    perturbations = check_perturbations(perturbations)
     section_kwargs["perturbations"] = perturbations
     if tilt is not None:     # explicit tilted starts instead of the (θ_p, θ̇_p) grid
         section_kwargs["initial_states"] = [

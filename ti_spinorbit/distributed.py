@@ -119,12 +119,13 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         system_or_systems, theta_p, thetadot_p, orbits, **kwargs)
     call.apply_defaults()
     section.check_orbits(orbits)
-    section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits)
+    from .perturbations import check_perturbations
+    kwargs["perturbations"] = check_perturbations(call.arguments["perturbations"])
+    section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits,
+                       perturbed=bool(kwargs["perturbations"]))
     check_tolerances(call.arguments["rtol"], call.arguments["atol"])
     from .kernels.tableau import check_method
     check_method(call.arguments["method"])
-    from .perturbations import check_perturbations
-    kwargs["perturbations"] = check_perturbations(call.arguments["perturbations"])
     if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
                          "would share one file); failed chunks are retried instead")

@@ -95,24 +95,27 @@ def check_memory(what, members, orbits, samples_per_orbit=None, window_orbits=16
     return require_memory(what, nbytes, advice, available=available)
 
 
-def record_width(system, model="auto"):
+def record_width(system, model="auto", perturbed=False):
     """Width of the kernels' record rows for members of ``system`` under ``model``: the
     planar model's (11) when "auto" will choose it (a BinarySystem whose start is planar and
     bodies equatorially symmetric) or "planar" is asked, else the 3-D one (31; also when
-    ``system`` is a list, not yet known)."""
+    ``system`` is a list, not yet known); with ``perturbed`` (tides, YORP or BYORP) the
+    records also carry the NACC work and external-angular-momentum accumulators (15, 35)."""
     from . import planar
     from .kernels import ensemble as K
+    from .perturbations import NACC
     from .systems import BinarySystem
 
+    extra = NACC if perturbed else 0
     if model == "planar":
-        return K.PLANAR.RECORD_WIDTH
+        return K.PLANAR.RECORD_WIDTH + extra
     if model != "auto" or not isinstance(system, BinarySystem):
-        return K.SPATIAL.RECORD_WIDTH
+        return K.SPATIAL.RECORD_WIDTH + extra
     try:
         ok = planar.qualifies(system.parameter_row(), system.initial_state(0.0, 1.0))
     except (ValueError, TypeError, ArithmeticError):
-        return K.SPATIAL.RECORD_WIDTH
-    return K.PLANAR.RECORD_WIDTH if np.all(ok) else K.SPATIAL.RECORD_WIDTH
+        return K.SPATIAL.RECORD_WIDTH + extra
+    return (K.PLANAR.RECORD_WIDTH if np.all(ok) else K.SPATIAL.RECORD_WIDTH) + extra
 
 
 def member_count(shape, *arrays):

@@ -62,7 +62,7 @@ def _check_run_inputs(rtol, atol, order, progress, window_orbits):
 
 
 def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None,
-               model="auto"):
+               model="auto", perturbed=False):
     """Refuse a run whose estimated peak memory (``resources.estimate_bytes``) exceeds what
     is available, from the input sizes alone: before any member is built. Inputs that do
     not broadcast are left to :func:`build_members`, which names them."""
@@ -73,7 +73,7 @@ def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None
     n = None if systems is None else resources.member_count(systems, theta_p, thetadot_p)
     if n is not None:
         resources.check_memory(what, n, orbits, samples_per_orbit,
-                               width=resources.record_width(system, model))
+                               width=resources.record_width(system, model, perturbed))
 
 
 def _system_argument(system):
@@ -187,14 +187,15 @@ def state_members(system: SystemLike, initial_states, escape_distance=ESCAPE_DIS
 
 
 def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordinates, order,
-             initial_states, samples_per_orbit=None, model="auto"):
+             initial_states, samples_per_orbit=None, model="auto", perturbed=False):
     """The member table of an entry point, from (θ_p, θ̇_p) or from ``initial_states``,
-    after the memory check."""
+    after the memory check (``perturbed``: the records carry the accumulators too)."""
     if initial_states is None:
         if theta_p is None and thetadot_p is None:     # one None: build_members names it
             raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
                             "initial_states=[InitialState, ...]")
-        check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit, model)
+        check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit, model,
+                   perturbed)
         return build_members(system, theta_p, thetadot_p, escape_distance, coordinates, order)
     if theta_p is not None or thetadot_p is not None:
         raise ValueError(f"{what}: give theta_p and thetadot_p or initial_states, not both")
@@ -204,7 +205,7 @@ def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordin
     count = 1 if not isinstance(initial_states, (list, tuple, np.ndarray)) else len(initial_states)
     if count == 0:
         raise ValueError("initial_states must hold at least one InitialState")
-    check_size(what, system, np.zeros(count), 0.0, orbits, samples_per_orbit, "3d")
+    check_size(what, system, np.zeros(count), 0.0, orbits, samples_per_orbit, "3d", perturbed)
     return state_members(system, initial_states, escape_distance)
 
 
@@ -399,11 +400,12 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
             raise ValueError("indicator_space='full' needs the 3-D model (the planar model "
                              "cannot carry out-of-plane deviations): use model='auto' or '3d'")
         model = "3d" if model == "auto" else model
+    perturbations = check_perturbations(perturbations)
     members, par, y0, tp, td = _members("surface_of_section", system, theta_p, thetadot_p,
                                         orbits, escape_distance, coordinates, order,
-                                        initial_states, model=model)
+                                        initial_states, model=model,
+                                        perturbed=bool(perturbations))
     _warn_near_circular(members)
-    perturbations = check_perturbations(perturbations)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
                    perturbation_rows=perturbation_rows(members, perturbations))
     with _progress.reporting(progress, "surface_of_section") as report:
@@ -652,10 +654,11 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     if not isinstance(states, (bool, np.bool_)):
         raise TypeError(f"states must be True or False (got {show(states)})")
+    perturbations = check_perturbations(perturbations)
     members, par, y0, tp, td = _members("time_series", system, theta_p, thetadot_p, orbits,
                                         escape_distance, coordinates, order, initial_states,
-                                        samples_per_orbit * (2 if states else 1), model)
-    perturbations = check_perturbations(perturbations)
+                                        samples_per_orbit * (2 if states else 1), model,
+                                        bool(perturbations))
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
                    perturbation_rows=perturbation_rows(members, perturbations))
     with _progress.reporting(progress, "time_series") as report:
