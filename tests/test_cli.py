@@ -379,6 +379,8 @@ def test_warmup_refuses_an_unknown_method(capsys):
     (["map", "--yorp", "5e-4", "--yorp-body", "primary", "--byorp", "1e-3", "--heliocentric",
       "1.1", "0.2"], "map_1991VH_yorp0.0005_yorp-primary_byorp0.001_helio1.1-0.2"),
     (["libration", "--tide", "secondary", "--strength", "1"], "libration_Didymos_tide-secondary"),
+    (["section", "--tide", "secondary", "--tide-radius", "150"],
+     "sos_1991VH_tide-secondary_Rtide150"),
 ])
 def test_default_names_carry_the_perturbations(argv, stem):
     args = cli._parser().parse_args(argv)
@@ -407,6 +409,9 @@ def test_default_names_carry_the_perturbations(argv, stem):
     (["--system", "test", "--yorp", "1e-3"],
      "--yorp: no heliocentric orbit is catalogued for 'test': pass --heliocentric A_AU E"),
     (["--tide", "both"], "argument --tide: invalid choice: 'both'"),
+    (["--tide-radius", "150"], "--tide-radius needs --tide primary|secondary"),
+    (["--yorp-radius", "150"], "--yorp-radius needs --yorp (the YORP coefficient)"),
+    (["--byorp", "1e-3", "--byorp-radius", "0"], "--byorp-radius must lie in [0.001, 1e+10]"),
 ])
 def test_bad_perturbation_flags_one_line_exit_2(flags, message, tmp_path, capsys):
     out = str(tmp_path / "x.png")
@@ -414,6 +419,29 @@ def test_bad_perturbation_flags_one_line_exit_2(flags, message, tmp_path, capsys
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1
     assert not os.path.exists(out)
+
+
+def test_tide_radius_flag_for_a_body_given_by_its_integrals(tmp_path, capsys):
+    """A --system file whose secondary has inertia integrals but no semi-axes has no radius
+    to default to: --tide asks for --tide-radius in one line, and with it the run saves it."""
+    import json
+
+    vh = tso.catalog.system("1991 VH")
+    d = vh.describe()
+    del d["secondary"]["semi_axes_m"]
+    d["secondary"]["integrals"] = {",".join(map(str, k)): v
+                                   for k, v in vh.secondary.integrals.items()}
+    path = tmp_path / "vh_integrals.json"
+    path.write_text(json.dumps(d))
+    run = ["section", "--system", str(path), "--thetadot", "0.83", "--orbits", "1", "--rtol",
+           "1e-9", "--tide", "secondary", "--k2", "1e-5", "--time-lag", "600"]
+    assert cli.main(run + ["--out", str(tmp_path / "a.png")]) == cli.EXIT_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and ("--tide: the secondary is not an ellipsoid or sphere, so "
+                                      "its radius is undefined: give --tide-radius M") in err
+    assert cli.main(run + ["--tide-radius", "150", "--out", str(tmp_path / "b.png")]) == 0
+    saved = tso.load(tmp_path / "b.npz")
+    assert saved.perturbations == (tso.Tides(k2=1e-5, time_lag=600.0, radius=150.0),)
 
 
 def test_section_with_a_tide_prints_and_saves_it(tmp_path, capsys):

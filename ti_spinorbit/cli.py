@@ -90,6 +90,9 @@ FLAG_RANGES = {
     "yorp": ("--yorp", -_pert.COEFFICIENT_LIMIT, _pert.COEFFICIENT_LIMIT, False, False),
     "byorp": ("--byorp", -_pert.COEFFICIENT_LIMIT, _pert.COEFFICIENT_LIMIT, False, False),
     "strength": ("--strength", *_pert.STRENGTH_RANGE, False, False),
+    "tide_radius": ("--tide-radius", *_pert.RADIUS_RANGE, False, False),
+    "yorp_radius": ("--yorp-radius", *_pert.RADIUS_RANGE, False, False),
+    "byorp_radius": ("--byorp-radius", *_pert.RADIUS_RANGE, False, False),
 }
 #: --heliocentric A_AU E: the binary's heliocentric orbit for --yorp / --byorp.
 HELIOCENTRIC_A_RANGE = _pert.HELIOCENTRIC_A_RANGE
@@ -263,6 +266,12 @@ def _parser():
                        help="the body --yorp acts on (default secondary)")
         g.add_argument("--byorp", type=float, default=None, metavar="B",
                        help="BYORP coefficient B in [-1, 1] (> 0 expands the orbit)")
+        for kind, whose in (("tide", "the --tide body"), ("yorp", "the --yorp-body"),
+                            ("byorp", "the secondary, for --byorp")):
+            g.add_argument(f"--{kind}-radius", type=float, default=None, metavar="M",
+                           help=f"radius of {whose}, m, in [1e-3, 1e10] (default its "
+                                "volume-equivalent radius (abc)^(1/3); needed when a "
+                                "--system file gives the body by its inertia integrals)")
         g.add_argument("--strength", type=float, default=1.0,
                        help="factor on every perturbation's force and torque, in [1e-12, "
                             "1e15] (default 1; 1e6 makes a million years act in one)")
@@ -591,12 +600,13 @@ def _perturbations(args):
     out = []
     if args.tide is not None:
         out.append(Tides(body=args.tide, k2=args.k2, time_lag=args.time_lag, Q=args.Q,
-                         strength=args.strength))
+                         radius=args.tide_radius, strength=args.strength))
     if args.yorp is not None:
-        out.append(YORP(body=args.yorp_body, coefficient=args.yorp, strength=args.strength,
-                        **sun))
+        out.append(YORP(body=args.yorp_body, coefficient=args.yorp, radius=args.yorp_radius,
+                        strength=args.strength, **sun))
     if args.byorp is not None:
-        out.append(BYORP(coefficient=args.byorp, strength=args.strength, **sun))
+        out.append(BYORP(coefficient=args.byorp, radius=args.byorp_radius,
+                         strength=args.strength, **sun))
     return out
 
 
@@ -607,9 +617,13 @@ def _check_perturbation_flags(args):
     if not hasattr(args, "tide"):
         return
     if args.tide is None:
-        for dest, flag in (("k2", "--k2"), ("time_lag", "--time-lag"), ("Q", "--Q")):
+        for dest, flag in (("k2", "--k2"), ("time_lag", "--time-lag"), ("Q", "--Q"),
+                           ("tide_radius", "--tide-radius")):
             if getattr(args, dest) is not None:
                 raise ValueError(f"{flag} needs --tide primary|secondary (the body that deforms)")
+    for kind in ("yorp", "byorp"):
+        if getattr(args, f"{kind}_radius") is not None and getattr(args, kind) is None:
+            raise ValueError(f"--{kind}-radius needs --{kind} (the {kind.upper()} coefficient)")
     if args.time_lag is not None and args.Q is not None:
         raise ValueError("--time-lag and --Q exclude each other: the tide has a constant time "
                          "lag or a constant Q, give one")
@@ -639,6 +653,7 @@ def _check_perturbation_flags(args):
         except ValueError as exc:
             text = _one_line(exc).replace("pass heliocentric_a_au (AU) and heliocentric_e to "
                                           "YORP / BYORP", "pass --heliocentric A_AU E")
+            text = text.replace("pass radius= (m) to the perturbation", f"give {flag}-radius M")
             raise ValueError(f"{flag}: {text}") from None
 
 
@@ -779,7 +794,8 @@ def _system(args):
 #: (--max-orbits), rtol1e-13, tilt5-0-0, sxy0-0.1, inc10; --model, --coordinates, --method and
 #: --indicator-space by their value alone (3d, apsidal, dop853, full); tides, YORP and BYORP:
 #: tide-secondary (--tide), k2 (--k2), dt600 (--time-lag), Q100 (--Q), yorp0.0005 (--yorp),
-#: yorp-primary (--yorp-body), byorp1e-3, str1e6 (--strength), helio1.1-0.2 (--heliocentric).
+#: yorp-primary (--yorp-body), byorp1e-3, str1e6 (--strength), helio1.1-0.2 (--heliocentric),
+#: Rtide150 (--tide-radius; Ryorp, Rbyorp likewise).
 #: --max-drift, --arch and output flags change no physics: not named.
 NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("elongations", "ab"), ("theta_p", "tp"), ("thetadot", "td"), ("grid", "g"),
@@ -789,7 +805,8 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"),
              ("indicator_space", ""), ("tide", "tide-"), ("k2", "k2"), ("time_lag", "dt"),
              ("Q", "Q"), ("yorp", "yorp"), ("yorp_body", "yorp-"), ("byorp", "byorp"),
-             ("strength", "str"), ("heliocentric", "helio"))
+             ("strength", "str"), ("heliocentric", "helio"), ("tide_radius", "Rtide"),
+             ("yorp_radius", "Ryorp"), ("byorp_radius", "Rbyorp"))
 
 
 def default_stem(args, prefix, system_name):
