@@ -29,43 +29,29 @@ CHECKED_VERSIONS = ((1, 7),)
 _ATTRIBUTE = "_ti_spinorbit_memo"
 
 
-def _key(ctx, node):
+def _position_key(ctx, node):
+    """Everything ``get_pos_info(ctx, node)`` depends on."""
     return (ctx.file, ctx.func.func.__name__, ctx.lineno_offset, ctx.indent, type(node),
             node.lineno, node.col_offset, getattr(node, "end_lineno", None),
             getattr(node, "end_col_offset", None))
 
 
-def memoise(original):
-    """``get_pos_info`` wrapped with a cache keyed on everything its result depends on."""
+def memoise(original, key):
+    """``original`` wrapped with a cache on ``key(*args)`` (its result depends on nothing
+    else); the wrapper keeps ``__wrapped__`` and its ``cache`` for the tests."""
     cache = {}
 
-    def get_pos_info(self, node):
-        key = _key(self, node)
-        text = cache.get(key)
-        if text is None:
-            text = cache[key] = original(self, node)
-        return text
-
-    get_pos_info.__wrapped__ = original
-    get_pos_info.cache = cache
-    setattr(get_pos_info, _ATTRIBUTE, True)
-    return get_pos_info
-
-
-def memoise_source(original):
-    """``getsourcelines`` wrapped with a cache keyed on the function object."""
-    cache = {}
-
-    def getsourcelines(func):
-        found = cache.get(func)
+    def memoised(*args):
+        k = key(*args)
+        found = cache.get(k)
         if found is None:
-            found = cache[func] = original(func)
+            found = cache[k] = original(*args)
         return found
 
-    getsourcelines.__wrapped__ = original
-    getsourcelines.cache = cache
-    setattr(getsourcelines, _ATTRIBUTE, True)
-    return getsourcelines
+    memoised.__wrapped__ = original
+    memoised.cache = cache
+    setattr(memoised, _ATTRIBUTE, True)
+    return memoised
 
 
 def install():
@@ -80,12 +66,14 @@ def install():
         from taichi.lang.ast.ast_transformer_utils import ASTTransformerContext
     except ImportError:
         return False
-    targets = ((ASTTransformerContext, "get_pos_info", memoise),
-               (kernel_impl, "getsourcelines", memoise_source))
+    # get_pos_info: the source-position string of a node; getsourcelines: a function's
+    # source (it cannot change under the function object; a reloaded module makes new ones)
+    targets = ((ASTTransformerContext, "get_pos_info", _position_key),
+               (kernel_impl, "getsourcelines", lambda func: func))
     if any(getattr(owner, name, None) is None for owner, name, _ in targets):
         return False
-    for owner, name, wrap in targets:
+    for owner, name, key in targets:
         current = getattr(owner, name)
         if not getattr(current, _ATTRIBUTE, False):
-            setattr(owner, name, wrap(current))
+            setattr(owner, name, memoise(current, key))
     return True
