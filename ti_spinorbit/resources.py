@@ -106,16 +106,16 @@ def record_width(system, model="auto", perturbed=False):
     from .perturbations import NACC
     from .systems import BinarySystem
 
-    extra = NACC if perturbed else 0
+    width = K.SPATIAL.RECORD_WIDTH
     if model == "planar":
-        return K.PLANAR.RECORD_WIDTH + extra
-    if model != "auto" or not isinstance(system, BinarySystem):
-        return K.SPATIAL.RECORD_WIDTH + extra
-    try:
-        ok = planar.qualifies(system.parameter_row(), system.initial_state(0.0, 1.0))
-    except (ValueError, TypeError, ArithmeticError):
-        return K.SPATIAL.RECORD_WIDTH + extra
-    return (K.PLANAR.RECORD_WIDTH if np.all(ok) else K.SPATIAL.RECORD_WIDTH) + extra
+        width = K.PLANAR.RECORD_WIDTH
+    elif model == "auto" and isinstance(system, BinarySystem):
+        try:
+            if np.all(planar.qualifies(system.parameter_row(), system.initial_state(0.0, 1.0))):
+                width = K.PLANAR.RECORD_WIDTH
+        except (ValueError, TypeError, ArithmeticError):
+            pass                            # left to the entry point's own checks: 3-D
+    return width + (NACC if perturbed else 0)
 
 
 def member_count(shape, *arrays):
