@@ -169,7 +169,7 @@ NUMBA_RTOLS = (1e-12, 1e-15)      # the baseline's tolerances (issue 13 §1)
 ACCURACY_REFERENCE_RTOL = 1e-16   # numba DOP853, the tight reference of the accuracy section
 TARGET_SPEEDUP = 300.0            # over the scipy baseline
 # issue 13 §2: cold compile of every variant (model x method x indicators, each in a fresh
-# process with an empty kernel cache: integrator, right-hand side and diagnostics kernels)
+# process with an empty kernel cache: the integrator and diagnostics kernels)
 # <= 25 s and <= 2x "the planar one" (the planar default: Cash-Karp without indicators, what
 # the README's first command compiles); warm start (fresh process, warm cache, import to the
 # first result of a one-orbit section) <= 1 s for each model.
@@ -821,7 +821,8 @@ def bench_accuracy(models, methods, rtols, members, orbits, numba_rtols=()):
 
 def bench_first_result(arch, repeat, cold, models=("planar",)):
     """Fresh processes, per model: with ``cold``, a run with a new empty kernel cache and
-    then ``repeat`` runs with it warm; else ``repeat`` runs with the default cache folder."""
+    then max(``repeat``, 3) runs with it warm (the best is the warm-start figure); else those
+    warm runs with the default cache folder."""
     runs = []
     for model in models:
         code = CHILD_FIRST_RESULT.format(system=SYSTEM, elongation=ELONGATION, model=model)
@@ -840,7 +841,7 @@ def bench_compile(arch, models, methods, repeat):
     """Cold compile of every variant (model x method x indicators, sampling off): each in a
     fresh process with a new empty kernel cache (``repeat`` times, the fastest kept), then
     its load from that cache in another fresh process. Kernel seconds are tso.warmup's
-    (integrator, right-hand side and diagnostics kernels; imports and ti.init excluded)."""
+    (the integrator and diagnostics kernels; imports and ti.init excluded)."""
     rows = []
     for model in models:
         for method in methods:
@@ -1137,7 +1138,7 @@ def print_report(result):
                     "against a tight reference, median and max over members",
         "compile": "each kernel variant in a fresh process with a new empty kernel cache "
                    "(cold), then loaded from it in another fresh process; kernel seconds "
-                   "(integrator, right-hand side, diagnostics) and the whole process"}
+                   "(integrator and diagnostics) and the whole process"}
     for name, columns in TABLES.items():
         if s.get(name):
             print(f"\n[{name}] {captions[name]}")

@@ -269,7 +269,8 @@ def _parser():
         for kind, whose in (("tide", "the --tide body"), ("yorp", "the --yorp-body"),
                             ("byorp", "the secondary, for --byorp")):
             g.add_argument(f"--{kind}-radius", type=float, default=None, metavar="M",
-                           help=f"radius of {whose}, m, in [1e-3, 1e10] (default its "
+                           help=f"radius of {whose}, m, in [{_pert.RADIUS_RANGE[0]:g}, "
+                                f"{_pert.RADIUS_RANGE[1]:g}] (default its "
                                 "volume-equivalent radius (abc)^(1/3); needed when a "
                                 "--system file gives the body by its inertia integrals)")
         g.add_argument("--strength", type=float, default=1.0,

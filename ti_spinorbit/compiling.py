@@ -202,7 +202,7 @@ class FirstUse:
     """``kernel`` (the integrator kernel, ``advance``) wrapped so that the first use of
     ``variant`` in this process is announced, compiled by a compile-only launch before the
     real one, and timed. ``other_kernels()`` wraps the run's first calls of the other kernels
-    (right-hand side, diagnostics), whose first use also compiles (or loads) them: their time
+    (diagnostics), whose first use also compiles (or loads) them: their time
     counts as compile time too. ``status`` is the members' status array, or a function
     returning it (the array the launch will be given). ``take_seconds()`` returns (and resets) the integrator
     kernel's compile time, which the caller keeps out of its own clock."""

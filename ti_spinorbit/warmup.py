@@ -27,7 +27,7 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     later processes through the disk cache) start without waiting.
 
     Each variant is run once on one member of 1991 VH for 0.01 orbit (which also compiles
-    the right-hand side and diagnostics kernels it uses).
+    the diagnostics kernel it uses; the integrator evaluates its own first stage).
 
     Parameters
     ----------
@@ -54,8 +54,7 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     list of dict
         One per variant: ``variant``, ``how`` ("compiled", "loaded" from the disk cache, or
         "ready" already in this process), ``kernel_seconds`` (the compile or load of the
-        kernels this variant uses first: integrator, and right-hand side and diagnostics when
-        not used before) and ``seconds`` (the whole first run).
+        kernels this variant uses first: integrator, and diagnostics when not used before) and ``seconds`` (the whole first run).
     """
     import itertools
     import sys
