@@ -181,23 +181,62 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 st = ESCAPE                     # unbound and receding
         return st
 
+    # Whole-state copies (loads, stores, records, a stage row): unrolled when the state lives
+    # in registers (``unroll_components``), else runtime loops over the components. Taichi
+    # lowers every unrolled assignment by rescanning the whole kernel (quadratic in its size),
+    # so the 3-D kernels' dozen 30-component copies cost 0.1-0.2 s of compile each; the copies
+    # are exact either way.
     @ti.func
     def _load(a: ti.template(), i):
         y = state(0.0)
-        for k in ti.static(range(NK)):
-            y[k] = a[i, k]
+        if ti.static(unroll_components):
+            for k in ti.static(range(NK)):
+                y[k] = a[i, k]
+        else:
+            for k in range(NK):
+                y[k] = a[i, k]
         return y
 
     @ti.func
     def _store(a: ti.template(), i, y):
-        for k in ti.static(range(NK)):
-            a[i, k] = y[k]
+        if ti.static(unroll_components):
+            for k in ti.static(range(NK)):
+                a[i, k] = y[k]
+        else:
+            for k in range(NK):
+                a[i, k] = y[k]
 
     @ti.func
     def _record(buf: ti.template(), i, slot, t, y):
         buf[i, slot, 0] = t
-        for k in ti.static(range(NK)):
-            buf[i, slot, 1 + k] = y[k]
+        if ti.static(unroll_components):
+            for k in ti.static(range(NK)):
+                buf[i, slot, 1 + k] = y[k]
+        else:
+            for k in range(NK):
+                buf[i, slot, 1 + k] = y[k]
+
+    @ti.func
+    def _set_first_stage(K: ti.template(), v):
+        """Row 0 of the stage matrix K = v."""
+        if ti.static(unroll_components):
+            for k in ti.static(range(NK)):
+                K[0, k] = v[k]
+        else:
+            for k in range(NK):
+                K[0, k] = v[k]
+
+    @ti.func
+    def _first_stage(K: ti.template()):
+        """Row 0 of the stage matrix K (the first stage) as a state vector."""
+        v = state(0.0)
+        if ti.static(unroll_components):
+            for k in ti.static(range(NK)):
+                v[k] = K[0, k]
+        else:
+            for k in range(NK):
+                v[k] = K[0, k]
+        return v
 
     @ti.kernel
     def advance(par: nd2f, y_nd: nd2f, yc_nd: nd2f, f_nd: nd2f, t_nd: nd1f, tc_nd: nd1f,
@@ -234,8 +273,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 after_reject = 0
                 K = kmat(0.0)
                 if first_stage_pending == 0:
-                    for c in ti.static(range(NK)):
-                        K[0, c] = f0[c]
+                    _set_first_stage(K, f0)
                 # shadow trajectory (chaos indicators): same steps, its own stages in K2
                 y_s = state(0.0)
                 ys_try = state(0.0)
@@ -247,8 +285,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 if ti.static(indicators):
                     y_s = _load(shadow_nd, i)
                     if first_stage_pending == 0:
-                        for c in ti.static(range(NK)):
-                            K2[0, c] = shadow_f_nd[i, c]
+                        _set_first_stage(K2, _load(shadow_f_nd, i))
                     ell = ind[i, 0]
                     s_weighted = ind[i, 1]
                     ybar_int = ind[i, 2]
@@ -363,8 +400,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                             tc = 0.0
                             t = ti.select(hit_end == 1, ts, next_sample[i])
                         f0 = fy
-                        for c in ti.static(range(NK)):
-                            K[0, c] = fy[c]
+                        _set_first_stage(K, fy)
                         if ti.static(indicators):
                             dl, ys_new, fs_new, grew = _renormalised_shadow(y, ys_try, fy, f_s1,
                                                                             d0)
@@ -373,8 +409,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 s_weighted += t_mid * dl
                                 ybar_int += 2.0 * s_weighted / t * hs
                                 y_s = ys_new
-                                for c in ti.static(range(NK)):
-                                    K2[0, c] = fs_new[c]
+                                _set_first_stage(K2, fs_new)
                         acc += 1
                         # (a step shortened for a sample or the end that did well keeps h)
                         h = ctl.accepted(h, hs, en, after_reject, hit_end == 1 or hit_sample == 1,
@@ -392,8 +427,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 _store(f_nd, i, f0)
                 if ti.static(indicators):
                     _store(shadow_nd, i, y_s)
-                    for c in ti.static(range(NK)):
-                        shadow_f_nd[i, c] = K2[0, c]
+                    _store(shadow_f_nd, i, _first_stage(K2))
                     ind[i, 0] = ell
                     ind[i, 1] = s_weighted
                     ind[i, 2] = ybar_int
