@@ -186,8 +186,9 @@ RHS_PERTURBATION = 1e-12          # RHS-only loop: next argument y0 + this · f(
 # after removing what the compiler removes (dead code: the potential's value, which dy/dt
 # does not use; the cos/sin 3ψ and order-3 terms; common subexpressions). One add, subtract,
 # multiply, divide or square root = 1 flop; negations free. Check: the optimised LLVM IR of
-# each model's evaluate_rhs (Taichi 1.7.4, x64, fast_math off) holds 138 (planar) and 832
-# (3-D) scalar fadd/fsub/fmul/fdiv/sqrt, no vector operations.
+# each model's evaluate_rhs (Taichi 1.7.4, x64, fast_math off) holds 140 (planar) and 768
+# (3-D) scalar fadd/fsub/fmul/fdiv/sqrt, no vector operations (the 3-D count 4 % under the
+# hand count: LLVM shares a few products the count repeats).
 #
 # planar, kernels/planar.py                                                                     141
 #   1/r 1 (the only division), start of V_r 2                                                     3
@@ -197,7 +198,7 @@ RHS_PERTURBATION = 1e-12          # RHS-only loop: next argument y0 + this · f(
 #     V_r 4, V_A 3, V_B 3                                                                        39
 #   rhs_member: dλ/dt 2, dψ_A/dt and dψ_B/dt 4, dv_r/dt 4, dℓ/dt 2, cos/sin rates 4,
 #     spins 2                                                                                    18
-# 3-D, kernels/eom.py + kernels/potential.py (G = 1 folds away)                                 835
+# 3-D, kernels/eom.py + kernels/potential.py (G = 1 folds away)                                 799
 #   eom.rhs around the potential: Ω1 3, Ω2 = S I2⁻¹ Sᵀ w2 33, dR/dt 12, dV/dt 15,
 #     dw1/dt 15, dw2/dt 15 (3 divisions each), Ω2 − Ω1 3, dS/dt 27, dS1/dt 27                   150
 #   mutual: R·R 5, sqrt 1, 1/r 1, e 3, ∇(mA mB/r) 6                                              16
@@ -205,11 +206,11 @@ RHS_PERTURBATION = 1e-12          # RHS-only loop: next argument y0 + this · f(
 #       the 6 even 4th-order monomials and their gradient 51, the K diagonal 6,
 #       K u 15 (a full 3×3 product: 0·x does not fold), L4 12, ∇L4 9); two bodies 236           251
 #     order 2: 1/r², 1/r³ 2, S ∇L2_B 15, U2 3, ∇U2 9, ∂U/∂R 27, torque on B 9                    65
-#     order 4: J'_B = S J_B Sᵀ 90, traces 4, J_A e 3, J'_B e 15, a, b 10, X 24,
+#     order 4: J'_B = S J_B Sᵀ 54 (S_rk j_k 9, 9 entries of 5), traces 4, J_A e 3, J'_B e 15, a, b 10, X 24,
 #       J_A J'_B e 3, J'_B J_A e 15, ∇X 36, S ∇L4_B 15, U4 4, ∇U4 12, 1/r⁵ 1,
-#       ∂U/∂R 27, torque on B 9, ε_AB 6, quadrupole-quadrupole torque 55                        329
+#       ∂U/∂R 27, torque on B 9, ε_AB 6, quadrupole-quadrupole torque 55                        293
 #     μ2 += e × τ 12, μ1 = R × ∂U/∂R − μ2 12                                                     24
-FLOPS_PER_RHS = {"planar": 141, "3d": 835}
+FLOPS_PER_RHS = {"planar": 141, "3d": 799}
 
 FULL = dict(sizes=(1, 16, 256, 1024, 4096, 16384), seconds=2.0, min_orbits=1.0,
             split_members=4096, rhs_seconds=1.0, window_orbits=2.0 * max(WINDOWS),

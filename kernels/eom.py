@@ -25,7 +25,7 @@ import taichi as ti
 from ti_spinorbit.bodies import ROW_LENGTH
 
 from . import perturb
-from .potential import mutual, vec3, mat3
+from .potential import mat_t_vec, mat_vec, mutual, vec3, mat3
 
 NSTATE = 30
 state = ti.types.vector(NSTATE, ti.f64)
@@ -72,8 +72,8 @@ def angular_velocities(p: ti.template(), i, y):
     w2 = get3(y, Y_W2)
     S = get33(y, Y_S)
     om1 = vec3(p[i, P_IA] * w1[0], p[i, P_IA + 1] * w1[1], p[i, P_IA + 2] * w1[2])
-    w2b = S.transpose() @ w2
-    om2 = S @ vec3(p[i, P_IB] * w2b[0], p[i, P_IB + 1] * w2b[1], p[i, P_IB + 2] * w2b[2])
+    w2b = mat_t_vec(S, w2)
+    om2 = mat_vec(S, vec3(p[i, P_IB] * w2b[0], p[i, P_IB + 1] * w2b[1], p[i, P_IB + 2] * w2b[2]))
     return om1, om2
 
 
@@ -134,7 +134,7 @@ def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template
     put3(dy, Y_W1, get3(base, Y_W1) + N1 / p[i, P_C1])
     put3(dy, Y_W2, get3(base, Y_W2) + N2 / p[i, P_C2])
     dy[NSTATE] = F.dot(V) + N1.dot(om1) + N2.dot(om2)
-    put3(dy, NSTATE + 1, get33(y, Y_S1) @ (R.cross(F) + N1 + N2))
+    put3(dy, NSTATE + 1, mat_vec(get33(y, Y_S1), R.cross(F) + N1 + N2))
     return dy
 
 

@@ -77,6 +77,35 @@ _CONTRACT3 = _contraction_terms(EXPONENTS_3, T3, 3)
 _CONTRACT4 = _contraction_terms(EXPONENTS_4, T4, 4)
 
 
+# 3x3 products written out. Taichi's ``@`` starts every sum from a computed zero
+# (x[0,0] y[0] * 0) and multiplies the explicit zeros of a diagonal matrix too: the same sums
+# in the same order plus work LLVM may not drop (no fast-math), and a front end that costs
+# the 3-D kernels a third of their variables. These give the same values (the dropped terms
+# are exact zeros) with the terms summed in Taichi's order, k = 0, 1, 2.
+@ti.func
+def mat_vec(M, v):
+    """M v."""
+    return vec3(M[0, 0] * v[0] + M[0, 1] * v[1] + M[0, 2] * v[2],
+                M[1, 0] * v[0] + M[1, 1] * v[1] + M[1, 2] * v[2],
+                M[2, 0] * v[0] + M[2, 1] * v[1] + M[2, 2] * v[2])
+
+
+@ti.func
+def mat_t_vec(M, v):
+    """Mᵀ v."""
+    return vec3(M[0, 0] * v[0] + M[1, 0] * v[1] + M[2, 0] * v[2],
+                M[0, 1] * v[0] + M[1, 1] * v[1] + M[2, 1] * v[2],
+                M[0, 2] * v[0] + M[1, 2] * v[1] + M[2, 2] * v[2])
+
+
+@ti.func
+def rotate_diagonal(S, d):
+    """S diag(d) Sᵀ, each entry Σ_k (S_rk d_k) S_ck."""
+    return mat3([[(S[r, 0] * d[0]) * S[c, 0] + (S[r, 1] * d[1]) * S[c, 1]
+                  + (S[r, 2] * d[2]) * S[c, 2] for c in ti.static(range(3))]
+                 for r in ti.static(range(3))])
+
+
 @ti.func
 def _powers(x):
     return ti.Vector([1.0, x, x * x, x * x * x, x * x * x * x])
@@ -137,7 +166,7 @@ def single_body_terms(p: ti.template(), i, off: ti.template(), u, order: ti.temp
                 val = p[i, off + terms[0]] + p[i, off + terms[1]] + p[i, off + terms[2]]
                 K[a[0], a[1]] = val
                 K[a[1], a[0]] = val
-        Ku = K @ u
+        Ku = mat_vec(K, u)
         L4 = 4.375 * q4 - 3.75 * u.dot(Ku) + 0.375 * (K[0, 0] + K[1, 1] + K[2, 2])
         g4 = 4.375 * dq4 - 7.5 * Ku
     return L2, g2, L3, g3, L4, g4
@@ -161,20 +190,20 @@ def mutual(p: ti.template(), i, offA: ti.template(), offB: ti.template(), G, R, 
     torqueB_e = vec3(0.0)                    # ∇_e of B-only terms, times its 1/r^(n+1)
     mu2 = vec3(0.0)
     if ti.static(order >= 2):
-        eB = S.transpose() @ e
+        eB = mat_t_vec(S, e)
         L2A, g2A, L3A, g3A, L4A, g4A = single_body_terms(p, i, offA, e, order, odd)
         L2B, g2B, L3B, g3B, L4B, g4B = single_body_terms(p, i, offB, eB, order, odd)
         inv_r2 = inv_r * inv_r
         inv_r3 = inv_r2 * inv_r
         # order 2
-        gB2 = S @ g2B
+        gB2 = mat_vec(S, g2B)
         U2 = mB * L2A + mA * L2B
         g2 = mB * g2A + mA * gB2
         U += U2 * inv_r3
         grad += ((g2 - g2.dot(e) * e) - 3.0 * U2 * e) * inv_r3 * inv_r
         torqueB_e += mA * gB2 * inv_r3
         if ti.static(order >= 3 and odd):
-            gB3 = S @ g3B
+            gB3 = mat_vec(S, g3B)
             U3 = mB * L3A - mA * L3B
             g3 = mB * g3A - mA * gB3
             inv_r4 = inv_r3 * inv_r
@@ -185,11 +214,11 @@ def mutual(p: ti.template(), i, offA: ti.template(), offB: ti.template(), G, R, 
             # quadrupole-quadrupole cross term X (docs/physics.md §3.2)
             JA = ti.Vector([p[i, offA + T2], p[i, offA + T2 + 1], p[i, offA + T2 + 2]])
             jB = ti.Vector([p[i, offB + T2], p[i, offB + T2 + 1], p[i, offB + T2 + 2]])
-            JBp = S @ ti.Matrix([[jB[0], 0.0, 0.0], [0.0, jB[1], 0.0], [0.0, 0.0, jB[2]]]) @ S.transpose()
+            JBp = rotate_diagonal(S, jB)             # J'_B = S J_B Sᵀ
             trA = JA[0] + JA[1] + JA[2]
             trB = jB[0] + jB[1] + jB[2]
             u = JA * e                               # J_A e
-            w = JBp @ e                              # J'_B e
+            w = mat_vec(JBp, e)                      # J'_B e
             a = e.dot(u)
             b = e.dot(w)
             JAJB = ti.Matrix([[JA[r_] * JBp[r_, c_] for c_ in ti.static(range(3))]
@@ -197,9 +226,9 @@ def mutual(p: ti.template(), i, offA: ti.template(), offB: ti.template(), G, R, 
             X = (26.25 * a * b - 3.75 * (a * trB + b * trA) - 15.0 * u.dot(w)
                  + 0.75 * trA * trB + 1.5 * (JAJB[0, 0] + JAJB[1, 1] + JAJB[2, 2]))
             Jw = JA * w                              # J_A J'_B e
-            Ju = JBp @ u                             # J'_B J_A e
+            Ju = mat_vec(JBp, u)                     # J'_B J_A e
             gX = 52.5 * (b * u + a * w) - 7.5 * (trB * u + trA * w) - 15.0 * (Jw + Ju)
-            gB4 = S @ g4B
+            gB4 = mat_vec(S, g4B)
             U4 = mB * L4A + mA * L4B + X
             g4 = mB * g4A + mA * gB4 + gX
             inv_r5 = inv_r3 * inv_r2
@@ -209,7 +238,7 @@ def mutual(p: ti.template(), i, offA: ti.template(), offB: ti.template(), G, R, 
             epsAB = vec3((JA[1] - JA[2]) * JBp[1, 2], (JA[2] - JA[0]) * JBp[0, 2],
                          (JA[0] - JA[1]) * JBp[0, 1])
             mu2 += -2.0 * G * inv_r5 * ((26.25 * a - 3.75 * trA) * e.cross(w)
-                                        - 7.5 * (u.cross(w) + e.cross(JBp @ u)) + 1.5 * epsAB)
+                                        - 7.5 * (u.cross(w) + e.cross(Ju)) + 1.5 * epsAB)
         mu2 += e.cross(-G * torqueB_e)
     dUdR = -G * grad
     mu1 = R.cross(dUdR) - mu2
