@@ -44,10 +44,10 @@ _LOG = logging.getLogger("ti_spinorbit")
 
 #: Seconds a cold compile of a variant takes when nothing was measured on this machine yet
 #: (2-core CPU, Taichi 1.7.4 with the settings of runtime.py, fresh process, integrator and
-#: diagnostics kernels: planar 0.7-0.9 s, 3-D 1.2-1.3 s); the shadow trajectory (indicators)
-#: adds about 10-25 %, dense sampling little. Estimates under ANNOUNCE_MIN_S are not
-#: announced (the planar default, about 1 s, just is).
-DEFAULT_COMPILE_SECONDS = {"planar": 1.0, "3d": 1.4}
+#: diagnostics kernels: planar 0.65-0.82 s, 3-D 1.0-1.16 s); the shadow trajectory
+#: (indicators) adds about 10-25 %, dense sampling little. Estimates under ANNOUNCE_MIN_S are
+#: not announced (the planar default, rounded up to 1 s, just is).
+DEFAULT_COMPILE_SECONDS = {"planar": 1.0, "3d": 1.2}
 INDICATORS_FACTOR = 1.2
 SAMPLING_FACTOR = 1.0
 #: Announce only compiles expected to take at least this long (seconds).
