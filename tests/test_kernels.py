@@ -184,3 +184,51 @@ def test_kernel_rhs_equals_reference_rhs(kind, rng):
         got = dy_scaled * factor * system.mean_motion
         for sl in (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 21), slice(21, 30)):
             np.testing.assert_allclose(got[sl], want[sl], rtol=0, atol=1e-12 * np.abs(want[sl]).max())
+
+
+def test_written_out_products_equal_taichis_bit_for_bit(rng):
+    """kernels/potential.py writes the 3x3 products out (mat_vec, mat_t_vec,
+    rotate_diagonal) instead of Taichi's ``@``, which starts each sum from a computed zero and
+    multiplies a diagonal matrix's zeros. The dropped terms are exact zeros, so on finite
+    inputs the values must be Taichi's to the bit (signed zeros aside: none occur here)."""
+    import taichi as ti
+    from ti_spinorbit.kernels.potential import mat3, mat_t_vec, mat_vec, rotate_diagonal, vec3
+
+    n = 64
+    M = rng.normal(size=(n, 3, 3)) * 10.0 ** rng.integers(-8, 9, size=(n, 1, 1))
+    v = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-8, 9, size=(n, 1))
+    out = np.zeros((n, 6, 3, 3))
+
+    @ti.kernel
+    def products(M_nd: ti.types.ndarray(dtype=ti.f64, ndim=3),
+                 v_nd: ti.types.ndarray(dtype=ti.f64, ndim=2),
+                 out: ti.types.ndarray(dtype=ti.f64, ndim=4)):
+        for i in range(M_nd.shape[0]):
+            S = mat3([[M_nd[i, r, c] for c in ti.static(range(3))] for r in ti.static(range(3))])
+            x = vec3(v_nd[i, 0], v_nd[i, 1], v_nd[i, 2])
+            D = ti.Matrix([[x[0], 0.0, 0.0], [0.0, x[1], 0.0], [0.0, 0.0, x[2]]])
+            mine = (mat_vec(S, x), mat_t_vec(S, x))
+            taichi = (S @ x, S.transpose() @ x)
+            for k in ti.static(range(2)):
+                for r in ti.static(range(3)):
+                    out[i, k, 0, r] = mine[k][r]
+                    out[i, 2 + k, 0, r] = taichi[k][r]
+            Q = rotate_diagonal(S, x)
+            Qt = S @ D @ S.transpose()
+            for r in ti.static(range(3)):
+                for c in ti.static(range(3)):
+                    out[i, 4, r, c] = Q[r, c]
+                    out[i, 5, r, c] = Qt[r, c]
+
+    products(M, v, out)
+    np.testing.assert_array_equal(out[:, 0:2], out[:, 2:4])
+    np.testing.assert_array_equal(out[:, 4], out[:, 5])
+    # and they are the products (a check that the kernel compared something): to round-off
+    # of the sums' magnitudes
+    a, x = np.abs(M), np.abs(v)
+    for got, spec in ((out[:, 0, 0], "nij,nj->ni"), (out[:, 1, 0], "nji,nj->ni")):
+        err = np.abs(got - np.einsum(spec, M, v)) / np.einsum(spec, a, x)
+        assert err.max() < 4 * np.finfo(float).eps
+    spec = "nik,nk,njk->nij"
+    err = np.abs(out[:, 4] - np.einsum(spec, M, v, M)) / np.einsum(spec, a, x, a)
+    assert err.max() < 8 * np.finfo(float).eps
