@@ -33,7 +33,10 @@ A third workload, ``ck45``, is the kernels' adaptive scheme without events: Cash
 controller constants, each member to its own end time (cost per member-orbit). Its lane
 variant keeps the L members of a group in lock-step (every lane computes a step each round, a
 finished lane's is discarded, as SIMD lanes would) and must equal the scalar results bit for
-bit.
+bit. Two more adaptive workloads use Verner's 9(8) pair, the fastest method: ``vern9`` in the
+package kernels' own form (a runtime loop over the 16 stages, the stage matrix in memory,
+``kernels/integrator.py``'s combinations; the lane kernel evaluates the L right-hand sides of
+a stage in one loop body) and ``vern9u`` with every stage unrolled, as ``ck45``.
 
     python experiments/simd_lanes.py                 # N = 4096, lanes 2, 4, 8
     python experiments/simd_lanes.py --quick         # CI: N = 256, lanes 2, ~10 s
@@ -58,13 +61,17 @@ EPS = 1e-12                 # rhs workload: next argument y0 + EPS f(previous)
 RK4_STEP = 2.0 * np.pi / 256
 # ck_lanes: lane counts of the adaptive workload (its L = 8 kernel took 195 s to compile and
 # ran 1.08x the scalar one: measured once, left out)
-FULL = dict(members=4096, lanes=(2, 4, 8), ck_lanes=(2, 4), seconds=0.5, repeat=5)
-QUICK = dict(members=256, lanes=(2,), ck_lanes=(2,), seconds=0.02, repeat=2)
+# vern_lanes: the same for Verner's 9(8) pair (16 stages: L = 2 is 32 inlined RHS copies)
+FULL = dict(members=4096, lanes=(2, 4, 8), ck_lanes=(2, 4), vern_lanes=(2,), seconds=0.5,
+            repeat=5)
+QUICK = dict(members=256, lanes=(2,), ck_lanes=(2,), vern_lanes=(2,), seconds=0.02, repeat=2)
 ORDER, ODD = 4, False       # 1991 VH: ellipsoids, no order-3 terms
-#: Largest relative difference of the explicit-lane results from the scalar ones: round-off
-#: of a differently ordered RHS; the rk4 runs (several orbits, chaotic members among them)
-#: amplify it, measured 5e-11 after 912 steps.
-AGREE = {"rhs": 1e-13, "rk4": 1e-8, "ck45": 0.0}
+#: Largest relative difference of the explicit-lane results from the scalar ones after 8
+#: repeats (measure()): round-off of a differently ordered RHS, which the rk4 steps (chaotic
+#: members among them) amplify with length: 5e-11 after 912 steps, 1e-5 after several
+#: thousand, so the check uses the fixed 8-repeat run. The unrolled layouts and the adaptive
+#: workloads do the same operations per member: bit for bit.
+AGREE = {"rhs": 1e-13, "rk4": 1e-8, "ck45": 0.0, "vern9": 0.0, "vern9u": 0.0}
 #: ck45 workload: adaptive Cash-Karp at rtol = atol = CK_TOL to repeats x CK_UNIT (scaled
 #: time), first step CK_H0; its cost is given per member-orbit, not per RHS
 CK_TOL = 1e-12
@@ -73,10 +80,11 @@ CK_H0 = 0.01
 #: step-size controller of the ensemble kernels (scipy naming, NR §16.2): factor
 #: clip(SAFETY err^(-1/5), MIN_FACTOR, MAX_FACTOR), no growth right after a rejection
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 5.0
-WORKLOADS = ("rhs", "rk4", "ck45")
+WORKLOADS = ("rhs", "rk4", "ck45", "vern9", "vern9u")
+ADAPTIVE = ("ck45", "vern9", "vern9u")          # cost per member-orbit, not per RHS
 
 
-def build_kernels(lanes_list, ck_lanes=()):
+def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
     """Taichi kernels {(workload, variant, L): kernel(par, y, out, repeats)}."""
     import taichi as ti
 
@@ -232,105 +240,201 @@ def build_kernels(lanes_list, ck_lanes=()):
                         out[k, base + l] = Z[k, l]
         return kernel
 
-    # ---- adaptive Cash-Karp 4(5), max-norm error control (the kernels' scheme, no events) ----
-    from ti_spinorbit.kernels.tableau import CASH_KARP as CK
+    # ---- adaptive embedded pairs, max-norm error control (the kernels' scheme, no events) ----
+    from ti_spinorbit.kernels.tableau import CASH_KARP, VERN9
 
-    @ti.func
-    def ck_step(pv, z, h):
-        """One Cash-Karp step: (propagated solution, max-norm error in tolerance units)."""
-        ks = [P.rhs_member(pv, z, ORDER, ODD)]
-        for st in ti.static(range(1, CK.stages)):
-            zs = z
-            for j in ti.static(range(st)):
-                if ti.static(CK.a[st][j] != 0.0):
-                    zs = zs + (CK.a[st][j] * h) * ks[j]
-            ks.append(P.rhs_member(pv, zs, ORDER, ODD))
-        dy = ti.Vector([0.0] * NS, ti.f64)
-        er = ti.Vector([0.0] * NS, ti.f64)
-        for st in ti.static(range(CK.stages)):
-            if ti.static(CK.b[st] != 0.0):
-                dy += CK.b[st] * ks[st]
-            if ti.static(CK.e[st] != 0.0):
-                er += CK.e[st] * ks[st]
-        z_new = z + h * dy
-        worst = 0.0
-        for k in ti.static(range(NS)):
-            scale = CK_TOL + CK_TOL * ti.max(ti.abs(z[k]), ti.abs(z_new[k]))
-            worst = ti.max(worst, ti.abs(h * er[k]) / scale)
-        return z_new, worst
+    def adaptive(tab):
+        """(scalar kernel, lane-kernel factory) of the adaptive workload with ``tab``: every
+        stage unrolled (the first one evaluated afresh each step, which costs the same RHS
+        count as the kernels' reuse of the accepted end's derivative)."""
 
-    @ti.func
-    def controlled(t, h, h_try, z, z_new, err, rejected, t_end):
-        """Accept or reject a step (the kernels' controller constants, above)."""
-        if err <= 1.0:
-            fac = MAX_FACTOR
-            if err > 0.0:
-                fac = ti.min(MAX_FACTOR, SAFETY * ti.pow(err, -1.0 / CK.order))
-            if rejected:
-                fac = ti.min(1.0, fac)
-            t += h_try
-            z = z_new
-            h = h_try * fac
-            rejected = 0
-        else:
-            h = h_try * ti.max(MIN_FACTOR, SAFETY * ti.pow(err, -1.0 / CK.order))
-            rejected = 1
-        return t, h, z, rejected
-
-    @ti.kernel
-    def scalar_ck(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
-        for i in range(y.shape[0]):
-            pv = P.member(par, i)
-            z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
-            t_end = repeats * CK_UNIT
-            t, h, rejected = 0.0, CK_H0, 0
-            while t < t_end:
-                h_try = ti.min(h, t_end - t)
-                z_new, err = ck_step(pv, z, h_try)
-                t, h, z, rejected = controlled(t, h, h_try, z, z_new, err, rejected, t_end)
+        @ti.func
+        def rk_step(pv, z, h):
+            """One step: (propagated solution, max-norm error in tolerance units)."""
+            ks = [P.rhs_member(pv, z, ORDER, ODD)]
+            for st in ti.static(range(1, tab.stages)):
+                zs = z
+                for j in ti.static(range(st)):
+                    if ti.static(tab.a[st][j] != 0.0):
+                        zs = zs + (tab.a[st][j] * h) * ks[j]
+                ks.append(P.rhs_member(pv, zs, ORDER, ODD))
+            dy = ti.Vector([0.0] * NS, ti.f64)
+            er = ti.Vector([0.0] * NS, ti.f64)
+            for st in ti.static(range(tab.stages)):
+                if ti.static(tab.b[st] != 0.0):
+                    dy += tab.b[st] * ks[st]
+                if ti.static(tab.e[st] != 0.0):
+                    er += tab.e[st] * ks[st]
+            z_new = z + h * dy
+            worst = 0.0
             for k in ti.static(range(NS)):
-                out[i, k] = z[k]
+                scale = CK_TOL + CK_TOL * ti.max(ti.abs(z[k]), ti.abs(z_new[k]))
+                worst = ti.max(worst, ti.abs(h * er[k]) / scale)
+            return z_new, worst
 
-    def unrolled_ck(L):
+        @ti.func
+        def controlled(t, h, h_try, z, z_new, err, rejected, t_end):
+            """Accept or reject a step (the kernels' controller constants, above)."""
+            if err <= 1.0:
+                fac = MAX_FACTOR
+                if err > 0.0:
+                    fac = ti.min(MAX_FACTOR, SAFETY * ti.pow(err, -tab.error_exponent))
+                if rejected:
+                    fac = ti.min(1.0, fac)
+                t += h_try
+                z = z_new
+                h = h_try * fac
+                rejected = 0
+            else:
+                h = h_try * ti.max(MIN_FACTOR, SAFETY * ti.pow(err, -tab.error_exponent))
+                rejected = 1
+            return t, h, z, rejected
+
         @ti.kernel
-        def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
-            for g in range(y.shape[1] // L):
-                base = g * L
-                PV = gather(par, base, L, NP)
-                Z = gather(y, base, L, NS)
+        def scalar(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+            for i in range(y.shape[0]):
+                pv = P.member(par, i)
+                z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
                 t_end = repeats * CK_UNIT
-                T = ti.Vector([0.0] * L, ti.f64)
-                H = ti.Vector([CK_H0] * L, ti.f64)
-                REJ = ti.Vector([0] * L, ti.i32)
-                running = 1
-                while running:
-                    running = 0
-                    # every lane computes a step (a finished lane's is discarded): the lanes
-                    # stay in lock-step, as SIMD lanes would
-                    for l in ti.static(range(L)):
-                        z = column(Z, l, NS)
-                        h_try = ti.min(H[l], t_end - T[l])
-                        z_new, err = ck_step(column(PV, l, NP), z, h_try)
-                        if T[l] < t_end:
-                            t, h, z, rej = controlled(T[l], H[l], h_try, z, z_new, err, REJ[l],
-                                                      t_end)
-                            T[l], H[l], REJ[l] = t, h, rej
-                            for k in ti.static(range(NS)):
-                                Z[k, l] = z[k]
-                        if T[l] < t_end:
-                            running = 1
+                t, h, rejected = 0.0, CK_H0, 0
+                while t < t_end:
+                    h_try = ti.min(h, t_end - t)
+                    z_new, err = rk_step(pv, z, h_try)
+                    t, h, z, rejected = controlled(t, h, h_try, z, z_new, err, rejected, t_end)
                 for k in ti.static(range(NS)):
-                    for l in ti.static(range(L)):
-                        out[k, base + l] = Z[k, l]
-        return kernel
+                    out[i, k] = z[k]
 
-    kernels[("ck45", "scalar", 1)] = scalar_ck
+        def unrolled_lanes(L):
+            @ti.kernel
+            def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+                for g in range(y.shape[1] // L):
+                    base = g * L
+                    PV = gather(par, base, L, NP)
+                    Z = gather(y, base, L, NS)
+                    t_end = repeats * CK_UNIT
+                    T = ti.Vector([0.0] * L, ti.f64)
+                    H = ti.Vector([CK_H0] * L, ti.f64)
+                    REJ = ti.Vector([0] * L, ti.i32)
+                    running = 1
+                    while running:
+                        running = 0
+                        # every lane computes a step (a finished lane's is discarded): the
+                        # lanes stay in lock-step, as SIMD lanes would
+                        for l in ti.static(range(L)):
+                            z = column(Z, l, NS)
+                            h_try = ti.min(H[l], t_end - T[l])
+                            z_new, err = rk_step(column(PV, l, NP), z, h_try)
+                            if T[l] < t_end:
+                                t, h, z, rej = controlled(T[l], H[l], h_try, z, z_new, err,
+                                                          REJ[l], t_end)
+                                T[l], H[l], REJ[l] = t, h, rej
+                                for k in ti.static(range(NS)):
+                                    Z[k, l] = z[k]
+                            if T[l] < t_end:
+                                running = 1
+                    for k in ti.static(range(NS)):
+                        for l in ti.static(range(L)):
+                            out[k, base + l] = Z[k, l]
+            return kernel
+
+        return scalar, unrolled_lanes, controlled
+
+    def adaptive_loop(tab):
+        """The same workload in the package kernels' form: a runtime loop over the stages,
+        the stage matrix in memory, the combinations from ``kernels/integrator.py``
+        (``unroll_components=False``); the lane kernel keeps one stage matrix per lane and
+        evaluates the L right-hand sides of a stage in one loop body."""
+        from ti_spinorbit.kernels.integrator import (make_error_norm, make_primitives,
+                                                     stage_matrix_type)
+
+        stage_point, combine, put_stage = make_primitives(tab, NS, unroll_components=False)
+        norm = make_error_norm(tab, unroll_components=False)
+        kmat = stage_matrix_type(tab, NS)
+        scalar_controlled = adaptive(tab)[2]
+
+        @ti.kernel
+        def scalar(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+            for i in range(y.shape[0]):
+                pv = P.member(par, i)
+                z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
+                t_end = repeats * CK_UNIT
+                t, h, rejected = 0.0, CK_H0, 0
+                K = kmat(0.0)
+                while t < t_end:
+                    h_try = ti.min(h, t_end - t)
+                    put_stage(K, 0, P.rhs_member(pv, z, ORDER, ODD))
+                    for st in range(1, tab.stages):
+                        put_stage(K, st, P.rhs_member(pv, stage_point(z, K, h_try, st), ORDER,
+                                                      ODD))
+                    dy, err, err3 = combine(K, h_try, True)
+                    z_new = z + dy
+                    e = norm(z, z_new, err, err3, CK_TOL, CK_TOL, NS)
+                    t, h, z, rejected = scalar_controlled(t, h, h_try, z, z_new, e, rejected,
+                                                          t_end)
+                for k in ti.static(range(NS)):
+                    out[i, k] = z[k]
+
+        def lanes_kernel(L):
+            @ti.kernel
+            def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
+                for g in range(y.shape[1] // L):
+                    base = g * L
+                    PV = gather(par, base, L, NP)
+                    Z = gather(y, base, L, NS)
+                    t_end = repeats * CK_UNIT
+                    T = ti.Vector([0.0] * L, ti.f64)
+                    H = ti.Vector([CK_H0] * L, ti.f64)
+                    HT = ti.Vector([0.0] * L, ti.f64)
+                    REJ = ti.Vector([0] * L, ti.i32)
+                    Ks = [kmat(0.0) for _ in ti.static(range(L))]
+                    running = 1
+                    while running:
+                        running = 0
+                        for l in ti.static(range(L)):
+                            HT[l] = ti.min(H[l], t_end - T[l])
+                            put_stage(Ks[l], 0, P.rhs_member(column(PV, l, NP), column(Z, l, NS),
+                                                             ORDER, ODD))
+                        for st in range(1, tab.stages):     # the L RHS of a stage together
+                            for l in ti.static(range(L)):
+                                zs = stage_point(column(Z, l, NS), Ks[l], HT[l], st)
+                                put_stage(Ks[l], st, P.rhs_member(column(PV, l, NP), zs, ORDER,
+                                                                  ODD))
+                        for l in ti.static(range(L)):
+                            z = column(Z, l, NS)
+                            dy, err, err3 = combine(Ks[l], HT[l], True)
+                            z_new = z + dy
+                            e = norm(z, z_new, err, err3, CK_TOL, CK_TOL, NS)
+                            if T[l] < t_end:
+                                t, h, z, rej = scalar_controlled(T[l], H[l], HT[l], z, z_new, e,
+                                                                 REJ[l], t_end)
+                                T[l], H[l], REJ[l] = t, h, rej
+                                for k in ti.static(range(NS)):
+                                    Z[k, l] = z[k]
+                            if T[l] < t_end:
+                                running = 1
+                    for k in ti.static(range(NS)):
+                        for l in ti.static(range(L)):
+                            out[k, base + l] = Z[k, l]
+            return kernel
+
+        return scalar, lanes_kernel
+
     for L in lanes_list:
         for workload in ("rhs", "rk4"):
             kernels[(workload, "unrolled", L)] = unrolled(L, workload)
             kernels[(workload, "lanes", L)] = lanes(L, workload)
+    scalar, unrolled_lanes, _ = adaptive(CASH_KARP)
+    kernels[("ck45", "scalar", 1)] = scalar
     for L in ck_lanes:
-        kernels[("ck45", "unrolled", L)] = unrolled_ck(L)
+        kernels[("ck45", "unrolled", L)] = unrolled_lanes(L)
+    scalar, lanes_kernel = adaptive_loop(VERN9)
+    kernels[("vern9", "scalar", 1)] = scalar
+    for L in vern_lanes:
+        kernels[("vern9", "unrolled", L)] = lanes_kernel(L)
+    scalar, unrolled_lanes, _ = adaptive(VERN9)       # every stage unrolled, as ck45
+    kernels[("vern9u", "scalar", 1)] = scalar
+    for L in vern_lanes:
+        kernels[("vern9u", "unrolled", L)] = unrolled_lanes(L)
     return kernels
 
 
@@ -360,7 +464,7 @@ def measure(kernels, kpar, q, seconds, rounds):
     n = len(q)
     aos = (np.ascontiguousarray(kpar), np.ascontiguousarray(q))
     soa = (np.ascontiguousarray(kpar.T), np.ascontiguousarray(q.T))
-    outputs, repeats, compile_s = {}, {}, {}
+    outputs, repeats, compile_s, checked = {}, {}, {}, {}
     for key, kernel in kernels.items():
         par, y = aos if key[1] == "scalar" else soa
         out = np.zeros_like(y)
@@ -368,6 +472,9 @@ def measure(kernels, kpar, q, seconds, rounds):
         compile_s[key] = wall
         wall, _ = timed(kernel, par, y, out, 8)
         repeats[key] = max(8, int(8 * seconds / max(wall, 1e-6)))
+        # the layouts are compared after these 8 repeats: a fixed length, because the timed
+        # runs' length varies with the machine and chaotic members amplify round-off with it
+        checked[key] = out.copy()
         outputs[key] = out
     # the scalar variant's repeats for every variant of a workload: the same work
     for key in kernels:
@@ -380,12 +487,12 @@ def measure(kernels, kpar, q, seconds, rounds):
     rows = []
     for key in kernels:
         workload, variant, L = key
-        # work units: RHS evaluations (rhs, rk4), member-orbits (ck45)
-        rhs_calls = (n * repeats[key] / 64 if workload == "ck45"
+        # work units: RHS evaluations (rhs, rk4), member-orbits (ck45, vern9)
+        rhs_calls = (n * repeats[key] / 64 if workload in ADAPTIVE
                      else n * repeats[key] * (4 if workload == "rk4" else 1))
         walls = np.array([t[0] for t in times[key]])
         cpus = np.array([t[1] for t in times[key]])
-        out = outputs[key] if variant == "scalar" else outputs[key].T
+        out = checked[key] if variant == "scalar" else checked[key].T
         rows.append({"workload": workload, "variant": variant, "lanes": L, "members": n,
                      "repeats": repeats[key], "rhs_calls": rhs_calls,
                      "compile_s": compile_s[key], "wall_s": walls.tolist(),
@@ -406,7 +513,7 @@ def measure(kernels, kpar, q, seconds, rounds):
     return rows
 
 
-def llvm_ir_counts(lanes_list, ck_lanes, kpar, q):
+def llvm_ir_counts(lanes_list, ck_lanes, vern_lanes, kpar, q):
     """Floating-point instructions in each kernel's optimised LLVM IR, scalar and vector
     (``<k x double>``), by vector width: whether LLVM packed the lanes. Re-initialises Taichi
     (the package's settings, no kernel cache, IR written to a temporary folder)."""
@@ -427,7 +534,7 @@ def llvm_ir_counts(lanes_list, ck_lanes, kpar, q):
                     cpu_block_dim_adaptive=False, default_cpu_block_dim=1,
                     print_kernel_llvm_ir_optimized=True)
             seen = set()
-            for key, kernel in build_kernels(lanes_list, ck_lanes).items():
+            for key, kernel in build_kernels(lanes_list, ck_lanes, vern_lanes).items():
                 par, y = (kpar, q) if key[1] == "scalar" else (np.ascontiguousarray(kpar.T),
                                                                np.ascontiguousarray(q.T))
                 kernel(par, y, np.zeros_like(y), 1)
@@ -449,18 +556,18 @@ def llvm_ir_counts(lanes_list, ck_lanes, kpar, q):
 def figure(rows):
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    fig, axes = plt.subplots(1, len(WORKLOADS), figsize=(4.3 * len(WORKLOADS), 3.8))
     for ax, workload in zip(axes, WORKLOADS):
         group = [r for r in rows if r["workload"] == workload]
         labels = [r["variant"] if r["variant"] == "scalar" else f"{r['variant']} {r['lanes']}"
                   for r in group]
         x = np.arange(len(group))
-        unit = 1e-3 if workload == "ck45" else 1.0          # ck45: microseconds per orbit
+        unit = 1e-3 if workload in ADAPTIVE else 1.0        # microseconds per orbit
         ax.bar(x - 0.2, [unit * r["ns_per_rhs_cpu_median"] for r in group], 0.4,
                label="per core (CPU time)")
         ax.bar(x + 0.2, [unit * r["ns_per_rhs_wall_median"] for r in group], 0.4, label="wall")
         ax.set_xticks(x, labels, rotation=30, fontsize=8)
-        ax.set_ylabel("us per member-orbit (median)" if workload == "ck45"
+        ax.set_ylabel("us per member-orbit (median)" if workload in ADAPTIVE
                       else "ns per RHS evaluation (median)")
         ax.set_title(f"planar RHS, 1991 VH a/b = 1.5: workload {workload}", fontsize=9)
         ax.legend(fontsize=7)
@@ -480,7 +587,7 @@ def main():
     rounds = args.repeat or s["repeat"]
     kpar, q = member_inputs(s["members"])
     t0 = time.perf_counter()
-    kernels = build_kernels(s["lanes"], s["ck_lanes"])
+    kernels = build_kernels(s["lanes"], s["ck_lanes"], s["vern_lanes"])
     rows = measure(kernels, kpar, q, s["seconds"], rounds)
     load = os.getloadavg()[0]
     import bench_throughput as bt                           # on the path after member_inputs
@@ -489,7 +596,7 @@ def main():
     print(f"[simd_lanes] CPU {cpu_model} ({', '.join(simd) or 'no AVX2'}), "
           f"{os.cpu_count()} CPUs")
     print(f"[simd_lanes] N = {s['members']}, {rounds} interleaved rounds, load average "
-          f"{load:.2f}; ns per RHS (ck45: per member-orbit), median, per core = process "
+          f"{load:.2f}; ns per RHS (adaptive workloads: per member-orbit), median, per core = process "
           "CPU time / work")
     print(f"{'workload':>8} {'variant':>9} {'L':>2} {'CPU ns':>7} {'best':>7} {'wall ns':>8} "
           f"{'speed-up':>8} {'(wall)':>7} {'max rel diff':>12} {'compile s':>9}")
@@ -506,7 +613,7 @@ def main():
         raise SystemExit(f"[simd_lanes] results differ from the scalar layout: {bad}")
     ir = {}
     if args.llvm_ir:
-        ir = llvm_ir_counts(s["lanes"], s["ck_lanes"], kpar[:64], q[:64])
+        ir = llvm_ir_counts(s["lanes"], s["ck_lanes"], s["vern_lanes"], kpar[:64], q[:64])
         print("[simd_lanes] optimised LLVM IR, f64 fadd/fsub/fmul/fdiv: scalar, vector "
               "(<k x double>), occurrences of each vector width")
         for (workload, variant, L), c in ir.items():
@@ -516,7 +623,7 @@ def main():
             for w in WORKLOADS}
     numbers = {f"{w} speed-up per core, best ({b['variant']} {b['lanes']})": b["speedup_cpu"]
                for w, b in best.items()}
-    numbers.update({f"{w} scalar ns per {'member-orbit' if w == 'ck45' else 'RHS'} per core": next(
+    numbers.update({f"{w} scalar ns per {'member-orbit' if w in ADAPTIVE else 'RHS'} per core": next(
         r["ns_per_rhs_cpu_median"] for r in rows if (r["workload"], r["variant"]) == (w, "scalar"))
         for w in WORKLOADS})
     keys = ("workload", "variant", "lanes", "ns_per_rhs_cpu_median", "ns_per_rhs_wall_median",
