@@ -241,16 +241,31 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
         return kernel
 
     # ---- adaptive embedded pairs, max-norm error control (the kernels' scheme, no events) ----
+    # Two forms of a step, one controller, one scalar kernel and one lock-step lane kernel:
+    # "unrolled" (every stage inlined, the first evaluated afresh each step: the same RHS
+    # count as the kernels' reuse of the accepted end's derivative) and "loop" (the package
+    # kernels' form: a runtime loop over the stages, the stage matrix in memory, the
+    # combinations of kernels/integrator.py; its lane kernel evaluates the L right-hand sides
+    # of a stage together in one loop body).
+    from ti_spinorbit.kernels.integrator import (make_error_norm, make_primitives,
+                                                 stage_matrix_type)
     from ti_spinorbit.kernels.tableau import CASH_KARP, VERN9
 
-    def adaptive(tab):
-        """(scalar kernel, lane-kernel factory) of the adaptive workload with ``tab``: every
-        stage unrolled (the first one evaluated afresh each step, which costs the same RHS
-        count as the kernels' reuse of the accepted end's derivative)."""
+    def adaptive(tab, form):
+        """(scalar kernel, lane-kernel factory) of the adaptive workload with ``tab`` in
+        ``form`` ("unrolled" or "loop")."""
+        if form == "loop":
+            stage_point, combine, put_stage = make_primitives(tab, NS, unroll_components=False)
+            norm = make_error_norm(tab, unroll_components=False)
+            kmat = stage_matrix_type(tab, NS)
+        else:   # no stage matrix (a placeholder type) and no loop primitives
+            stage_point = combine = put_stage = norm = None
+            kmat = ti.types.matrix(1, 1, ti.f64)
 
         @ti.func
-        def rk_step(pv, z, h):
-            """One step: (propagated solution, max-norm error in tolerance units)."""
+        def unrolled_step(pv, z, h):
+            """One step, every stage inlined: (propagated solution, max-norm error in
+            tolerance units)."""
             ks = [P.rhs_member(pv, z, ORDER, ODD)]
             for st in ti.static(range(1, tab.stages)):
                 zs = z
@@ -273,7 +288,53 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
             return z_new, worst
 
         @ti.func
-        def controlled(t, h, h_try, z, z_new, err, rejected, t_end):
+        def finish_loop_step(z, K: ti.template(), h):
+            """The loop form's step from its filled stage matrix: (solution, error)."""
+            dy, err, err3 = combine(K, h, True)
+            z_new = z + dy
+            return z_new, norm(z, z_new, err, err3, CK_TOL, CK_TOL, NS)
+
+        @ti.func
+        def step(pv, z, h, K: ti.template()):
+            """One step of member (pv, z); K is the loop form's stage matrix."""
+            z_new, err = z, 0.0
+            if ti.static(form == "loop"):
+                put_stage(K, 0, P.rhs_member(pv, z, ORDER, ODD))
+                for st in range(1, tab.stages):
+                    put_stage(K, st, P.rhs_member(pv, stage_point(z, K, h, st), ORDER, ODD))
+                z_new, err = finish_loop_step(z, K, h)
+            else:
+                z_new, err = unrolled_step(pv, z, h)
+            return z_new, err
+
+        @ti.func
+        def lane_steps(PV, Z, HT, Ks: ti.template(), L: ti.template()):
+            """One step of each of the L lanes: (new states as an (NS, L) matrix, errors)."""
+            ZN = Z
+            ERR = ti.Vector([0.0] * L, ti.f64)
+            if ti.static(form == "loop"):
+                for l in ti.static(range(L)):
+                    put_stage(Ks[l], 0, P.rhs_member(column(PV, l, NP), column(Z, l, NS),
+                                                     ORDER, ODD))
+                for st in range(1, tab.stages):         # the L RHS of a stage together
+                    for l in ti.static(range(L)):
+                        zs = stage_point(column(Z, l, NS), Ks[l], HT[l], st)
+                        put_stage(Ks[l], st, P.rhs_member(column(PV, l, NP), zs, ORDER, ODD))
+                for l in ti.static(range(L)):
+                    z_new, err = finish_loop_step(column(Z, l, NS), Ks[l], HT[l])
+                    ERR[l] = err
+                    for k in ti.static(range(NS)):
+                        ZN[k, l] = z_new[k]
+            else:
+                for l in ti.static(range(L)):
+                    z_new, err = unrolled_step(column(PV, l, NP), column(Z, l, NS), HT[l])
+                    ERR[l] = err
+                    for k in ti.static(range(NS)):
+                        ZN[k, l] = z_new[k]
+            return ZN, ERR
+
+        @ti.func
+        def controlled(t, h, h_try, z, z_new, err, rejected):
             """Accept or reject a step (the kernels' controller constants, above)."""
             if err <= 1.0:
                 fac = MAX_FACTOR
@@ -297,80 +358,11 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
                 z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
                 t_end = repeats * CK_UNIT
                 t, h, rejected = 0.0, CK_H0, 0
-                while t < t_end:
-                    h_try = ti.min(h, t_end - t)
-                    z_new, err = rk_step(pv, z, h_try)
-                    t, h, z, rejected = controlled(t, h, h_try, z, z_new, err, rejected, t_end)
-                for k in ti.static(range(NS)):
-                    out[i, k] = z[k]
-
-        def unrolled_lanes(L):
-            @ti.kernel
-            def kernel(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
-                for g in range(y.shape[1] // L):
-                    base = g * L
-                    PV = gather(par, base, L, NP)
-                    Z = gather(y, base, L, NS)
-                    t_end = repeats * CK_UNIT
-                    T = ti.Vector([0.0] * L, ti.f64)
-                    H = ti.Vector([CK_H0] * L, ti.f64)
-                    REJ = ti.Vector([0] * L, ti.i32)
-                    running = 1
-                    while running:
-                        running = 0
-                        # every lane computes a step (a finished lane's is discarded): the
-                        # lanes stay in lock-step, as SIMD lanes would
-                        for l in ti.static(range(L)):
-                            z = column(Z, l, NS)
-                            h_try = ti.min(H[l], t_end - T[l])
-                            z_new, err = rk_step(column(PV, l, NP), z, h_try)
-                            if T[l] < t_end:
-                                t, h, z, rej = controlled(T[l], H[l], h_try, z, z_new, err,
-                                                          REJ[l], t_end)
-                                T[l], H[l], REJ[l] = t, h, rej
-                                for k in ti.static(range(NS)):
-                                    Z[k, l] = z[k]
-                            if T[l] < t_end:
-                                running = 1
-                    for k in ti.static(range(NS)):
-                        for l in ti.static(range(L)):
-                            out[k, base + l] = Z[k, l]
-            return kernel
-
-        return scalar, unrolled_lanes, controlled
-
-    def adaptive_loop(tab):
-        """The same workload in the package kernels' form: a runtime loop over the stages,
-        the stage matrix in memory, the combinations from ``kernels/integrator.py``
-        (``unroll_components=False``); the lane kernel keeps one stage matrix per lane and
-        evaluates the L right-hand sides of a stage in one loop body."""
-        from ti_spinorbit.kernels.integrator import (make_error_norm, make_primitives,
-                                                     stage_matrix_type)
-
-        stage_point, combine, put_stage = make_primitives(tab, NS, unroll_components=False)
-        norm = make_error_norm(tab, unroll_components=False)
-        kmat = stage_matrix_type(tab, NS)
-        scalar_controlled = adaptive(tab)[2]
-
-        @ti.kernel
-        def scalar(par: nd2f, y: nd2f, out: nd2f, repeats: ti.i32):
-            for i in range(y.shape[0]):
-                pv = P.member(par, i)
-                z = ti.Vector([y[i, k] for k in ti.static(range(NS))], ti.f64)
-                t_end = repeats * CK_UNIT
-                t, h, rejected = 0.0, CK_H0, 0
                 K = kmat(0.0)
                 while t < t_end:
                     h_try = ti.min(h, t_end - t)
-                    put_stage(K, 0, P.rhs_member(pv, z, ORDER, ODD))
-                    for st in range(1, tab.stages):
-                        put_stage(K, st, P.rhs_member(pv, stage_point(z, K, h_try, st), ORDER,
-                                                      ODD))
-                    dy, err, err3 = combine(K, h_try, True)
-                    z_new = z + dy
-                    e = norm(z, z_new, err, err3, CK_TOL, CK_TOL, NS)
-                    t, h, z, rejected = scalar_controlled(t, h, h_try, z, z_new, e, rejected,
-                                                          t_end)
+                    z_new, err = step(pv, z, h_try, K)
+                    t, h, z, rejected = controlled(t, h, h_try, z, z_new, err, rejected)
                 for k in ti.static(range(NS)):
                     out[i, k] = z[k]
 
@@ -390,23 +382,15 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
                     running = 1
                     while running:
                         running = 0
+                        # every lane computes a step (a finished lane's is discarded): the
+                        # lanes stay in lock-step, as SIMD lanes would
                         for l in ti.static(range(L)):
                             HT[l] = ti.min(H[l], t_end - T[l])
-                            put_stage(Ks[l], 0, P.rhs_member(column(PV, l, NP), column(Z, l, NS),
-                                                             ORDER, ODD))
-                        for st in range(1, tab.stages):     # the L RHS of a stage together
-                            for l in ti.static(range(L)):
-                                zs = stage_point(column(Z, l, NS), Ks[l], HT[l], st)
-                                put_stage(Ks[l], st, P.rhs_member(column(PV, l, NP), zs, ORDER,
-                                                                  ODD))
+                        ZN, ERR = lane_steps(PV, Z, HT, Ks, L)
                         for l in ti.static(range(L)):
-                            z = column(Z, l, NS)
-                            dy, err, err3 = combine(Ks[l], HT[l], True)
-                            z_new = z + dy
-                            e = norm(z, z_new, err, err3, CK_TOL, CK_TOL, NS)
                             if T[l] < t_end:
-                                t, h, z, rej = scalar_controlled(T[l], H[l], HT[l], z, z_new, e,
-                                                                 REJ[l], t_end)
+                                t, h, z, rej = controlled(T[l], H[l], HT[l], column(Z, l, NS),
+                                                          column(ZN, l, NS), ERR[l], REJ[l])
                                 T[l], H[l], REJ[l] = t, h, rej
                                 for k in ti.static(range(NS)):
                                     Z[k, l] = z[k]
@@ -423,18 +407,13 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
         for workload in ("rhs", "rk4"):
             kernels[(workload, "unrolled", L)] = unrolled(L, workload)
             kernels[(workload, "lanes", L)] = lanes(L, workload)
-    scalar, unrolled_lanes, _ = adaptive(CASH_KARP)
-    kernels[("ck45", "scalar", 1)] = scalar
-    for L in ck_lanes:
-        kernels[("ck45", "unrolled", L)] = unrolled_lanes(L)
-    scalar, lanes_kernel = adaptive_loop(VERN9)
-    kernels[("vern9", "scalar", 1)] = scalar
-    for L in vern_lanes:
-        kernels[("vern9", "unrolled", L)] = lanes_kernel(L)
-    scalar, unrolled_lanes, _ = adaptive(VERN9)       # every stage unrolled, as ck45
-    kernels[("vern9u", "scalar", 1)] = scalar
-    for L in vern_lanes:
-        kernels[("vern9u", "unrolled", L)] = unrolled_lanes(L)
+    for workload, tab, form, lane_counts in (("ck45", CASH_KARP, "unrolled", ck_lanes),
+                                             ("vern9", VERN9, "loop", vern_lanes),
+                                             ("vern9u", VERN9, "unrolled", vern_lanes)):
+        scalar, lanes_kernel = adaptive(tab, form)
+        kernels[(workload, "scalar", 1)] = scalar
+        for L in lane_counts:
+            kernels[(workload, "unrolled", L)] = lanes_kernel(L)
     return kernels
 
 
