@@ -10,12 +10,18 @@ per member, the relative drifts
 (scaled units; ``L`` is the inertial vector) and a verdict in its status:
 
 * ``done`` — finished, drifts finite and within the limit;
-* ``inaccurate`` — finished, but a drift exceeds the limit. Its data are kept (never dropped)
-  and it is counted apart: summaries (chaotic fractions, overlap decisions, libration
-  amplitudes) exclude it unless asked;
+* ``inaccurate`` — a drift exceeds the limit. Its data are kept (never dropped) and it is
+  counted apart: summaries (chaotic fractions, overlap decisions, libration amplitudes)
+  exclude it unless asked;
 * ``non-finite`` — a drift or diagnostic is NaN/Inf (the kernels' own ``non-finite`` status
   also lands here), never ``done`` with a NaN;
-* members that stopped early (collision, escape, step underflow) keep that status.
+* a member that stopped early (collision, escape, step underflow, step budget) is judged by
+  its drift up to the stop, against the same limit: within it, it keeps that status (a
+  physical outcome, or the integrator's own failure); past it, it is ``inaccurate``, because
+  an escape or a collision reached with the conservation laws broken is an artefact of the
+  tolerance as often as it is physics (an e = 0.6 orbit at rtol 1e-3 "escapes" with the
+  energy off by 700 %, and stays bound at 1e-10). What it stopped for is kept beside the
+  verdict, in the result's ``stop_status`` (the kernels' code).
 
 **The default limit** scales with the tolerance and the run length, because the drift of a
 healthy Cash-Karp run does: measured on 1991 VH and 2004 DC (48 starts each over the whole
@@ -82,18 +88,25 @@ def drifts(diag_start, diag_end, exchange=None):
     return energy, angmom
 
 
+#: Kernel statuses of members that stopped before the end, judged by their drift to the stop.
+STOPPED_EARLY = (Status.COLLISION, Status.ESCAPE, Status.STEP_UNDERFLOW, Status.STEP_BUDGET)
+
+
 def verdict(status, energy_drift, angmom_drift, limit):
-    """Status codes after the accuracy check (a new int32 array): ``done`` members whose
-    drift is not finite become ``non-finite``, those above ``limit`` become ``inaccurate``;
-    every other status is kept."""
+    """Status codes after the accuracy check (a new int32 array) from the kernels' codes
+    ``status``: ``done`` members whose drift is not finite become ``non-finite``; ``done``
+    members and members that stopped early (:data:`STOPPED_EARLY`) whose finite drift is
+    above ``limit`` become ``inaccurate``; every other status is kept. The kernels' codes
+    themselves are what a result keeps as ``stop_status``."""
     status = np.array(status, dtype=np.int32, copy=True)
     energy_drift = np.asarray(energy_drift, dtype=np.float64)
     angmom_drift = np.asarray(angmom_drift, dtype=np.float64)
     done = status == Status.DONE
+    judged = done | np.isin(status, np.array(STOPPED_EARLY, dtype=np.int32))
     finite = np.isfinite(energy_drift) & np.isfinite(angmom_drift)
     status[done & ~finite] = Status.NONFINITE
     worst = np.fmax(energy_drift, angmom_drift)
-    status[done & finite & (worst > limit)] = Status.INACCURATE
+    status[judged & finite & (worst > limit)] = Status.INACCURATE
     return status
 
 

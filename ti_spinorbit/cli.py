@@ -949,34 +949,61 @@ def _write(result, data, extra, figure, out):
     return out, data
 
 
-def _accuracy_status(args, status, energy_drift, max_drift, what="members"):
+def _accuracy_status(args, status, energy_drift, max_drift, what="members", stop_status=None):
     """Exit status of a run by its accuracy verdict. Members whose numbers cannot be trusted,
-    "inaccurate" (drift above the limit) and "non-finite" (NaN/Inf), are counted on stderr
-    (even with --quiet: it qualifies the results); returns EXIT_INACCURATE when there are any,
-    unless --allow-inaccurate. Collisions, escapes and step underflows are outcomes of a
-    start, reported per member, and do not change the exit status."""
+    "inaccurate" (drift above the limit, also when the member stopped early: an escape or a
+    collision reached with the conservation laws broken) and "non-finite" (NaN/Inf), and
+    members stopped by their step budget, are counted on stderr (even with --quiet: it
+    qualifies the results); returns EXIT_INACCURATE when there are any, unless
+    --allow-inaccurate. Collisions, escapes and step underflows within the drift limit are
+    outcomes of a start, reported per member, and do not change the exit status.
+    ``stop_status`` (the kernels' codes) names what inaccurate members stopped for."""
     import numpy as np
 
-    from .results import Status
+    from .results import STATUS_NAMES, Status
 
-    INACCURATE, NONFINITE = Status.INACCURATE, Status.NONFINITE
+    INACCURATE, NONFINITE, BUDGET = Status.INACCURATE, Status.NONFINITE, Status.STEP_BUDGET
     status = np.asarray(status)
     inaccurate = int(np.count_nonzero(status == INACCURATE))
     nonfinite = int(np.count_nonzero(status == NONFINITE))
-    if not inaccurate and not nonfinite:
+    budget = int(np.count_nonzero(status == BUDGET))
+    if not inaccurate and not nonfinite and not budget:
         return EXIT_OK
     allowed = getattr(args, "allow_inaccurate", False)
     parts = []
     if inaccurate:
         worst = float(np.nanmax(np.where(status == INACCURATE, energy_drift, np.nan)))
+        early = ""
+        if stop_status is not None:
+            stops = np.asarray(stop_status).reshape(status.shape)[status == INACCURATE]
+            codes, n = np.unique(stops[stops != Status.DONE], return_counts=True)
+            if len(codes):
+                early = " (stopped early, not trusted: " + ", ".join(
+                    f"{k} {STATUS_NAMES[c]}" for c, k in zip(codes, n)) + ")"
         parts.append(f"{inaccurate} of {status.size} {what} inaccurate: conservation drift "
-                     f"above {max_drift:.3g} (largest energy drift {worst:.3g})")
+                     f"above {max_drift:.3g} (largest energy drift {worst:.3g}){early}")
+    if budget:
+        parts.append(f"{budget} of {status.size} {what} stopped by the step budget (far more "
+                     "steps than their time scales need: a perturbation too strong, or a "
+                     "near-contact)")
     if nonfinite:
         parts.append(f"{nonfinite} of {status.size} {what} non-finite (NaN/Inf)")
     print(f"ti-spinorbit {args.command}: {'; '.join(parts)}; kept in the data file with their "
           "status" + ("" if allowed else f"; tighten --rtol, or --allow-inaccurate to accept "
                                          f"(exit status {EXIT_INACCURATE})"), file=sys.stderr)
     return EXIT_OK if allowed else EXIT_INACCURATE
+
+
+def _status_text(result, k):
+    """Member k's status, with what it stopped for when the verdict overrode it
+    ("inaccurate (escape)")."""
+    from .results import STATUS_NAMES, Status
+
+    name = result.status_names[k]
+    stop = getattr(result, "stop_status", None)
+    if stop is not None and name == "inaccurate" and int(stop[k]) != Status.DONE:
+        name += f" ({STATUS_NAMES[int(stop[k])]})"
+    return name
 
 
 def _print(args, *lines):
@@ -1067,10 +1094,11 @@ def _cmd_section(args):
     for k, v in enumerate(starts):
         tilt = f", largest pole tilt {result.max_tilt[k]:.3g} deg" if tilted else ""
         _print(args, f"  thetadot_p/n = {v:5.2f}: {result.count[k]} crossings, status "
-                     f"{result.status_names[k]}, energy drift {result.energy_drift[k]:.1e}, "
+                     f"{_status_text(result, k)}, energy drift {result.energy_drift[k]:.1e}, "
                      f"angular-momentum drift {result.angmom_drift[k]:.1e}{tilt}")
     _print(args, f"wrote {out} and {data}", *filter(None, [_finish_checkpoint(args, data)]))
-    return _accuracy_status(args, result.status, result.energy_drift, result.max_drift)
+    return _accuracy_status(args, result.status, result.energy_drift, result.max_drift,
+                            stop_status=result.stop_status)
 
 
 def _cmd_map(args):

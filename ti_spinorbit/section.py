@@ -247,7 +247,10 @@ class SectionResult(Result, _display.Readable):
     ``coordinates`` "inertial" (``thetadot_p`` and ``initial_thetadot_p`` are the inertial
     spin rate) or "apsidal" (spin rate minus the apsidal rate ϖ̇, the paper's; ``apsidal_rate``
     then holds ϖ̇/n at every crossing, NaN where e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``);
-    θ_p is the same in both (docs/physics.md §6.7)."""
+    θ_p is the same in both (docs/physics.md §6.7); ``stop_status`` the integrator's own
+    status codes before the accuracy verdict: why each member stopped ("done" when it ran to
+    the end), kept for an "inaccurate" member that collided or escaped (None in files written
+    before it existed)."""
 
     theta_p: np.ndarray = unit('deg')
     thetadot_p: np.ndarray = unit(SPIN)
@@ -281,6 +284,7 @@ class SectionResult(Result, _display.Readable):
     max_npa_angle: np.ndarray = unit('deg', default=None)
     indicator_space: str = unit(INDICATOR_SPACE, default="planar")
     perturbations: tuple = unit(PERTURBATIONS, default=())
+    stop_status: np.ndarray = unit(STATUS, default=None)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -435,7 +439,8 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
         max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
-        indicator_space=indicator_space, perturbations=perturbations)
+        indicator_space=indicator_space, perturbations=perturbations,
+        stop_status=np.asarray(out.status, dtype=np.int32).copy())
 
 
 def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4):
@@ -496,7 +501,8 @@ class TimeSeriesResult(Result, _display.Readable):
     ``rtol``, ``orbits`` the run's tolerance and length (orbital periods); ``coordinates``
     "inertial" (as above) or "apsidal": then ``theta`` is the long axis from the osculating
     line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
-    e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7."""
+    e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7; ``stop_status`` the
+    integrator's status codes before the accuracy verdict (why each member stopped)."""
 
     t: np.ndarray = unit('s')
     alpha: np.ndarray = unit('deg')
@@ -528,6 +534,7 @@ class TimeSeriesResult(Result, _display.Readable):
     attitude_class: np.ndarray = unit(ATTITUDE_CLASS, default=None)
     states: np.ndarray = unit(STATE_ROW, default=None)
     perturbations: tuple = unit(PERTURBATIONS, default=())
+    stop_status: np.ndarray = unit(STATUS, default=None)
     work: np.ndarray = unit('J', default=None)
     external_angmom: np.ndarray = unit('kg m^2 s^-1', default=None)
 
@@ -692,7 +699,7 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa, attitude_class=_attitude_classes(members, out.samples),
         states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None,
-        perturbations=perturbations,
+        perturbations=perturbations, stop_status=np.asarray(out.status, dtype=np.int32).copy(),
         work=None if exchange is None else exchange[..., 0] * e_unit,
         external_angmom=None if exchange is None else exchange[..., 1:4] * l_unit)
 
