@@ -45,10 +45,13 @@ from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 
 RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE = range(6)
 #: Set on the host only, after a run, by the accuracy check (ti_spinorbit.accuracy): a
-#: finished member whose conservation drift exceeds the limit. Its data are kept.
+#: member whose conservation drift exceeds the limit. Its data are kept.
 INACCURATE = 6
+#: The member's accepted + rejected steps reached the launch's ``max_steps`` budget
+#: (ti_spinorbit.cost): stopped at its last accepted state, everything recorded kept.
+STEP_BUDGET = 7
 STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite",
-                "inaccurate")
+                "inaccurate", "step budget")
 
 #: Columns of 3-D event and sample records: time (scaled) then the 30-element scaled state
 #: (planar records are converted to this layout on the host).
@@ -244,7 +247,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 events: nd3f, n_events: nd1i, samples: nd3f, n_samples: nd1i, next_sample: nd1f,
                 shadow_nd: nd2f, shadow_f_nd: nd2f, ind: nd2f,
                 rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64, d0: ti.f64,
-                order: ti.template(), odd: ti.template(), sampling: ti.template(),
+                max_steps: ti.i64, order: ti.template(), odd: ti.template(), sampling: ti.template(),
                 indicators: ti.template()):
         """Advance every running member (see the module docstring)."""
         cap = events.shape[1]
@@ -269,6 +272,9 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 nsm = n_samples[i]
                 acc = 0
                 rej = 0
+                # steps left before the budget (counters carry every earlier launch's, so a
+                # resumed run stops at the same step as an uninterrupted one)
+                budget = max_steps - counters[i, C_ACCEPTED] - counters[i, C_REJECTED]
                 calls = 0
                 after_reject = 0
                 K = kmat(0.0)
@@ -361,6 +367,8 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 new_attempt = 1
                                 if h < min_step:
                                     st = ti.select(en >= NONFINITE_ERROR, NONFINITE, STEP_UNDERFLOW)
+                                elif acc + rej >= budget:
+                                    st = STEP_BUDGET
                     elif mode == _STEP:                         # fy = f(y_try) of an accepted step
                         g0 = model.pericentre_function(y)
                         g1 = model.pericentre_function(y_try)
@@ -422,6 +430,8 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 nsm += 1
                                 next_sample[i] += sample_dt
                         st = _stop_status(par, i, y)
+                        if st == RUNNING and t < ts and acc + rej >= budget:
+                            st = STEP_BUDGET
                 _store(y_nd, i, y)
                 _store(yc_nd, i, yc)
                 _store(f_nd, i, f0)

@@ -103,13 +103,14 @@ class RunState:
         return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
 
     def launch(self, advance, par, t_end, t_stop, events_buf, n_events, samples_buf, n_samples,
-               rtol, atol, min_step, sample_dt, separation, order, odd, sampling, indicators):
+               rtol, atol, min_step, sample_dt, separation, max_steps, order, odd, sampling,
+               indicators):
         """One launch of ``advance`` (a kernel set's ``advance``, or ``compiling.FirstUse``
         wrapping it) on this state, updated in place."""
         advance(par, self.y, self.yc, self.f, self.t, self.tc, self.h, t_end, t_stop,
-                     self.status, self.counters, events_buf, n_events, samples_buf, n_samples,
-                     self.next_sample, self.shadow, self.shadow_f, self.ind, rtol, atol,
-                     min_step, sample_dt, separation, order, odd, sampling, indicators)
+                self.status, self.counters, events_buf, n_events, samples_buf, n_samples,
+                self.next_sample, self.shadow, self.shadow_f, self.ind, rtol, atol,
+                min_step, sample_dt, separation, max_steps, order, odd, sampling, indicators)
 
 
 def check_tolerances(rtol, atol):
@@ -241,7 +242,8 @@ class Ensemble:
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
             indicators=False, separation=SHADOW_SEPARATION,
             progress: Optional[Callable[[float], None]] = None, checkpoint=None,
-            resume=False, overwrite_checkpoint=False, indicator_space="planar") -> RunOutput:
+            resume=False, overwrite_checkpoint=False, indicator_space="planar",
+            max_steps=None) -> RunOutput:
         """Integrate every member to ``t_stop`` (scaled; scalar or per member).
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
@@ -272,7 +274,14 @@ class Ensemble:
         refused at once (``CheckpointLocked``). Without ``resume`` a directory that holds a
         checkpoint is refused (``CheckpointExists``, nothing touched) unless
         ``overwrite_checkpoint=True`` replaces it.
+
+        ``max_steps`` caps every member's accepted + rejected steps (default: the budget of
+        :func:`ti_spinorbit.cost.step_budget`, 100 times the most expensive member's
+        estimate); a member that reaches it stops with the status "step budget" and keeps
+        what it recorded. A run whose estimated cost is above ``cost.LONG_RUN_STEPS`` warns
+        (:class:`ti_spinorbit.cost.LongRunWarning`) before it starts.
         """
+        from . import cost
         from . import checkpoint as ckpt
 
         kern = self.kernels
@@ -293,11 +302,18 @@ class Ensemble:
         require_memory("the recorded crossings and samples",
                        _record_bytes(t_stop, sample_dt, kern.RECORD_WIDTH, cap),
                        "integrate fewer members or orbits per call, or sample less densely")
+        estimate = cost.steps_per_orbit(self.par, self._y_start, self.rtol, self.method)
+        orbits = t_stop / (2.0 * np.pi)
+        cost.check_cost("the integration", estimate, orbits)
+        if max_steps is None:
+            max_steps = cost.step_budget(estimate, orbits)
+        max_steps = require_count("max_steps", max_steps, 1, 2 ** 62)
         settings = {"model": self.model, "method": self.method, "order": self.order, "odd": self.odd,
                     "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
                     "indicators": bool(indicators), "separation": float(separation),
-                    "indicator_space": indicator_space, "perturbed": self.perturbed}
+                    "indicator_space": indicator_space, "perturbed": self.perturbed,
+                    "max_steps": int(max_steps)}
         args = (t_stop, window_orbits, sample_dt, indicators, separation, progress, checkpoint,
                 resume, settings)
         if checkpoint is None:
@@ -351,7 +367,8 @@ class Ensemble:
             launched = time.perf_counter()
             st.launch(advance, self.kpar, t_end, t_stop, events_buf, n_events, samples_buf,
                       n_samples, self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
-                      float(separation), self.order, self.odd, sampling, bool(indicators))
+                      float(separation), int(settings["max_steps"]), self.order, self.odd,
+                      sampling, bool(indicators))
             compiled = advance.take_seconds()
             t0, launched = t0 + compiled, launched + compiled
             st.launches += 1

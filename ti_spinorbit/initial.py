@@ -163,12 +163,25 @@ class InitialState:
 
     # ---- checks that need the bodies ---------------------------------------------------------
     def check(self, system, name="initial state"):
-        """Raise ValueError (one line) if the bodies touch or the orbit is not bound.
+        """Raise ValueError (one line) if the bodies touch, the orbit is not bound, or a spin
+        is beyond the bounds every other path holds (|ω₁| <= ``MAX_PRIMARY_SPIN`` n and
+        |ω₂| <= ``MAX_SPIN`` n, ``ti_spinorbit._validate``: the steps per orbit grow with
+        the spin, so a faster one makes a run of unbounded length).
 
         Contact: |R| <= the sum of the bodies' bounding radii (the kernels' collision test).
         Bound: the two-point-mass orbital energy V²/2 − G(m1 + m2)/|R| must be negative; the
         mutual potential's higher orders change it by (size/|R|)² only, so this is the
         orbit's eccentricity < 1 test of the paper's set-up."""
+        from ._validate import MAX_PRIMARY_SPIN, MAX_SPIN
+
+        n = system.mean_motion
+        for body, omega, limit in (("primary", self.primary_omega, MAX_PRIMARY_SPIN),
+                                   ("secondary", self.secondary_omega, MAX_SPIN)):
+            rate = float(np.linalg.norm(omega)) / n
+            if not rate <= limit:
+                raise ValueError(f"{name}: {body}_omega is {rate:.3g} n (|ω| = "
+                                 f"{rate * n:.3g} rad/s); it must be at most {limit:g} n "
+                                 f"({limit * n:.3g} rad/s) for {system.name!r}")
         r = float(np.linalg.norm(self.R))
         contact = system.primary.bounding_radius + system.secondary.bounding_radius
         if r <= contact:

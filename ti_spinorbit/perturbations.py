@@ -49,6 +49,15 @@ Q_RANGE = (1e-3, 1e12)
 RADIUS_RANGE = (1e-3, 1e10)           # m
 STRENGTH_RANGE = (1e-12, 1e15)
 COEFFICIENT_LIMIT = 1.0               # |f_Y|, |B|
+#: How far a perturbation may go and still be one (checked per system when a run starts,
+#: :func:`perturbation_rows`): a spin changed by at most this many n per orbit (tide or
+#: YORP torque, with the tide's lag at its largest), the orbit's semimajor axis by at most
+#: this fraction per orbit (BYORP), the tide's conservative force at most this fraction of
+#: the mutual gravity at pericentre. Beyond them the "perturbation" is the dynamics, the
+#: first-order tidal expansion no longer holds, and the steps per orbit grow without bound.
+SPIN_CHANGE_LIMIT = 10.0              # n per orbit
+ORBIT_CHANGE_LIMIT = 0.1              # relative change of a per orbit
+TIDE_FORCE_LIMIT = 0.1                # conservative tide / mutual gravity at pericentre
 HELIOCENTRIC_A_RANGE = (0.05, 1e4)    # AU
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
 UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.perturbations)"
@@ -373,9 +382,59 @@ def check_perturbations(perturbations):
     return items
 
 
+def _largest_moment(system, body):
+    return float(np.max(getattr(system, body).moments))
+
+
+def change_per_orbit(p, system):
+    """How strongly ``p`` acts on ``system``: a list of (quantity, value, limit) with the
+    value scaling linearly with ``p.strength``. Spins in units of n per orbit (the torque's
+    largest value × 2π / (C n²), C the body's largest moment; a tide's lag taken at its
+    largest, 1/(2Q) or Δt·n), the semimajor axis as a fraction per orbit (BYORP, 4π a_B /
+    (n² a)), and the tide's conservative force κ / r_p⁷ over the mutual gravity G m₁ m₂ / r_p²
+    at pericentre r_p = a (1 − e)."""
+    from .systems import G
+
+    n, rp = system.mean_motion, system.a * (1.0 - system.e)
+    if isinstance(p, Tides):
+        kappa = p.coefficient(system)
+        lag = 0.5 / (p.Q if p.Q is not None else DEFAULT_Q) if p.time_lag is None \
+            else min(1.0, p.time_lag * n)
+        force = kappa / rp ** 5 / (G * system.primary.mass * system.secondary.mass)
+        spin = 2.0 * math.pi * kappa * lag / (rp ** 6 * _largest_moment(system, p.body) * n ** 2)
+        return [(f"the {p.body}'s spin", spin, SPIN_CHANGE_LIMIT, "n per orbit"),
+                ("the tide's force over the mutual gravity at pericentre", force,
+                 TIDE_FORCE_LIMIT, "")]
+    if isinstance(p, YORP):
+        spin = 2.0 * math.pi * abs(p.torque(system)) / (_largest_moment(system, p.body) * n ** 2)
+        return [(f"the {p.body}'s spin", spin, SPIN_CHANGE_LIMIT, "n per orbit")]
+    change = 4.0 * math.pi * abs(p.acceleration(system)) / (n ** 2 * system.a)
+    return [("the semimajor axis", change, ORBIT_CHANGE_LIMIT, "of itself per orbit")]
+
+
+def _check_strength(k, p, system):
+    """ValueError when ``p`` (perturbations[k]) is too strong to be a perturbation of
+    ``system`` (:func:`change_per_orbit`), naming the largest strength that is."""
+    changes = change_per_orbit(p, system)
+    largest = min(p.strength * limit / value if value > 0 else math.inf
+                  for _, value, limit, _ in changes)
+    for quantity, value, limit, unit_text in changes:
+        if not value <= limit:
+            amount = f"{value:.3g} {unit_text}".rstrip()
+            what = f"make {quantity} {amount}" if not unit_text else \
+                f"change {quantity} by {amount}"
+            raise ValueError(
+                f"perturbations[{k}] ({p.kind} on the {p.body}, strength {p.strength:g}) would "
+                f"{what} for {system.name!r}, above the limit {limit:g}: it would no longer be "
+                f"a perturbation; use a strength of at most {largest:.3g}")
+
+
 def perturbation_rows(systems, perturbations):
     """(N, NPERT) scaled blocks of the members' ``systems`` (one per member), or None
-    without perturbations."""
+    without perturbations. A perturbation too strong to be one for a member's system
+    (:func:`change_per_orbit` against :data:`SPIN_CHANGE_LIMIT`, :data:`ORBIT_CHANGE_LIMIT`,
+    :data:`TIDE_FORCE_LIMIT`) is refused here, before any work (ValueError naming it and the
+    largest strength allowed)."""
     items = check_perturbations(perturbations)
     if not items:
         return None
@@ -384,6 +443,8 @@ def perturbation_rows(systems, perturbations):
     for k, s in enumerate(systems):
         key = id(s)
         if key not in cache:
+            for j, p in enumerate(items):
+                _check_strength(j, p, s)
             cache[key] = sum((p.block(s) for p in items), np.zeros(NPERT))
         rows[k] = cache[key]
     return rows

@@ -30,7 +30,10 @@ import numpy as np
 class Status(enum.IntEnum):
     """A member's status: the integrator's verdict (kernels), then the accuracy check's
     (``INACCURATE``, set on the host by :mod:`ti_spinorbit.accuracy`). The values are the
-    codes stored in every ``status`` array and archive."""
+    codes stored in every ``status`` array and archive. ``STEP_BUDGET``: the member took more
+    steps than its budget (``ti_spinorbit.cost``) and was stopped there, so that a member the
+    integrator cannot carry never stalls the ensemble (a code after ``INACCURATE`` because
+    archives already hold codes 0-6)."""
 
     RUNNING = 0
     DONE = 1
@@ -39,6 +42,7 @@ class Status(enum.IntEnum):
     STEP_UNDERFLOW = 4
     NONFINITE = 5
     INACCURATE = 6
+    STEP_BUDGET = 7
 
     @property
     def label(self) -> str:
