@@ -196,7 +196,7 @@ def test_budget_stops_are_judged_and_the_cli_exits_3(tmp_path, capsys, monkeypat
 
 @pytest.mark.parametrize("method", ["cash-karp", "dop853", "vern9"])
 def test_step_estimate_bounds_the_measured_steps(method):
-    """The estimate is an upper bound within a factor of six of the steps a run takes, for a
+    """The estimate is an upper bound within a factor of eight of the steps a run takes, for a
     slow and a fast (15 n) primary, e = 0.05 and 0.3, two tolerances: far inside the budget's
     factor of 100, and a wrong exponent or spin term would leave the band."""
     from ti_spinorbit import section
@@ -209,7 +209,7 @@ def test_step_estimate_bounds_the_measured_steps(method):
                                        method=method)
             measured = (r.accepted + r.rejected) / 2.0
             ratio = cost.steps_per_orbit(par, y0, rtol, method) / measured
-            assert np.all((ratio >= 1.0) & (ratio <= 6.0)), (name, rtol, ratio)
+            assert np.all((ratio >= 1.0) & (ratio <= 8.0)), (name, rtol, ratio)
 
 
 def test_cost_tables_follow_the_kernels():

@@ -50,7 +50,8 @@ def test_bad_max_drift_is_refused_naming_it(bad):
     (DONE, 1e-9, 1e-3, INACCURATE),                # angular momentum above
     (DONE, np.nan, 1e-9, NONFINITE),               # never "done" with a NaN
     (DONE, 1e-9, np.inf, NONFINITE),
-    (COLLISION, 1e-3, 1e-3, COLLISION),            # stopped early: its own status stays
+    (COLLISION, 1e-3, 1e-3, INACCURATE),           # stopped early past the limit: not trusted
+    (COLLISION, 1e-9, 1e-9, COLLISION),            # stopped early within it: its own status
     (ESCAPE, np.nan, np.nan, ESCAPE),
     (STEP_UNDERFLOW, 1e-9, 1e-9, STEP_UNDERFLOW),
     (NONFINITE, np.nan, np.nan, NONFINITE)])

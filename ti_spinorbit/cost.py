@@ -11,10 +11,12 @@ past a perturbation, a spin of 10⁷ n). Two guards keep every accepted input fi
 
    with e_m the method's error exponent (1/5 Cash-Karp, 1/8 DOP853, 1/9 Verner 9(8): a step
    of length h makes an error ∝ h^(1/e_m)) and A_m the steps per orbit of a slowly spinning
-   member at rtol 1e-12. A_m is measured on the eleven catalogued systems (two starts
-   each, 3 orbits, rtol 1e-8, 1e-12 and 1e-15: ``python experiments/step_cost.py`` prints
-   the table): Cash-Karp 300-420, DOP853 56-89, Verner 29-45 steps per orbit at 1e-12, and
-   the fit's rtol slope within 5 % of e_m. ω₁ and ω₂ are read off the start (scaled units:
+   member at rtol 1e-12, set above what the eleven catalogued systems take (two starts
+   each, 3 orbits, rtol 1e-8, 1e-12 and 1e-15; ``python experiments/step_cost.py`` prints
+   the table): Cash-Karp 300-420, DOP853 53-89, Verner 27-45 steps per orbit at 1e-12. The
+   measured rtol slopes are −0.200, −0.112 and −0.095 against −e_m = −0.200, −0.125 and
+   −0.111, and the estimate is 2.1 to 5.6 times the measured steps of every member: an
+   upper bound, by design. ω₁ and ω₂ are read off the start (scaled units:
    n = 1) through the largest principal-moment ratio, so they bound the fastest component
    of the spin; the factor (1 − e)^(−3/2) is the pericentre's angular rate over n's, up to
    the (1 + e)^(1/2) that the fit does not need. The run's estimate is the sum over members.
@@ -29,8 +31,9 @@ past a perturbation, a spin of 10⁷ n). Two guards keep every accepted input fi
    member that reaches it stops at its last accepted state with the status
    ``"step budget"`` (:class:`ti_spinorbit.results.Status`), keeping everything recorded, and
    the rest of the ensemble goes on. ``BUDGET_FACTOR = 100`` is far above the estimate's
-   scatter (healthy members take 0.3-1.3 × the estimate), so only a member whose motion is
-   much stiffer than its time scales say (a near-contact, a runaway perturbation) meets it.
+   scatter (healthy members take 0.18-0.48 × the estimate), so only a member whose motion
+   is hundreds of times stiffer than its time scales say (a near-contact, a runaway
+   perturbation) meets it.
    One budget serves the whole launch (a kernel scalar): it is set by the member estimated
    to be the most expensive.
 

@@ -305,24 +305,26 @@ class Ensemble:
         estimate = cost.steps_per_orbit(self.par, self._y_start, self.rtol, self.method)
         orbits = t_stop / (2.0 * np.pi)
         cost.check_cost("the integration", estimate, orbits)
-        if max_steps is None:
-            max_steps = cost.step_budget(estimate, orbits)
-        max_steps = require_count("max_steps", max_steps, 1, 2 ** 62)
+        # the default budget follows from the inputs (the fingerprint covers them), so a
+        # checkpoint records only what was asked for
+        requested = None if max_steps is None else require_count("max_steps", max_steps, 1,
+                                                                   2 ** 62)
+        budget = cost.step_budget(estimate, orbits) if requested is None else requested
         settings = {"model": self.model, "method": self.method, "order": self.order, "odd": self.odd,
                     "rtol": self.rtol, "atol": self.atol, "min_step": self.min_step,
                     "window_orbits": window_orbits, "sample_dt": sample_dt,
                     "indicators": bool(indicators), "separation": float(separation),
                     "indicator_space": indicator_space, "perturbed": self.perturbed,
-                    "max_steps": int(max_steps)}
+                    "max_steps": requested}
         args = (t_stop, window_orbits, sample_dt, indicators, separation, progress, checkpoint,
-                resume, settings)
+                resume, settings, budget)
         if checkpoint is None:
             return self._windows(*args)
         with ckpt.claim(checkpoint, resume=resume, overwrite=overwrite_checkpoint):
             return self._windows(*args)
 
     def _windows(self, t_stop, window_orbits, sample_dt, indicators, separation, progress,
-                 checkpoint, resume, settings) -> RunOutput:
+                 checkpoint, resume, settings, max_steps) -> RunOutput:
         """The windows of :meth:`run` (inputs checked, checkpoint directory owned)."""
         import time
 
@@ -367,7 +369,7 @@ class Ensemble:
             launched = time.perf_counter()
             st.launch(advance, self.kpar, t_end, t_stop, events_buf, n_events, samples_buf,
                       n_samples, self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
-                      float(separation), int(settings["max_steps"]), self.order, self.odd,
+                      float(separation), int(max_steps), self.order, self.odd,
                       sampling, bool(indicators))
             compiled = advance.take_seconds()
             t0, launched = t0 + compiled, launched + compiled
