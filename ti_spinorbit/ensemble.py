@@ -398,12 +398,12 @@ class Ensemble:
             with np.errstate(divide="ignore", invalid="ignore"):
                 megno = ind[:, 2] / self.t
                 lyapunov = ind[:, 0] / self.t * 2.0 * np.pi   # per orbit (2π scaled time)
-        ev = [self._spatial_records(e) for e in events]
-        sm = [self._spatial_records(s) for s in samples]
+        ev, ev_x = self._spatial_records(events)
+        sm, sm_x = self._spatial_records(samples)
         return RunOutput(
-            events=[e for e, _ in ev], samples=[s for s, _ in sm],
-            event_exchange=[x for _, x in ev] if self.perturbed else None,
-            sample_exchange=[x for _, x in sm] if self.perturbed else None,
+            events=ev, samples=sm,
+            event_exchange=ev_x if self.perturbed else None,
+            sample_exchange=sm_x if self.perturbed else None,
             exchange=self.exchange(self.y),
             diag_start=st.diag_start, diag_end=self.diagnostics(), t=self.t.copy(),
             y=self.spatial(self.y), status=self.status.copy(), counters=self.counters.copy(),
@@ -465,20 +465,27 @@ class Ensemble:
             h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
         return h.hexdigest()
 
-    def _spatial_records(self, chunks):
-        """Concatenate a member's record chunks and convert them to (count, 31) 3-D rows;
-        with the accumulators of a perturbed run apart, (count, 4) (else an empty array)."""
+    def _spatial_records(self, chunks_per_member):
+        """Every member's record chunks as (count, 31) 3-D rows (time, state), and apart the
+        accumulators of a perturbed run, (count, NACC) (zero columns without): two lists,
+        one entry per member. All members are converted in one pass, then split."""
         from .kernels import ensemble as K
-        from .perturbations import NACC
 
-        if not chunks:
-            return np.zeros((0, K.RECORD_WIDTH)), np.zeros((0, NACC))
-        rec = np.concatenate(chunks)
+        counts = np.array([sum(len(c) for c in chunks) for chunks in chunks_per_member],
+                          dtype=np.int64)
         ns = 1 + self.equations.nstate
+        width = self.kernels.RECORD_WIDTH
+        rec = np.concatenate([np.zeros((0, width))] +
+                             [c for chunks in chunks_per_member for c in chunks])
         acc = rec[:, ns:]
         if self.equations is models.SPATIAL:
-            return rec[:, :ns], acc
-        return np.concatenate([rec[:, :1], self.equations.to_spatial(rec[:, 1:ns])], axis=1), acc
+            rows = rec[:, :ns]
+        else:
+            rows = np.empty((len(rec), K.RECORD_WIDTH))
+            rows[:, 0] = rec[:, 0]
+            rows[:, 1:] = self.equations.to_spatial(rec[:, 1:ns])
+        cuts = np.cumsum(counts)[:-1]
+        return np.split(rows, cuts), np.split(acc, cuts)
 
 
 def _next_span(span, seconds, window):

@@ -156,9 +156,14 @@ def build_members(system: SystemLike, theta_p, thetadot_p,
                          f"{theta_p.shape} and thetadot_p of shape {thetadot_p.shape}") from None
     index, theta_p, thetadot_p = (np.ravel(x) for x in (index, theta_p, thetadot_p))
     members = [systems[k] for k in index]
-    par = _parameter_rows(members, escape_distance)
-    y0 = np.stack([s.initial_state(np.radians(tp), td)
-                   for s, tp, td in zip(members, theta_p, thetadot_p)])
+    # one row and one vectorised start per distinct system, spread over its members
+    par = np.empty((len(index), len(systems[0].parameter_row(escape_distance))))
+    y0 = np.empty((len(index), 30))
+    for k, system in enumerate(systems):
+        sel = np.flatnonzero(index == k)
+        if len(sel):
+            par[sel] = system.parameter_row(escape_distance)
+            y0[sel] = system.initial_states(np.radians(theta_p[sel]), thetadot_p[sel])
     if coordinates == "apsidal":
         y0, _ = _coords.apsidal_initial_states(members, par, y0, theta_p, thetadot_p, order)
     return members, par, y0, theta_p.copy(), thetadot_p.copy()
@@ -209,25 +214,41 @@ def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordin
     return state_members(system, initial_states, escape_distance)
 
 
+def _member_groups(members):
+    """[(system, member indices)] of the distinct systems of a member list, in first-seen
+    order (one entry for an ensemble of one system)."""
+    ids = np.fromiter(map(id, members), dtype=np.uint64, count=len(members))
+    _, first, inverse = np.unique(ids, return_index=True, return_inverse=True)
+    order = np.argsort(first)                       # groups in first-seen order
+    return [(members[first[g]], np.flatnonzero(inverse.ravel() == g)) for g in order]
+
+
+def _segment_max(values, counts, floor):
+    """Per segment of ``values`` (consecutive runs of ``counts``), the largest non-NaN value
+    joined with ``floor`` by ``np.fmax`` (a segment with none keeps ``floor``)."""
+    out = np.array(floor, dtype=np.float64, copy=True)
+    has = counts > 0
+    if has.any():
+        starts = (np.cumsum(counts) - counts)[has]
+        out[has] = np.fmax(out[has], np.fmax.reduceat(values, starts))
+    return out
+
+
 def _state_rows_and_tilt(members, records_list, y0, y_end):
     """Per member: its start as a state row (docs/physics.md §6.8), the largest pole tilt and
     the largest angle of the spin angular momentum from the short axis (degrees,
-    docs/physics.md §6.9) over the start, every record and the end."""
+    docs/physics.md §6.9) over the start, every record and the end. Every record of every
+    member goes through one array pass (no loop over members)."""
     from .attitude import npa_angle, pole_tilt
     from .initial import physical_rows
 
     rows = np.empty((len(members), 30))
-    groups = {}
-    for k, m in enumerate(members):
-        groups.setdefault(id(m), (m, []))[1].append(k)
-    for m, idx in groups.values():
+    for m, idx in _member_groups(members):
         rows[idx] = physical_rows(m, y0[idx])
-    tilt = np.fmax(pole_tilt(y0), pole_tilt(y_end))
-    npa = np.fmax(npa_angle(y0), npa_angle(y_end))
-    for k, rec in enumerate(records_list):
-        if len(rec):
-            tilt[k] = max(tilt[k], float(np.nanmax(pole_tilt(rec[:, 1:]))))
-            npa[k] = max(npa[k], float(np.nanmax(npa_angle(rec[:, 1:]))))
+    counts = np.fromiter((len(r) for r in records_list), dtype=np.int64, count=len(records_list))
+    flat = np.concatenate([np.zeros((0, 30))] + [r[:, 1:31] for r in records_list if len(r)])
+    tilt = _segment_max(pole_tilt(flat), counts, np.fmax(pole_tilt(y0), pole_tilt(y_end)))
+    npa = _segment_max(npa_angle(flat), counts, np.fmax(npa_angle(y0), npa_angle(y_end)))
     return rows, tilt, npa
 
 
