@@ -226,8 +226,17 @@ class BinarySystem(_display.Readable):
         """Scaled 30-element state at pericentre (docs/physics.md §6.4).
 
         theta_p in radians from the line of centres, thetadot_p in units of n."""
+        return self.initial_states(np.array([theta_p], dtype=np.float64),
+                                   np.array([thetadot_p], dtype=np.float64))[0]
+
+    def initial_states(self, theta_p, thetadot_p) -> np.ndarray:
+        """:meth:`initial_state` of many starts at once: theta_p (radians) and thetadot_p
+        (units of n) 1-D arrays of one length; returns (N, 30). The numbers are those of
+        the one-start form, bit for bit (the same operations, elementwise)."""
         from .kernels import eom
 
+        theta_p = np.asarray(theta_p, dtype=np.float64).ravel()
+        thetadot_p = np.asarray(thetadot_p, dtype=np.float64).ravel()
         e = self.e
         r = 1.0 - e
         v = math.sqrt((1.0 + e) / (1.0 - e))        # vis-viva at pericentre, μ = a = 1
@@ -235,16 +244,18 @@ class BinarySystem(_display.Readable):
             2.0 * math.pi / (self.primary_spin_period * self.mean_motion)
         I1 = self.primary.moments / (self.total_mass * self.a**2)
         I2 = self.secondary.moments / (self.total_mass * self.a**2)
-        c, s = math.cos(theta_p), math.sin(theta_p)
-        S = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        y = np.zeros(eom.NSTATE)
-        y[eom.Y_R:eom.Y_R + 3] = (r, 0.0, 0.0)
-        y[eom.Y_V:eom.Y_V + 3] = (0.0, v, 0.0)
-        y[eom.Y_W1 + 2] = I1[2] * omega1 / I1.max()
+        # the C library's cos and sin, as ever (NumPy's vector forms may differ in the last bit)
+        c = np.fromiter(map(math.cos, theta_p), dtype=np.float64, count=len(theta_p))
+        s = np.fromiter(map(math.sin, theta_p), dtype=np.float64, count=len(theta_p))
+        y = np.zeros((len(theta_p), eom.NSTATE))
+        y[:, eom.Y_R] = r
+        y[:, eom.Y_V + 1] = v
+        y[:, eom.Y_W1 + 2] = I1[2] * omega1 / I1.max()
         # spin about z (a principal axis of both frames since S is a z-rotation)
-        y[eom.Y_W2 + 2] = I2[2] * thetadot_p / I2.max()
-        y[eom.Y_S:eom.Y_S + 9] = S.ravel()
-        y[eom.Y_S1:eom.Y_S1 + 9] = np.eye(3).ravel()
+        y[:, eom.Y_W2 + 2] = I2[2] * thetadot_p / I2.max()
+        S = y[:, eom.Y_S:eom.Y_S + 9]                 # [[c, -s, 0], [s, c, 0], [0, 0, 1]]
+        S[:, 0], S[:, 1], S[:, 3], S[:, 4], S[:, 8] = c, -s, s, c, 1.0
+        y[:, eom.Y_S1:eom.Y_S1 + 9] = np.eye(3).ravel()
         return y
 
     def tilted_start(self, theta_p: float, thetadot_p: float, **tilts):
