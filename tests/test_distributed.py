@@ -7,7 +7,6 @@ workers keep Taichi's default settings so that they share offline-cache entries 
 process (a different cpu_max_num_threads would compile everything again)."""
 
 import dataclasses
-import inspect
 import os
 import subprocess
 import sys
@@ -214,9 +213,8 @@ def test_argument_errors(client, vh):
         tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, rtol=0.5)
     with pytest.raises(TypeError, match="rtool"):
         tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, rtool=1e-9)
-    if "checkpoint" in inspect.signature(tso.surface_of_section).parameters:
-        with pytest.raises(ValueError, match="checkpoint"):   # chunks would share one file
-            tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, checkpoint="run.ckpt")
+    with pytest.raises(ValueError, match="checkpoint"):       # chunks would share one file
+        tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, checkpoint="run.ckpt")
 
 
 def test_ensemble_wide_model_choice_is_made_over_all_members(client, rng, faulty_workers):
@@ -225,8 +223,6 @@ def test_ensemble_wide_model_choice_is_made_over_all_members(client, rng, faulty
     chunk of an ensemble holding one lumpy, not equator-symmetric, system must be told to use
     the 3-D model, even a chunk of plain ellipsoids that would qualify on its own. (Checked
     on what the chunks receive: integrating the lumpy 3-D kernels costs minutes of compile.)"""
-    if "model" not in inspect.signature(tso.surface_of_section).parameters:
-        pytest.skip("surface_of_section has no model choice")
     lumpy = tso.BinarySystem(lumpy_body(rng, scale=300.0, mass=2e12),
                              lumpy_body(rng, scale=100.0, mass=1e11), 3000.0, 0.1, name="lumpy")
     plain = tso.catalog.system("test")
