@@ -36,6 +36,10 @@ from types import SimpleNamespace
 
 import taichi as ti
 
+from ti_spinorbit.layout import (C_ACCEPTED, C_REJECTED, C_RHS, COLLISION, DIAG_FIELDS, DONE,
+                                 ESCAPE, INACCURATE, NONFINITE, RECORD_WIDTH, RUNNING,
+                                 STATUS_NAMES, STEP_BUDGET, STEP_UNDERFLOW)
+
 from . import eom, perturb, planar
 from .eom import NSTATE
 from .controller import DEFAULT_CONTROLLER, NONFINITE_ERROR
@@ -43,25 +47,10 @@ from .integrator import make_error_norm, make_primitives, stage_matrix_type
 from .potential import mutual, vec3
 from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 
-RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE = range(6)
-#: Set on the host only, after a run, by the accuracy check (ti_spinorbit.accuracy): a
-#: member whose conservation drift exceeds the limit. Its data are kept.
-INACCURATE = 6
-#: The member's accepted + rejected steps reached the launch's ``max_steps`` budget
-#: (ti_spinorbit.cost): stopped at its last accepted state, everything recorded kept.
-STEP_BUDGET = 7
-STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite",
-                "inaccurate", "step budget")
-
-#: Columns of 3-D event and sample records: time (scaled) then the 30-element scaled state
-#: (planar records are converted to this layout on the host).
-RECORD_WIDTH = 1 + NSTATE
-DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
-               "L_orbit_x", "L_orbit_y", "L_orbit_z", "L_primary_x", "L_primary_y",
-               "L_primary_z", "L_secondary_x", "L_secondary_y", "L_secondary_z",
-               "orth_S", "orth_S1")
-# Counter columns.
-C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2
+# Status codes, record width, diagnostics and counter columns are ti_spinorbit.layout's.
+# INACCURATE is set on the host only, by the accuracy check; STEP_BUDGET when a member's
+# accepted + rejected steps reach the launch's ``max_steps`` (stopped at its last accepted
+# state, everything recorded kept). The host imports them from there, not from here.
 
 NEWTON_MAX_ITER = DEFAULT_CONTROLLER.event_max_iter
 #: Largest stage matrix (stages x state components) kept in registers with unrolled

@@ -23,29 +23,21 @@ dS/dt = hat(Ω2 − Ω1) S equals S hat(Ω2') − hat(Ω1) S because S hat(x) S�
 import taichi as ti
 
 from ti_spinorbit.bodies import ROW_LENGTH
+from ti_spinorbit.layout import spatial as _L
 
 from . import perturb
 from .potential import mat_t_vec, mat_vec, mutual, vec3, mat3
 
-NSTATE = 30
+# The state offsets and the member parameter row (two body rows, then derived constants,
+# scaled units) are ti_spinorbit.layout's, shared with the host.
+NSTATE = _L.NSTATE
+Y_R, Y_V, Y_W1, Y_W2, Y_S, Y_S1 = _L.Y_R, _L.Y_V, _L.Y_W1, _L.Y_W2, _L.Y_S, _L.Y_S1
+BODY_A, BODY_B = _L.BODY_A, _L.BODY_B
+P_MRED, P_C1, P_C2, P_IA, P_IB = _L.P_MRED, _L.P_C1, _L.P_C2, _L.P_IA, _L.P_IB
+P_CONTACT, P_ESCAPE, NPAR = _L.P_CONTACT, _L.P_ESCAPE, _L.NPAR
 state = ti.types.vector(NSTATE, ti.f64)
 #: State with the perturbation accumulators (W, L_ext) appended (``perturb.NACC``).
 state_perturbed = ti.types.vector(NSTATE + perturb.NACC, ti.f64)
-
-# Member parameter row layout (scaled units): two body rows, then derived constants.
-BODY_A = 0
-BODY_B = ROW_LENGTH
-P_MRED = 2 * ROW_LENGTH          # reduced mass m1 m2 / (m1 + m2)
-P_C1 = P_MRED + 1                # largest principal moment of the primary
-P_C2 = P_MRED + 2                # largest principal moment of the secondary
-P_IA = P_MRED + 3                # C1 / (A1, B1, C1)
-P_IB = P_MRED + 6                # C2 / (A2, B2, C2)
-P_CONTACT = P_MRED + 9           # sum of bounding radii: collision below this distance
-P_ESCAPE = P_MRED + 10           # escape beyond this distance
-NPAR = P_MRED + 11
-
-# Offsets in the state vector.
-Y_R, Y_V, Y_W1, Y_W2, Y_S, Y_S1 = 0, 3, 6, 9, 12, 21
 
 
 @ti.func

@@ -49,28 +49,21 @@ The torques about z are τ_k = −V_k, so m ℓ + Γ1 + Γ2 is conserved exactly
 
 import taichi as ti
 
+from ti_spinorbit.layout import planar as _L
+
 from . import perturb
 
-NSTATE = 10
+# The state offsets and the member parameter row (scaled units) are ti_spinorbit.layout's,
+# shared with the host (ti_spinorbit.planar fills the row).
+NSTATE = _L.NSTATE
+Y_R, Y_VR, Y_L, Y_LAM, Y_CA, Y_SA = _L.Y_R, _L.Y_VR, _L.Y_L, _L.Y_LAM, _L.Y_CA, _L.Y_SA
+Y_W1, Y_CB, Y_SB, Y_W2 = _L.Y_W1, _L.Y_CB, _L.Y_SB, _L.Y_W2
+P_MM, P_INV_M, P_K1, P_F1, P_K2, P_F2 = _L.P_MM, _L.P_INV_M, _L.P_K1, _L.P_F1, _L.P_K2, _L.P_F2
+P_P2, P_Q2, P_P3, P_Q3, P_P4, P_Q4 = _L.P_P2, _L.P_Q2, _L.P_P3, _L.P_Q3, _L.P_P4, _L.P_Q4
+P_X, P_CONTACT, P_ESCAPE, NPAR = _L.P_X, _L.P_CONTACT, _L.P_ESCAPE, _L.NPAR
 state = ti.types.vector(NSTATE, ti.f64)
 #: State with the perturbation accumulators (W, L_ext) appended (``perturb.NACC``).
 state_perturbed = ti.types.vector(NSTATE + perturb.NACC, ti.f64)
-
-# Offsets in the state vector.
-Y_R, Y_VR, Y_L, Y_LAM, Y_CA, Y_SA, Y_W1, Y_CB, Y_SB, Y_W2 = range(10)
-
-# Member parameter row (scaled units).
-P_MM = 0            # mA mB
-P_INV_M = 1         # 1 / reduced mass
-P_K1, P_F1 = 2, 3   # 1/C1 (torque -> dw1/dt), C1/I1zz (w1 -> ω1)
-P_K2, P_F2 = 4, 5
-P_P2, P_Q2 = 6, 9            # (a0, a2, b2)
-P_P3, P_Q3 = 12, 16          # (a1, b1, a3, b3)
-P_P4, P_Q4 = 20, 25          # (a0, a2, b2, a4, b4)
-P_X = 30                     # (x0, xA, xB, xAB, xm)
-P_CONTACT = 35
-P_ESCAPE = 36
-NPAR = 37
 
 
 @ti.func

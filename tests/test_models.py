@@ -44,7 +44,6 @@ def test_spatial_shadow_direction_matches_the_kernel_layout():
     u = np.zeros(eom.NSTATE)
     u[[eom.Y_R, eom.Y_R + 1, eom.Y_V, eom.Y_V + 1, eom.Y_W2 + 2]] = 1.0
     assert np.array_equal(models.SPATIAL.shadow_direction(), u / np.linalg.norm(u))
-    assert models.SPATIAL_NSTATE == eom.NSTATE
 
 
 def test_ensemble_uses_the_model_object(rows):

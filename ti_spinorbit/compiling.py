@@ -186,7 +186,7 @@ def _launch(kernel, args):
 def _one_member(args, n, status):
     """Arguments of a compile-only launch: one-member copies of every per-member array (first
     dimension ``n``), the status "done" (the kernel skips the member); the rest as given."""
-    from .kernels.ensemble import DONE
+    from .layout import DONE
 
     out = []
     for a in args:

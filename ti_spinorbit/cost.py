@@ -44,6 +44,8 @@ import warnings
 
 import numpy as np
 
+from .layout import spatial as _L
+
 #: Steps per orbit of a slowly spinning, near-circular member at rtol 1e-12, and the
 #: method's error exponent (kernels/tableau.py ``error_exponent``; a test checks they agree).
 METHOD_COST = {"cash-karp": (420.0, 1.0 / 5.0), "dop853": (90.0, 1.0 / 8.0),
@@ -56,8 +58,6 @@ BUDGET_FLOOR = 100_000
 #: 1e10 steps is 20-60 minutes of two CPU cores with the 3-D model.
 LONG_RUN_STEPS = 1e10
 
-# offsets in the 30-number scaled state and parameter row (kernels/eom.py; checked by tests)
-_Y_R, _Y_V, _Y_W1, _Y_W2 = 0, 3, 6, 9
 
 
 class LongRunWarning(UserWarning):
@@ -73,15 +73,12 @@ def steps_per_orbit(par, y0, rtol, method="cash-karp"):
     """Estimated integration steps per orbit of each member, (N,) floats (see the module
     docstring). ``par`` the members' scaled parameter rows, ``y0`` their 30-number scaled
     starts (``BinarySystem.initial_state``), ``rtol`` the relative tolerance."""
-    from .bodies import ROW_LENGTH
-
     amplitude, exponent = METHOD_COST[method]
     par = np.asarray(par, dtype=np.float64)
     y0 = np.asarray(y0, dtype=np.float64)
-    p_ia = 2 * ROW_LENGTH + 3                   # kernels/eom.py P_IA, then P_IB
-    w1 = _spin_bound(y0[:, _Y_W1:_Y_W1 + 3], par[:, p_ia:p_ia + 3])
-    w2 = _spin_bound(y0[:, _Y_W2:_Y_W2 + 3], par[:, p_ia + 3:p_ia + 6])
-    R, V = y0[:, _Y_R:_Y_R + 3], y0[:, _Y_V:_Y_V + 3]
+    w1 = _spin_bound(y0[:, _L.Y_W1:_L.Y_W1 + 3], par[:, _L.P_IA:_L.P_IA + 3])
+    w2 = _spin_bound(y0[:, _L.Y_W2:_L.Y_W2 + 3], par[:, _L.P_IB:_L.P_IB + 3])
+    R, V = y0[:, _L.Y_R:_L.Y_R + 3], y0[:, _L.Y_V:_L.Y_V + 3]
     r = np.linalg.norm(R, axis=1)
     # eccentricity vector with G(m1 + m2) = 1 (scaled units)
     ev = (np.sum(V * V, axis=1) - 1.0 / r)[:, None] * R - np.sum(R * V, axis=1)[:, None] * V

@@ -20,7 +20,7 @@ from typing import Callable, List, Optional
 
 import numpy as np
 
-from . import compiling, models, runtime
+from . import compiling, layout, models, runtime
 from ._validate import (require_count, require_memory, require_positive, require_range,
                         require_real)
 
@@ -234,7 +234,7 @@ class Ensemble:
             np.ascontiguousarray(y, dtype=np.float64).reshape(-1, 30)
         member = np.arange(len(y), dtype=np.int32) if member is None else \
             np.ascontiguousarray(member, dtype=np.int32)
-        out = np.zeros((len(y), len(K.DIAG_FIELDS)))
+        out = np.zeros((len(y), len(layout.DIAG_FIELDS)))
         if len(y):
             K.diagnostics(self.par, y, member, out, self.order, self.odd)
         return out
@@ -329,7 +329,6 @@ class Ensemble:
         import time
 
         from . import checkpoint as ckpt
-        from .kernels import ensemble as K
 
         kern = self.kernels
         n = self.n
@@ -364,7 +363,7 @@ class Ensemble:
                    {i: list(s) for i, s in enumerate(samples) if s}}
         t0 = time.perf_counter() - st.seconds
         span = min(window, 2.0 * np.pi)  # first window: one orbit, then adapted to wall time
-        while np.any(self.status == K.RUNNING):
+        while np.any(self.status == layout.RUNNING):
             t_end = np.minimum(t_stop, self.t + span)
             launched = time.perf_counter()
             st.launch(advance, self.kpar, t_end, t_stop, events_buf, n_events, samples_buf,
@@ -384,8 +383,8 @@ class Ensemble:
                     pending[name].setdefault(i, []).append(chunk)
             n_events[:] = 0
             n_samples[:] = 0
-            finished = (self.status == K.RUNNING) & (self.t >= t_stop)
-            self.status[finished] = K.DONE
+            finished = (self.status == layout.RUNNING) & (self.t >= t_stop)
+            self.status[finished] = layout.DONE
             st.seconds = time.perf_counter() - t0
             if checkpoint is not None:
                 ckpt.save(checkpoint, settings, fingerprint, st.as_dict(), pending)
@@ -469,8 +468,6 @@ class Ensemble:
         """Every member's record chunks as (count, 31) 3-D rows (time, state), and apart the
         accumulators of a perturbed run, (count, NACC) (zero columns without): two lists,
         one entry per member. All members are converted in one pass, then split."""
-        from .kernels import ensemble as K
-
         counts = np.array([sum(len(c) for c in chunks) for chunks in chunks_per_member],
                           dtype=np.int64)
         ns = 1 + self.equations.nstate
@@ -481,7 +478,7 @@ class Ensemble:
         if self.equations is models.SPATIAL:
             rows = rec[:, :ns]
         else:
-            rows = np.empty((len(rec), K.RECORD_WIDTH))
+            rows = np.empty((len(rec), layout.RECORD_WIDTH))
             rows[:, 0] = rec[:, 0]
             rows[:, 1:] = self.equations.to_spatial(rec[:, 1:ns])
         cuts = np.cumsum(counts)[:-1]

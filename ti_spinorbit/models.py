@@ -16,9 +16,10 @@ not import Taichi.
 import numpy as np
 
 from . import planar as _planar
+from .layout import planar as _planar_layout, spatial as _spatial_layout
 
 #: Number of state components of the public (3-D) layout.
-SPATIAL_NSTATE = 30
+SPATIAL_NSTATE = _spatial_layout.NSTATE
 #: Seed of the full-space shadow direction (``indicator_space="full"``): fixed, so that runs
 #: are reproducible and every member gets the same random components.
 FULL_DIRECTION_SEED = 20151030
@@ -115,10 +116,9 @@ class Spatial(Model):
     def shadow_direction(self):
         """R_x, R_y, V_x, V_y and the secondary's spin w2_z, so a planar start stays planar
         (the same for every member: slot-invariant)."""
-        # state offsets of kernels/eom.py (Y_R = 0, Y_V = 3, Y_W2 = 9), kept here so that
-        # this module does not import Taichi
+        L = _spatial_layout
         u = np.zeros(SPATIAL_NSTATE)
-        u[[0, 1, 3, 4, 9 + 2]] = 1.0
+        u[[L.Y_R, L.Y_R + 1, L.Y_V, L.Y_V + 1, L.Y_W2 + 2]] = 1.0
         return u / np.linalg.norm(u)
 
     def full_direction(self, y):
@@ -141,7 +141,7 @@ class Spatial(Model):
 
 class Planar(Model):
     name = "planar"
-    nstate = 10
+    nstate = _planar_layout.NSTATE
 
     def qualifies(self, par, y0):
         return _planar.qualifies(par, y0)

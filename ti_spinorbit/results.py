@@ -26,6 +26,8 @@ import enum
 
 import numpy as np
 
+from . import layout
+
 
 class Status(enum.IntEnum):
     """A member's status: the integrator's verdict (kernels), then the accuracy check's
@@ -35,14 +37,14 @@ class Status(enum.IntEnum):
     integrator cannot carry never stalls the ensemble (a code after ``INACCURATE`` because
     archives already hold codes 0-6)."""
 
-    RUNNING = 0
-    DONE = 1
-    COLLISION = 2
-    ESCAPE = 3
-    STEP_UNDERFLOW = 4
-    NONFINITE = 5
-    INACCURATE = 6
-    STEP_BUDGET = 7
+    RUNNING = layout.RUNNING
+    DONE = layout.DONE
+    COLLISION = layout.COLLISION
+    ESCAPE = layout.ESCAPE
+    STEP_UNDERFLOW = layout.STEP_UNDERFLOW
+    NONFINITE = layout.NONFINITE
+    INACCURATE = layout.INACCURATE
+    STEP_BUDGET = layout.STEP_BUDGET
 
     @property
     def label(self) -> str:
@@ -59,9 +61,8 @@ class Status(enum.IntEnum):
                              f"(got {text!r})") from None
 
 
-#: Status names by code (the text of ``status_names``; equal to kernels.ensemble.STATUS_NAMES).
-STATUS_NAMES = tuple(s.name.lower().replace("_", " ").replace("nonfinite", "non-finite")
-                     for s in Status)
+#: Status names by code (the text of ``status_names``), ti_spinorbit.layout's.
+STATUS_NAMES = layout.STATUS_NAMES
 
 # units shared by many fields
 SPIN = "mean motion n"                 # spin rates and frequencies in units of n

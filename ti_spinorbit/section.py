@@ -470,7 +470,7 @@ def _derived_columns(par, records, names, ensemble=None, apsidal=False, order=4)
     split (scaled); with ``apsidal`` also "apsidal_rate" (ϖ̇/n, model of ``order``) and
     "true_anomaly" (rad) of the osculating orbit (docs/physics.md §6.7). All records are
     derived together: one NumPy pass, one kernel launch."""
-    from .kernels.ensemble import RECORD_WIDTH
+    from .layout import RECORD_WIDTH
     from .observables import derive
 
     counts = np.array([len(r) for r in records])

@@ -1,0 +1,100 @@
+"""The layouts the kernels and the host share: state offsets, parameter columns, the
+perturbation block, record widths and status codes, in one place and without Taichi.
+
+The kernels (``kernels/eom.py``, ``kernels/planar.py``, ``kernels/perturb.py``,
+``kernels/ensemble.py``) take their offsets from here, and so does every host module that
+reads a state or a parameter row (cost estimates, shadow directions, observables), so a
+layout is written once and nothing has to be kept in step by hand.
+
+**3-D model** (``kernels/eom.py``; docs/physics.md §4): the 30-number scaled state
+
+    y = [R(3), V(3), w1(3), w2(3), S(9, row-major), S1(9, row-major)]
+
+(length a, time 1/n, mass m1 + m2; w = Γ/C), and a parameter row of the two bodies' rows
+(``bodies.ROW_LENGTH`` each) followed by the derived constants P_MRED ... P_ESCAPE.
+
+**Planar model** (``kernels/planar.py``; docs/physics.md §5): the 10-number state
+[r, v_r, ℓ, λ, cos ψ_A, sin ψ_A, w1, cos ψ_B, sin ψ_B, w2] and a 37-column row of Fourier
+coefficients of the mutual potential (``ti_spinorbit.planar.parameter_rows``).
+
+**Perturbations** (``kernels/perturb.py``; docs/physics.md §13): a block of NPERT columns after
+a model's row, and NACC accumulators (work W, external angular momentum L_ext) after its state.
+
+**Records**: one row per event or sample, the time and then the 3-D state (RECORD_WIDTH);
+planar records are converted to it on the host.
+
+**Statuses**: the codes in every ``status`` array, archive and checkpoint
+(:class:`ti_spinorbit.results.Status` names them). Codes are never renumbered: files hold
+them.
+"""
+
+from .bodies import ROW_LENGTH
+
+
+class spatial:
+    """The 3-D model's state offsets and parameter columns (``kernels/eom.py``)."""
+
+    NSTATE = 30
+    Y_R, Y_V, Y_W1, Y_W2, Y_S, Y_S1 = 0, 3, 6, 9, 12, 21
+    BODY_A = 0                       # the primary's body row
+    BODY_B = ROW_LENGTH              # the secondary's
+    P_MRED = 2 * ROW_LENGTH          # reduced mass m1 m2 / (m1 + m2)
+    P_C1 = P_MRED + 1                # largest principal moment of the primary
+    P_C2 = P_MRED + 2                # largest principal moment of the secondary
+    P_IA = P_MRED + 3                # C1 / (A1, B1, C1)
+    P_IB = P_MRED + 6                # C2 / (A2, B2, C2)
+    P_CONTACT = P_MRED + 9           # sum of bounding radii: collision below this distance
+    P_ESCAPE = P_MRED + 10           # escape beyond this distance
+    NPAR = P_MRED + 11
+
+
+class planar:
+    """The planar model's state offsets and parameter columns (``kernels/planar.py``)."""
+
+    NSTATE = 10
+    Y_R, Y_VR, Y_L, Y_LAM, Y_CA, Y_SA, Y_W1, Y_CB, Y_SB, Y_W2 = range(10)
+    P_MM = 0                         # mA mB
+    P_INV_M = 1                      # 1 / reduced mass
+    P_K1, P_F1 = 2, 3                # 1/C1 (torque -> dw1/dt), C1/I1zz (w1 -> ω1)
+    P_K2, P_F2 = 4, 5
+    P_P2, P_Q2 = 6, 9                # (a0, a2, b2)
+    P_P3, P_Q3 = 12, 16              # (a1, b1, a3, b3)
+    P_P4, P_Q4 = 20, 25              # (a0, a2, b2, a4, b4)
+    P_X = 30                         # (x0, xA, xB, xAB, xm)
+    P_CONTACT = 35
+    P_ESCAPE = 36
+    NPAR = 37
+
+
+class perturbation:
+    """Columns of the perturbation block, relative to its start (a model's NPAR)."""
+
+    Q_TIDE1 = 0        # tide on the primary: κ, Δt, 1/(2Q) (0: constant time lag)
+    Q_TIDE2 = 3        # tide on the secondary
+    Q_YORP1 = 6        # YORP torque on the primary, about its z axis
+    Q_YORP2 = 7        # on the secondary
+    Q_BYORP = 8        # BYORP acceleration of the relative motion along V
+    NPERT = 9
+    NACC = 4           # accumulators after the state: W, then L_ext (x, y, z)
+    #: Floor of the bulge's relative angular rate in the constant-Q lag (units of n).
+    Q_RATE_FLOOR = 1e-3
+
+
+#: Columns of a 3-D event or sample record: the scaled time, then the 30-number state.
+RECORD_WIDTH = 1 + spatial.NSTATE
+
+#: Status codes (``ti_spinorbit.results.Status``): the kernels set RUNNING ... NONFINITE and
+#: STEP_BUDGET; the host's accuracy check sets INACCURATE.
+RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE, INACCURATE, STEP_BUDGET = range(8)
+STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite",
+                "inaccurate", "step budget")
+
+#: Counter columns of every member: accepted steps, rejected steps, right-hand-side calls.
+C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2
+
+#: The diagnostics' columns (``kernels/ensemble.py`` ``diagnostics``): three energies, the
+#: orbit's, the primary's and the secondary's angular-momentum vectors, orthonormality errors.
+DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
+               "L_orbit_x", "L_orbit_y", "L_orbit_z", "L_primary_x", "L_primary_y",
+               "L_primary_z", "L_secondary_x", "L_secondary_y", "L_secondary_z",
+               "orth_S", "orth_S1")
