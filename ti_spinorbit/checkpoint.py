@@ -37,6 +37,12 @@ Safety rules:
   says to replace it. A directory left by a kill before the first state (records files or
   ``*.tmp-PID`` files only) holds no checkpoint: a run (resumed or not) starts afresh in it;
   stray ``*.tmp-*`` files are removed whenever a run takes the lock;
+* **read-only checkpoints**: a checkpoint in a directory that cannot be written (a read-only
+  folder or mount, an archive of finished runs) resumes without a lock and without writing
+  anything when its run is finished; an unfinished one is refused before any work, in one
+  line (its next window could not be saved: copy the directory or make it writable);
+* ``checkpoint=`` must be a path (str or os.PathLike) or None: anything else is a one-line
+  TypeError naming ``checkpoint``;
 * the state records the run settings, a SHA-256 digest of the inputs (parameter rows,
   initial states, end times) and the writing package version; resuming with anything
   different raises :class:`CheckpointError` (a ValueError) naming what differs, never reuses
@@ -97,6 +103,19 @@ class CheckpointExists(CheckpointError):
     """``checkpoint=DIR`` without ``resume=True`` on a directory that holds a checkpoint."""
 
 
+def _fspath(path, what="checkpoint"):
+    """``path`` as a str, or a one-line TypeError naming the parameter (``checkpoint=123``
+    must not surface as os.fspath's "expected str, bytes or os.PathLike object")."""
+    if isinstance(path, (str, os.PathLike)):
+        path = os.fspath(path)
+        if isinstance(path, str):
+            if not path:
+                raise ValueError(f"{what} must be a directory path, not the empty string")
+            return path
+    raise TypeError(f"{what} must be a directory path (str or os.PathLike) or None (got "
+                    f"{type(path).__name__} {_one_line(repr(path), 60)})")
+
+
 def _records_name(launch):
     return f"records-{launch:06d}.npz"
 
@@ -110,15 +129,20 @@ def _atomic_savez(path, digest=False, **arrays):
     """Write an .npz beside ``path`` and move it over; returns the SHA-256 (hex) of the bytes
     written when ``digest`` (read back: zipfile seeks while writing), else None."""
     tmp = f"{path}.tmp-{os.getpid()}"
-    with open(tmp, "wb") as fh:
-        np.savez(fh, **arrays)
-        fh.flush()
-        os.fsync(fh.fileno())
-    sha = None
-    if digest:
-        with open(tmp, "rb") as fh:
-            sha = hashlib.sha256(fh.read()).hexdigest()
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        sha = None
+        if digest:
+            with open(tmp, "rb") as fh:
+                sha = hashlib.sha256(fh.read()).hexdigest()
+        os.replace(tmp, path)
+    except BaseException:       # a failed write leaves no temporary file behind
+        with contextlib.suppress(OSError):
+            os.remove(tmp)
+        raise
     return sha
 
 
@@ -140,7 +164,7 @@ def save(path, settings, fingerprint, state, new_records):
     far (hex str), shared with the caller: this window's digest is appended to it."""
     from . import __version__
 
-    path = os.fspath(path)
+    path = _fspath(path)
     os.makedirs(path, exist_ok=True)
     width = state["y"].shape[1] + 1
     launch = state["launches"] - 1
@@ -202,13 +226,13 @@ def _refuse_foreign(path):
 
 def holds_checkpoint(path):
     """True when the directory ``path`` holds a checkpoint (a state file) of some run."""
-    return os.path.isfile(os.path.join(os.fspath(path), STATE))
+    return os.path.isfile(os.path.join(_fspath(path), STATE))
 
 
 def remove(path):
     """Delete a finished run's checkpoint: the files a run writes in ``path`` (state, records,
     lock, temporary files), then the directory itself when nothing else is left in it."""
-    path = os.fspath(path)
+    path = _fspath(path)
     _clean(path, [n for n in os.listdir(path) if _is_checkpoint_file(n)])
     with contextlib.suppress(OSError):
         os.rmdir(path)
@@ -219,7 +243,7 @@ def check_target(path, resume=False, overwrite=False, cli=False):
     with these flags must not write: a path that is not a directory, or (without ``resume``
     and ``overwrite``) a directory that holds a checkpoint. Raises CheckpointError (its
     message names the CLI flags when ``cli``)."""
-    path = os.fspath(path)
+    path = _fspath(path)
     how = ("--resume to continue it or --overwrite-checkpoint to replace it" if cli else
            "resume=True to continue it or overwrite_checkpoint=True to replace it")
     if os.path.exists(path) and not os.path.isdir(path):
@@ -233,6 +257,37 @@ def check_target(path, resume=False, overwrite=False, cli=False):
             "(refused: a run would destroy it)")
 
 
+def _writable(path):
+    """Whether files can be created in the directory ``path`` (a real probe: permission bits
+    say nothing for root or on a read-only mount)."""
+    import tempfile
+
+    try:
+        with tempfile.TemporaryFile(dir=path):
+            return True
+    except OSError:
+        return False
+
+
+def _check_finished(path):
+    """A checkpoint in a directory this process cannot write (a read-only folder or mount, an
+    archive of finished runs) can be resumed when its run is finished: resuming then only
+    reads it (no lock, no state, no clean-up is written). An unfinished one is refused before
+    any work, in one line: its next window could not be saved."""
+    arrays = _read(os.path.join(path, STATE), STATE, ("status",))
+    status = arrays.get("status")
+    if status is None or status.ndim != 1 or status.dtype.kind not in "iu":
+        raise _damaged(path, f"{STATE} has no status array")
+    from .results import Status
+
+    running = int(np.count_nonzero(status == Status.RUNNING))
+    if running:
+        raise CheckpointError(
+            f"checkpoint {path!r} is in a folder that cannot be written and its run is not "
+            f"finished ({running} of {status.size} members still running): make the folder "
+            "writable, or copy the directory elsewhere and resume from the copy")
+
+
 @contextlib.contextmanager
 def claim(path, resume=False, overwrite=False):
     """Own the checkpoint directory ``path`` for one run (a context manager).
@@ -241,11 +296,20 @@ def claim(path, resume=False, overwrite=False):
     naming the holder, writes the holder's identity, applies the overwrite rule
     (:func:`check_target`), removes stray temporary files and, for a fresh start, any
     earlier checkpoint files (the state first, so that a kill midway leaves no state).
-    The lock is released however the block ends (return, exception, KeyboardInterrupt)."""
+    The lock is released however the block ends (return, exception, KeyboardInterrupt).
+
+    A ``resume`` of a checkpoint in a directory that cannot be written (read-only folder or
+    mount) takes no lock and writes nothing: it is allowed when the checkpointed run is
+    finished (the resumed run then only reads it), and refused with a CheckpointError
+    before any work otherwise."""
     import filelock
 
-    path = os.fspath(path)
+    path = _fspath(path)
     check_target(path, resume, overwrite)
+    if resume and holds_checkpoint(path) and not _writable(path):
+        _check_finished(path)         # a read-only checkpoint of a finished run: read it
+        yield path
+        return
     try:
         os.makedirs(path, exist_ok=True)
     except OSError as exc:
@@ -318,7 +382,7 @@ def load(path, settings, fingerprint):
     (both ValueError) for a mismatched one or a directory that is not a checkpoint."""
     from . import __version__
 
-    path = os.fspath(path)
+    path = _fspath(path)
     if not os.path.exists(path):
         return None
     if not os.path.isdir(path):
@@ -425,7 +489,7 @@ class Launches:
     next launch ({} without a directory)."""
 
     def __init__(self, directory, resume=False, overwrite=False):
-        self.directory = None if directory is None else os.fspath(directory)
+        self.directory = None if directory is None else _fspath(directory)
         self.resume, self.overwrite, self.count = bool(resume), bool(overwrite), 0
         if self.directory is not None and os.path.exists(self.directory) \
                 and not os.path.isdir(self.directory):

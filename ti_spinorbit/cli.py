@@ -443,28 +443,32 @@ def _check_range(flag, value, low, high, low_open=False, high_open=False):
 
 def _check_output(flag, path, extensions):
     """The output file must be writable where it is asked for, with one of our extensions:
-    a typo, a folder or a read-only file must fail before a long run, not after it. Probes
-    by opening (an existing file for appending, which changes nothing; a new one beside it as
-    a temporary file), because permission bits do not tell for root or read-only mounts."""
+    a typo, a folder, a read-only file, a dangling symbolic link, control characters or a
+    name longer than the folder allows (:func:`ti_spinorbit.files.check_name`) must fail
+    before a long run, not after it. Probes by opening (an existing file for appending, which
+    changes nothing, and always a temporary file beside it, where the atomic write will put
+    its bytes), because permission bits do not tell for root or read-only mounts."""
     import tempfile
+
+    from .files import check_name, target
 
     if path is None:
         return
     ext = os.path.splitext(path)[1].lower()
     if ext not in extensions:
         raise ValueError(f"{flag} must end in {', '.join(extensions)} (got {path!r})")
+    check_name(flag, path)
     if os.path.isdir(path):
         raise ValueError(f"{flag}: {path!r} is a folder; give a file name")
-    folder = os.path.dirname(os.path.abspath(path))
+    folder = os.path.dirname(os.path.abspath(target(path)))
     if not os.path.isdir(folder):
         raise ValueError(f"{flag}: folder {folder!r} does not exist (got {path!r})")
     try:
         if os.path.exists(path):
             with open(path, "ab"):
                 pass
-        else:
-            with tempfile.TemporaryFile(dir=folder):
-                pass
+        with tempfile.TemporaryFile(dir=folder):
+            pass
     except OSError as exc:
         what = "file" if os.path.exists(path) else "folder"
         raise ValueError(f"{flag}: cannot write {path!r} ({what} not writable: "
@@ -534,8 +538,9 @@ def check_args(args):
     elif args.command in ("benchmark", "systems"):
         _check_output("--out", getattr(args, "out", None), (".json",))
         if args.command == "benchmark":
-            _refuse_existing(args, args.out or "benchmark.json",
-                             "--out" if args.out else "the report (default --out)")
+            flag = "--out" if args.out else "the report (default --out)"
+            _claim_outputs(args, [(flag, args.out or "benchmark.json")])
+            _refuse_existing(args, args.out or "benchmark.json", flag)
     elif args.command == "figures":                  # figures: --out is a folder
         if os.path.exists(args.out) and not os.path.isdir(args.out):
             raise ValueError(f"--out: {args.out!r} is a file; give a folder")
@@ -816,8 +821,12 @@ def default_stem(args, prefix, system_name):
     other parameters never share a file: ``sos_1991VH_ab1.06_o1000``."""
     import re
 
+    from .files import safe_part
+
     defaults = vars(_parser().parse_args([args.command]))
-    parts = [prefix, system_name.replace(" ", "")]
+    # a system's name (a system file's included) is made safe for a file name: no folder
+    # separators, control characters or newlines ("sub/evil" -> "sub-evil")
+    parts = [prefix, safe_part(system_name)]
     for dest, tag in NAME_TAGS:
         value = getattr(args, dest, None)
         if value is None or value == defaults.get(dest):
@@ -837,7 +846,7 @@ def default_stem(args, prefix, system_name):
             text = _fmt(value) if isinstance(value, (int, float)) else str(value)
         # exponents short and without "+": 1e6, 1e-13 (not 1e+06, 1e-13 stays)
         text = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
-        parts.append(tag + text.replace(" ", "").replace(os.sep, "-"))
+        parts.append(safe_part(tag + text, tidy=False))
     return "_".join(parts)
 
 
@@ -849,17 +858,68 @@ def _refuse_existing(args, path, flag):
                          "--overwrite to replace it, or choose another --out")
 
 
+#: The output names this process's running command owns (files.Claim), freed when it ends.
+_CLAIMS = []
+
+
+def _claim_outputs(args, outputs):
+    """Own the output names of this run (:func:`ti_spinorbit.files.claim`: a lock beside each
+    one, held until the command ends): a second run with the same names, started while this
+    one goes, is refused at once in one line (exit status 2) instead of silently replacing
+    this run's files."""
+    from .files import claim
+
+    _CLAIMS.append(claim(outputs, command=getattr(args, "command_line", None)))
+
+
+def _release_outputs():
+    """Free the output names of the command that ends (its lock files are deleted)."""
+    while _CLAIMS:
+        _CLAIMS.pop().release()
+
+
+def _finishes_a_run(args, out, data, checkpoint):
+    """True when this ``--resume`` command finishes an earlier run of the same command that
+    was killed after writing its data file and before its figure: the data file exists, the
+    figure does not, the checkpoint is still there and the data file records this very
+    command line. The run then resumes from its checkpoint (nothing is integrated again),
+    and rewrites the data file (the same numbers) and the figure, instead of being refused."""
+    from .checkpoint import holds_checkpoint
+    from .io import read_metadata
+
+    if not getattr(args, "resume", False) or checkpoint is None or os.path.exists(out) \
+            or not os.path.isfile(data) or not os.path.isdir(checkpoint) \
+            or not holds_checkpoint(checkpoint):
+        return False
+    try:
+        meta = read_metadata(data)
+    except (OSError, ValueError):
+        return False
+    return meta.get("command") == getattr(args, "command_line", None)
+
+
 def _paths(args, prefix, system_name):
     """(figure path, data path) from --out/--data or the defaults :func:`default_stem`.png
-    /.npz, both checked writable (defaults included) and not already there (unless
-    --overwrite), and the checkpoint directory checked, before any work."""
+    /.npz, both checked writable (defaults included; names that fit, no dangling links),
+    claimed for this run (:func:`_claim_outputs`) and then not already there (unless
+    --overwrite, or this --resume finishes the same command's run: :func:`_finishes_a_run`),
+    and the checkpoint directory checked, before any work."""
+    from .files import check_name
+
     out = args.out or default_stem(args, prefix, system_name) + ".png"
     data = args.data or os.path.splitext(out)[0] + ".npz"
-    _check_output("--out" if args.out else "the figure (default --out)", out, FIGURE_EXTENSIONS)
-    _check_output("--data" if args.data else "the data file (default --data)", data, (".npz",))
-    _refuse_existing(args, out, "--out" if args.out else "the figure (default --out)")
-    _refuse_existing(args, data, "--data" if args.data else "the data file (default --data)")
+    out_flag = "--out" if args.out else "the figure (default --out)"
+    data_flag = "--data" if args.data else "the data file (default --data)"
+    _check_output(out_flag, out, FIGURE_EXTENSIONS)
+    _check_output(data_flag, data, (".npz",))
     checkpoint = _checkpoint_path(args, data)
+    if checkpoint is not None:
+        check_name("--checkpoint" if getattr(args, "checkpoint", None) is not None else
+                   "the checkpoint (default: the --data path with .ckpt)", checkpoint)
+    _claim_outputs(args, [(out_flag, out), (data_flag, data)])     # before the checks below
+    _refuse_existing(args, out, out_flag)
+    if not _finishes_a_run(args, out, data, checkpoint):
+        _refuse_existing(args, data, data_flag)
     if checkpoint is not None:   # a checkpoint that would be refused: before any work
         from .checkpoint import check_target
 
@@ -919,13 +979,17 @@ def _finish_checkpoint(args, data):
         return f"kept checkpoint {path} (--keep-checkpoint)"
     from .checkpoint import remove
 
-    remove(path)
+    try:
+        remove(path)
+    except OSError as exc:       # a read-only folder: the outputs are written all the same
+        return f"kept checkpoint {path} (it cannot be removed: {exc.strerror or exc})"
     return f"removed checkpoint {path} (the run is complete; --keep-checkpoint keeps it)"
 
 
 def _save(result, path, extra):
     """Write a result with :func:`ti_spinorbit.io.save` (self-describing, loadable with
-    ``io.load``), the command's own numbers in the metadata under ``extra``."""
+    ``io.load``; atomic: a killed write leaves no partial file), the command's own numbers in
+    the metadata under ``extra``."""
     from .io import save
 
     return save(result, path, extra=extra)
@@ -936,8 +1000,10 @@ class FigureError(RuntimeError):
 
 
 def _write(result, data, extra, figure, out):
-    """The data file first, then the figure (``figure()`` returns its Axes): a plotting
-    failure never loses the numbers of a run. Returns the paths written."""
+    """The data file first, then the figure (``figure()`` returns its Axes), each written
+    atomically (:mod:`ti_spinorbit.files`): a plotting failure never loses the numbers of a
+    run, and a run killed between the two is finished by the same ``--resume`` command
+    (:func:`_finishes_a_run`). Returns the paths written."""
     from .plotting import save_figure
 
     data = _save(result, data, extra)
@@ -1033,16 +1099,18 @@ def _cmd_systems(args):
     if args.show:
         system = catalog.system(args.show)
         if args.out:
-            with open(args.out, "w") as f:
-                json.dump(system.describe(), f, indent=1)
+            from .files import write_json     # atomic: a killed write leaves no partial file
+
+            write_json(args.out, system.describe(), indent=1)
         if not args.quiet:
             for k, v in system.describe().items():
                 print(f"{k:24s} {v}")
         return 0
     systems = [catalog.system(name) for name in catalog.names()]
     if args.out:
-        with open(args.out, "w") as f:
-            json.dump([s.describe() for s in systems], f, indent=1)
+        from .files import write_json
+
+        write_json(args.out, [s.describe() for s in systems], indent=1)
     _print(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} "
                  f"{'omega0':>7s} {'P_orb (h)':>9s}  {'primary (m)':>17s}  "
                  f"{'secondary semi-axes (m)':>23s}")
@@ -1339,8 +1407,9 @@ def _cmd_benchmark(args):
               "status_counts": {str(n): int(c) for n, c in zip(names, counts)},
               "machine": {"platform": platform.platform(), "processor": platform.processor(),
                           "cpu_count": os.cpu_count(), "python": platform.python_version()}}
-    with open(out, "w") as f:
-        json.dump(report, f, indent=1)
+    from .files import write_json      # atomic: a killed write leaves no partial report
+
+    write_json(out, report, indent=1)
     _print(args, f"{args.system}: {args.members} members x {args.orbits:g} orbits at rtol "
                  f"{args.rtol:g} on {report['arch']}: {best.seconds:.3g} s (best of {args.repeat}), "
                  f"{rate:.0f} member-orbits/s; first call {warmup:.1f} s; wrote {out}")
@@ -1432,8 +1501,11 @@ def _checked_run(args):
     with warnings.catch_warnings():
         warnings.simplefilter("default", ImplausibleInputWarning)   # once per run, per place
         warnings.showwarning = show
-        check_args(args)
-        return HANDLERS[args.command](args)
+        try:
+            check_args(args)
+            return HANDLERS[args.command](args)
+        finally:
+            _release_outputs()
 
 
 def main(argv=None):

@@ -42,6 +42,7 @@ import zipfile
 import numpy as np
 
 from . import perturbations, runtime
+from .files import atomic_write
 from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 
 #: Layout version written into every archive's metadata; bump it when the layout changes.
@@ -137,7 +138,10 @@ def _json_default(x):
 
 
 def write_archive(path, arrays, metadata):
-    """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``.
+    """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``,
+    atomically (:func:`ti_spinorbit.files.atomic_write`: a temporary file in the same folder,
+    fsync-ed, then moved over the name; a failed or killed write leaves an existing file as
+    it was and never a partial one). ``path`` may also be an open binary file object.
 
     Returns the path written. A name ending in ``.npz`` in any case (``r.NPZ``) is written
     as given; NumPy's rule of appending ``.npz`` applies to other names only."""
@@ -146,7 +150,9 @@ def write_archive(path, arrays, metadata):
     if isinstance(path, (str, os.PathLike)):
         if not os.fspath(path).lower().endswith(".npz"):
             path = os.fspath(path) + ".npz"
-        with open(path, "wb") as fh:        # a file object: NumPy keeps the name as it is
+        # a temporary file beside it, fsync-ed, then os.replace: a write that fails or is
+        # killed never leaves a partial file under the name nor harms the file it replaces
+        with atomic_write(path) as fh:      # a file object: NumPy keeps the name as it is
             np.savez_compressed(fh, **entries)
         return path
     np.savez_compressed(path, **entries)
@@ -291,6 +297,7 @@ def save(result, path, extra=None, include_sections=True):
     ``status_codes`` and ``status_counts``; see the module docstring for the layout.
     """
     kind = kind_of(result)
+    _check_save_args(path, extra)
     systems, arrays, units_out = _Systems(), {}, {}
     block = _encode(result, "", systems, arrays, units_out, bool(include_sections))
     fields = block["fields"]
@@ -309,6 +316,22 @@ def save(result, path, extra=None, include_sections=True):
                              "rename them")
         meta.update(extra)
     return write_archive(path, arrays, meta)
+
+
+def _check_save_args(path, extra):
+    """save()'s ``path`` and ``extra`` before any work: one-line TypeErrors naming them."""
+    if not isinstance(path, (str, os.PathLike)) and not callable(getattr(path, "write", None)):
+        raise TypeError(f"path must be a file name (str or os.PathLike) or a binary file "
+                        f"object (got {type(path).__name__} {_one_line(repr(path))[:60]})")
+    if extra is None:
+        return
+    if not isinstance(extra, dict):
+        raise TypeError(f"extra must be a dict of JSON-able metadata, {{name: value}} (got "
+                        f"{type(extra).__name__} {_one_line(repr(extra))[:60]})")
+    bad = [k for k in extra if not isinstance(k, str)]
+    if bad:
+        raise TypeError(f"extra: metadata keys must be str (got {type(bad[0]).__name__} "
+                        f"{bad[0]!r})")
 
 
 def save_result(result, path, kind=None, extra=None):
@@ -394,7 +417,9 @@ def load(path):
     ArchiveError
         (a ValueError) Not a ti_spinorbit archive (not an .npz, no metadata, no ``kind``), an
         unknown kind, a ``format_version`` this version of the package cannot read, or a
-        damaged or malformed file of any sort; one line naming the file and the fault.
+        damaged, malformed or edited file of any sort (every one-bit flip included; arrays
+        whose shapes, dtypes or status / attitude codes are not what the package writes);
+        one line naming the file and the fault.
     """
     from . import __version__
 
@@ -424,7 +449,9 @@ def load(path):
         try:
             if version == 0:
                 meta = _upgrade_v0(p, meta, entries)
-            return _decode_file(meta, entries)
+            result = _decode_file(meta, entries)
+            _check_loaded(p, result)
+            return result
         except ArchiveError:
             raise
         except _DAMAGE as exc:
@@ -476,6 +503,131 @@ def _decode(block, arrays, prefix, systems):
     for name, items in block.get("perturbations", {}).items():
         kwargs[name] = perturbations.from_description(items)
     return cls(**{renamed.get(k, k): v for k, v in kwargs.items()})   # format 1's old names
+
+
+# ---- what a loaded result must look like -------------------------------------------------
+#: Per kind: field -> (dimensions, dtype kinds). Dimensions are names bound by the first
+#: array that has them (``n`` members, ``w`` crossings, ``s`` samples, ``k`` lengths, ...) or
+#: fixed sizes; dtype kinds as ``numpy.dtype.kind`` ("f" float, "iu" integer, "b" bool,
+#: "UO" text). A field not listed (or None) is not checked; a listed one that does not fit
+#: makes :func:`load` refuse the file, naming the field, instead of failing later in repr,
+#: plot or to_xarray.
+_F, _I, _B, _S = "f", "iu", "b", "UO"
+_SECTION = {
+    **{k: (("n", "w"), _F) for k in ("theta_p", "thetadot_p", "t", "r", "a", "e",
+                                      "apsidal_rate")},
+    **{k: (("n",), _I) for k in ("count", "status", "accepted", "rejected", "rhs_calls",
+                                  "stop_status")},
+    **{k: (("n",), _F) for k in ("energy_drift", "angmom_drift", "initial_theta_p",
+                                  "initial_thetadot_p", "megno", "lyapunov", "max_tilt",
+                                  "max_npa_angle")},
+    "initial_states": (("n", 30), _F),
+}
+_TIME_SERIES = {
+    **{k: (("n", "s"), _F) for k in ("t", "alpha", "theta", "thetadot", "r", "energy",
+                                      "energy_orbit", "energy_primary", "energy_secondary",
+                                      "work")},
+    **{k: (("n", "s", 3), _F) for k in ("angmom_orbit", "angmom_primary", "angmom_secondary",
+                                         "external_angmom")},
+    **{k: (("n",), _I) for k in ("status", "attitude_class", "stop_status")},
+    **{k: (("n",), _F) for k in ("initial_theta_p", "initial_thetadot_p", "energy_drift",
+                                  "angmom_drift", "max_tilt", "max_npa_angle")},
+    "initial_states": (("n", 30), _F), "states": (("n", "s", 30), _F),
+}
+_GRID = ("theta_p", "thetadot_p")
+_PGRID = ("elongations", "eccentricities")
+_SHAPES = {
+    "section": _SECTION, "time_series": _TIME_SERIES,
+    "chaos_map": {
+        "theta_p": (("theta_p",), _F), "thetadot_p": (("thetadot_p",), _F),
+        **{k: (_GRID, _F) for k in ("megno", "lyapunov", "mean_thetadot", "energy_drift",
+                                    "angmom_drift", "max_tilt")},
+        "status": (_GRID, _I), "attitude_class": (_GRID, _I), "classification": (_GRID, _S),
+        "fraction_lengths": (("k",), _F), "fraction_by_length": (("k",), _F),
+        "tilt": ((2,), _F)},
+    "parameter_map": {
+        "elongations": (("elongations",), _F), "eccentricities": (("eccentricities",), _F),
+        "theta_p": (("start",), _F), "thetadot_p": (("start",), _F),
+        "omega0": (("elongations",), _F), "chaotic_fraction": (_PGRID, _F),
+        **{k: ((*_PGRID, "start"), _F) for k in ("megno", "energy_drift", "angmom_drift")},
+        "classification": ((*_PGRID, "start"), _S), "status": ((*_PGRID, "start"), _I),
+        "inaccurate": (_PGRID, _I), "fraction_monotone": (_PGRID, _B),
+        "fraction_lengths": (("k",), _F), "fraction_by_length": (("k", *_PGRID), _F)},
+    "overlap_scan": {
+        "elongations": (("m",), _F), "overlaps": (("m",), _B), "lengths": (("k",), _F),
+        "overlaps_by_length": (("k", "m"), _B), "megno_overlaps_by_length": (("k", "m"), _I)},
+    "relaxed_libration": {
+        **{k: (("k",), _F) for k in ("lengths", "centres_by_length", "amplitudes_by_length")}},
+}
+
+
+def _code_ranges():
+    """Unit text of a code field -> the codes allowed (status codes, attitude classes)."""
+    from .attitude import CLASS_UNIT, CLASSES
+    from .results import STATUS, STATUS_NAMES
+
+    return {STATUS: (0, len(STATUS_NAMES) - 1), CLASS_UNIT: (-1, len(CLASSES) - 1)}
+
+
+def _check_loaded(path, result):
+    """Refuse a loaded result whose arrays do not have the shapes, dtypes and code ranges the
+    package writes (an edited or damaged file): ArchiveError naming the file and field."""
+    from .results import STATUS_NAMES, units as field_units
+
+    kind = kind_of(result)
+    where = f"{path!r} is damaged or edited: {kind} field"
+    dims = {}
+    systems = getattr(result, "systems", None)
+    if isinstance(systems, list):
+        dims["n"] = len(systems)
+    unit_of = field_units(result)
+    ranges = _code_ranges()
+    for name, (shape, kinds) in _SHAPES.get(kind, {}).items():
+        value = getattr(result, name, None)
+        if value is None:
+            continue
+        if not isinstance(value, np.ndarray) or value.dtype.kind not in kinds:
+            got = value.dtype if isinstance(value, np.ndarray) else type(value).__name__
+            want = {_F: "float", _I: "integer", _B: "bool", _S: "text"}[kinds]
+            raise ArchiveError(f"{where} {name!r} holds {got}, not {want}")
+        if value.ndim != len(shape):
+            raise ArchiveError(f"{where} {name!r} has shape {value.shape}, not "
+                               f"{len(shape)}-dimensional ({', '.join(map(str, shape))})")
+        for axis, (d, size) in enumerate(zip(shape, value.shape)):
+            want = d if isinstance(d, int) else dims.setdefault(d, size)
+            if size != want:
+                why = "" if isinstance(d, int) else f" ({d}), as in the other fields"
+                raise ArchiveError(f"{where} {name!r} has shape {value.shape}, but its axis "
+                                   f"{axis} must have {want} entries{why}")
+    for name, unit_text in unit_of.items():
+        value = getattr(result, name, None)
+        if unit_text not in ranges or not isinstance(value, np.ndarray) or value.size == 0:
+            continue
+        low, high = ranges[unit_text]
+        if value.dtype.kind not in _I:
+            raise ArchiveError(f"{where} {name!r} holds {value.dtype}, not integer codes")
+        if value.min() < low or value.max() > high:
+            bad = value[(value < low) | (value > high)].flat[0]
+            raise ArchiveError(f"{where} {name!r} holds code {bad}, outside {low}..{high} "
+                               f"({unit_text})")
+    status = getattr(result, "status", None)
+    if isinstance(status, str) and status not in STATUS_NAMES:      # RelaxedLibration
+        raise ArchiveError(f"{where} 'status' is {status!r}, not one of "
+                           f"{', '.join(STATUS_NAMES)}")
+    if kind == "relaxed_libration":
+        c, x = result.candidates, result.extents
+        if len(c) != len(x) or any(not isinstance(a, np.ndarray) or not isinstance(b, np.ndarray)
+                                   or a.ndim != 1 or a.shape != b.shape or a.dtype.kind != "f"
+                                   or b.dtype.kind != "f" for a, b in zip(c, x)):
+            raise ArchiveError(f"{where}s 'candidates' and 'extents' do not pair up (one "
+                               "float vector of each per launch, of equal lengths)")
+    if kind == "overlap_scan" and len(result.decisions) != len(result.elongations):
+        raise ArchiveError(f"{where} 'decisions' holds {len(result.decisions)} records for "
+                           f"{len(result.elongations)} elongations")
+    for name in ("section", "sections"):        # nested results: the same rules
+        nested = getattr(result, name, None)
+        if nested is not None and type(nested) in _kinds().values():
+            _check_loaded(path, nested)
 
 
 def _upgrade_v0(path, meta, arrays):

@@ -28,6 +28,8 @@ class ArchiveError(ValueError):
 _MAX_DEFLATE_RATIO = 1100
 #: Largest metadata entry read (bytes uncompressed): real metadata is kilobytes to megabytes.
 _MAX_METADATA_BYTES = 256 * 2**20
+#: Zip general-purpose flag bit 0: the entry is encrypted (zipfile asks for a password).
+_ENCRYPTED = 0x1
 #: Errors that reading or decoding a damaged or hostile file can raise (never a bug of ours
 #: with a valid file): each becomes an ArchiveError naming the file.
 _DAMAGE = (KeyError, IndexError, TypeError, AttributeError, ValueError, RecursionError,
@@ -38,6 +40,32 @@ _DAMAGE = (KeyError, IndexError, TypeError, AttributeError, ValueError, Recursio
 def _one_line(exc):
     text = " ".join(str(exc).split()) or type(exc).__name__
     return text if len(text) <= 300 else text[:297] + "..."
+
+
+#: Bytes read per call when filling an array (as numpy.lib.format's BUFFER_SIZE).
+_BLOCK = 2**24
+
+
+def _read_data(fh, shape, fortran, dtype, count, where):
+    """The array after an entry's ``.npy`` header, read straight into place in blocks (one
+    allocation, as ``numpy.lib.format.read_array``), then the end of the entry read, which
+    makes zipfile check its CRC-32: a flipped bit anywhere in the data is an error, never a
+    changed number."""
+    array = np.empty(count, dtype=dtype)
+    nbytes = count * dtype.itemsize
+    if nbytes:
+        view = memoryview(array.view(np.uint8))
+        done = 0
+        while done < nbytes:
+            got = fh.readinto(view[done:done + _BLOCK])
+            if not got:
+                raise ArchiveError(f"{where} ends after {done} of its {nbytes} bytes of data")
+            done += got
+    if fh.read(1):
+        raise ArchiveError(f"{where} holds more data than its header says")
+    if fortran:
+        return array.reshape(tuple(shape)[::-1]).transpose()
+    return array.reshape(tuple(shape))
 
 
 class _Entries:
@@ -86,6 +114,9 @@ class _Entries:
         if not ok:
             raise ArchiveError(f"{where} claims {info.file_size} bytes from "
                                f"{info.compress_size} compressed bytes (impossible)")
+        if info.flag_bits & _ENCRYPTED:     # zipfile would raise RuntimeError (password)
+            raise ArchiveError(f"{where} is flagged as encrypted (NumPy never writes that: a "
+                               "flipped bit)")
         if limit is not None and info.file_size > limit:
             raise ArchiveError(f"{where} holds {info.file_size} bytes, more than the "
                                f"{limit} bytes allowed for it")
@@ -102,9 +133,12 @@ class _Entries:
                     if reader is None:
                         raise ArchiveError(f"{where} has .npy format version {version}")
                     shape, fortran, dtype = reader(fh, version)
-            except (ValueError, SyntaxError, TypeError) as exc:
-                if isinstance(exc, ArchiveError):
-                    raise
+            except (ArchiveError, zipfile.BadZipFile, zlib.error):
+                raise             # damage the caller names as such (a bad CRC-32, deflate)
+            except Exception as exc:  # noqa: BLE001 - the header is Python literal text
+                # parsed by NumPy (ast): damaged text raises ValueError, SyntaxError,
+                # tokenize.TokenError, RecursionError, MemoryError, ...; every one means the
+                # same: a bad header
                 raise ArchiveError(f"{where} has a bad .npy header "
                                    f"({type(exc).__name__})") from None
             header = fh.tell()
@@ -117,8 +151,8 @@ class _Entries:
                 raise ArchiveError(f"{where} has a header for shape {tuple(shape)} of {dtype} "
                                    f"({count * dtype.itemsize} bytes) but holds "
                                    f"{info.file_size - header} bytes of data")
-        with self.zf.open(info) as fh:   # sizes agree: reading allocates what the file holds
-            return fmt.read_array(fh, allow_pickle=False)
+            # sizes agree: reading allocates what the file holds, from the same stream
+            return _read_data(fh, shape, fortran, dtype, count, where)
 
     def metadata(self):
         info = self._names.get("metadata")

@@ -505,10 +505,21 @@ def raw_markup(fig):
 
 
 def save_figure(ax, path):
-    """Write the figure of ``ax`` to ``path`` (PNG/PDF by extension) and close it."""
+    """Write the figure of ``ax`` to ``path`` (PNG, PDF or SVG by extension; PNG without
+    one) and close it. The write is atomic (:func:`ti_spinorbit.files.atomic_write`): the
+    image goes to a temporary file in the same folder, fsync-ed, then replaces ``path``, so a
+    failed or killed write never leaves a partial figure and never harms an existing one."""
+    import os
+
+    from .files import atomic_write
+
     plt = _pyplot()
     fig = ax.figure
-    fig.tight_layout()
-    fig.savefig(path, bbox_inches="tight")      # legends outside the axes stay in the file
-    plt.close(fig)
+    try:
+        fig.tight_layout()
+        fmt = os.path.splitext(os.fspath(path))[1][1:].lower() or "png"
+        with atomic_write(path) as fh:       # a file object: the format is given by name
+            fig.savefig(fh, format=fmt, bbox_inches="tight")   # legends outside the axes stay
+    finally:
+        plt.close(fig)
     return path

@@ -17,6 +17,19 @@ OverlapScan            (elongation); the ranges also (bound: low, high)
 RelaxedLibration       (candidate) with coord launch (0: coarse bracket, then zooms)
 =====================  ===========================================================
 
+Every array field of a result is there (round trip: ``tests/test_files_safety.py``):
+
+* state rows, ``initial_states`` (member, element) and a time series' ``states`` (member,
+  sample, element), with the coordinate ``element`` (``R_x`` ... ``secondary_omega_z``,
+  docs/physics.md §6.8) and ``element_unit`` giving each column's unit;
+* ``max_tilt``, ``max_npa_angle`` (deg), ``attitude_class`` (code) with
+  ``attitude_class_name`` (text), per member (or per map cell); ``stop_status`` where kept;
+* the convergence evidence over run lengths, dimension ``length`` (orbits):
+  ``fraction_by_length`` (chaos map; parameter map also per elongation and eccentricity,
+  with ``fraction_monotone``), ``overlaps_by_length`` and ``megno_overlaps_by_length``
+  (overlap scan, per elongation), ``centres_by_length`` and ``amplitudes_by_length``
+  (relaxed libration); a chaos map's start ``tilt`` (dimension ``tilt_angle``: roll, pitch).
+
 A nested section (``ChaosMap.section``, ``OverlapScan.sections``) is not merged in (its
 dimensions differ): convert it on its own, ``to_xarray(cmap.section)``.
 
@@ -86,6 +99,63 @@ def _labels(a):
     return a.astype(str) if isinstance(a, np.ndarray) and a.dtype == object else a
 
 
+def _element_labels():
+    """The 30 columns of a state row (``ti_spinorbit.initial.ROW_SLICES``) as labels: ``R_x``,
+    ``V_z``, ``primary_attitude_01`` (row 0, column 1), ``secondary_omega_y``, ...; and the
+    unit of each column."""
+    from .initial import _UNITS, ROW_SLICES
+
+    labels, col_units = [], []
+    for name, sl in ROW_SLICES.items():
+        size = sl.stop - sl.start
+        labels += ([f"{name}_{c}" for c in "xyz"] if size == 3 else
+                   [f"{name}_{i}{j}" for i in range(3) for j in range(3)])
+        col_units += [_UNITS[name]] * size
+    return labels, col_units
+
+
+def _states(data, coords, r, dims):
+    """Initial state rows (member, element) and sampled ones (``dims`` + element), where the
+    result has them, with the element coordinate and the unit of each column."""
+    rows = {"initial_states": ("member", "element"), "states": (*dims, "element")}
+    present = [k for k in rows if getattr(r, k, None) is not None]
+    for k in present:
+        data[k] = (rows[k], getattr(r, k))
+    if present:
+        labels, col_units = _element_labels()
+        coords["element"] = labels
+        coords["element_unit"] = ("element", col_units)
+
+
+def _attitude(data, r, dims):
+    """Pole tilt, non-principal-axis angle and attitude class (code and name) where present."""
+    from .attitude import CLASSES
+
+    for k in ("max_tilt", "max_npa_angle", "stop_status"):
+        if getattr(r, k, None) is not None:
+            data[k] = (dims, getattr(r, k))
+    if getattr(r, "attitude_class", None) is not None:
+        codes = np.asarray(r.attitude_class)
+        data["attitude_class"] = (dims, codes)
+        names = np.array([CLASSES[c] if 0 <= c < len(CLASSES) else "" for c in codes.ravel()],
+                         dtype=str).reshape(codes.shape)
+        data["attitude_class_name"] = (dims, names)
+
+
+def _by_length(data, coords, r, fields, dims):
+    """Convergence evidence: the arrays over the run lengths checked (``length`` dimension,
+    coordinate ``lengths``-field in orbits), with ``dims`` after it where given."""
+    lengths_field, values = fields[0], fields[1:]
+    lengths = getattr(r, lengths_field, None)
+    if lengths is None:
+        return
+    coords["length"] = np.asarray(lengths)
+    for k in values:
+        v = getattr(r, k, None)
+        if v is not None:
+            data[k] = (("length", *dims[k]), v)
+
+
 def _section(r, units):
     n, width = np.shape(r.theta_p)
     member_vars = ["count", "energy_drift", "angmom_drift", "status", "accepted", "rejected",
@@ -99,6 +169,8 @@ def _section(r, units):
               "initial_theta_p": ("member", r.initial_theta_p),
               "initial_thetadot_p": ("member", r.initial_thetadot_p),
               "system": ("member", [s.name for s in r.systems])}
+    _states(data, coords, r, ("member",))
+    _attitude(data, r, ("member",))
     return data, coords
 
 
@@ -124,6 +196,8 @@ def _time_series(r, units):
         coords["initial_theta_p"] = ("member", r.initial_theta_p)
     if r.initial_thetadot_p is not None:
         coords["initial_thetadot_p"] = ("member", r.initial_thetadot_p)
+    _states(data, coords, r, ("member", "sample"))
+    _attitude(data, r, ("member",))
     return data, coords
 
 
@@ -133,7 +207,14 @@ def _chaos_map(r, units):
             for k in ("megno", "lyapunov", "classification", "mean_thetadot", "status",
                       "energy_drift", "angmom_drift") if getattr(r, k) is not None}
     data["status_name"] = (dims, io.status_names(r.status))
-    return data, {"theta_p": r.theta_p, "thetadot_p": r.thetadot_p}
+    coords = {"theta_p": r.theta_p, "thetadot_p": r.thetadot_p}
+    _attitude(data, r, dims)
+    _by_length(data, coords, r, ("fraction_lengths", "fraction_by_length"),
+               {"fraction_by_length": ()})
+    if getattr(r, "tilt", None) is not None:         # the map's start tilt (roll, pitch)
+        data["tilt"] = ("tilt_angle", np.asarray(r.tilt))
+        coords["tilt_angle"] = ["roll", "pitch"]
+    return data, coords
 
 
 def _parameter_map(r, units):
@@ -148,6 +229,10 @@ def _parameter_map(r, units):
     coords = {"elongation": r.elongations, "eccentricity": r.eccentricities,
               "start": np.arange(len(r.theta_p)), "theta_p": ("start", r.theta_p),
               "thetadot_p": ("start", r.thetadot_p)}
+    if getattr(r, "fraction_monotone", None) is not None:
+        data["fraction_monotone"] = (grid, np.asarray(r.fraction_monotone))
+    _by_length(data, coords, r, ("fraction_lengths", "fraction_by_length"),
+               {"fraction_by_length": grid})
     return data, coords
 
 
@@ -172,7 +257,11 @@ def _overlap_scan(r, units):
         data[name] = (("elongation", "bound"), ranges(name))
     for name in list(data):
         units.setdefault(name, units.get("decisions/" + name))
-    return data, {"elongation": r.elongations, "bound": ["low", "high"]}
+    coords = {"elongation": r.elongations, "bound": ["low", "high"]}
+    _by_length(data, coords, r, ("lengths", "overlaps_by_length", "megno_overlaps_by_length"),
+               {"overlaps_by_length": ("elongation",),
+                "megno_overlaps_by_length": ("elongation",)})
+    return data, coords
 
 
 def _relaxed_libration(r, units):
@@ -181,6 +270,8 @@ def _relaxed_libration(r, units):
     coords = {"candidate": np.arange(len(launch)), "launch": ("candidate", launch),
               "thetadot_p": ("candidate", np.concatenate(r.candidates))}
     units["extent"], units["thetadot_p"] = units["extents"], units["candidates"]
+    _by_length(data, coords, r, ("lengths", "centres_by_length", "amplitudes_by_length"),
+               {"centres_by_length": (), "amplitudes_by_length": ()})
     return data, coords
 
 
@@ -190,7 +281,9 @@ _BUILDERS = {"section": _section, "time_series": _time_series, "chaos_map": _cha
 _COORD_UNITS = {"elongation": "1 (a/b)", "eccentricity": "1", "member": "index",
                 "crossing": "index", "sample": "index", "start": "index", "candidate": "index",
                 "launch": "index", "component": "inertial axis", "bound": "",
-                "system": "name", "status_name": "name"}
+                "system": "name", "status_name": "name", "attitude_class_name": "name",
+                "element": "state row column (docs/physics.md §6.8)", "element_unit": "unit",
+                "length": "orbital periods", "tilt_angle": "name"}
 
 
 def to_xarray(result_or_path):
