@@ -116,6 +116,12 @@ def _fspath(path, what="checkpoint"):
                     f"{type(path).__name__} {_one_line(repr(path), 60)})")
 
 
+def check_path(path):
+    """``checkpoint=`` of an entry point checked before any work: None stays None, a path
+    becomes a str, anything else is a one-line TypeError naming ``checkpoint``."""
+    return None if path is None else _fspath(path)
+
+
 def _records_name(launch):
     return f"records-{launch:06d}.npz"
 

@@ -586,6 +586,10 @@ def _check_loaded(path, result):
         value = getattr(result, name, None)
         if value is None:
             continue
+        if kinds == _S and isinstance(value, np.ndarray) and value.dtype == object \
+                and not all(isinstance(v, str) for v in value.flat):
+            bad = next(v for v in value.flat if not isinstance(v, str))
+            raise ArchiveError(f"{where} {name!r} holds {type(bad).__name__} {bad!r}, not text")
         if not isinstance(value, np.ndarray) or value.dtype.kind not in kinds:
             got = value.dtype if isinstance(value, np.ndarray) else type(value).__name__
             want = {_F: "float", _I: "integer", _B: "bool", _S: "text"}[kinds]
