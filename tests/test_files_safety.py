@@ -194,6 +194,13 @@ def test_atomic_writes_keep_modes_and_symlinks(small, tmp_path):
     same_arrays(small, tso.load(real))
 
 
+def test_save_into_a_missing_folder_names_the_file_not_the_temporary(small, tmp_path):
+    with pytest.raises(FileNotFoundError) as info:
+        io.save(small, tmp_path / "absent" / "r.npz")
+    assert str(info.value) == (f"[Errno 2] cannot write '{tmp_path / 'absent' / 'r.npz'}' in "
+                               f"folder '{tmp_path / 'absent'}' (No such file or directory)")
+
+
 def test_cli_outputs_are_complete_and_no_helper_files_stay(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert cli.main([*SECTION, "--out", "s.png"]) == 0

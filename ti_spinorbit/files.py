@@ -174,6 +174,9 @@ def atomic_write(path, mode="wb", encoding=None):
             break
         except FileExistsError:
             continue
+        except OSError as exc:     # name the file asked for, not the temporary one
+            raise type(exc)(exc.errno, f"cannot write {os.fspath(path)!r} in folder {folder!r} "
+                                       f"({exc.strerror})") from None
     else:   # pragma: no cover - 100 collisions of 32 random bits
         raise FileExistsError(f"cannot create a temporary file beside {final!r}")
     try:
