@@ -29,7 +29,9 @@ docs/physics.md §13.1). Constant Q replaces Δt by (1/2Q) / |w| with w = Ω_b �
 (1/2Q) / sqrt(|w|² + Q_RATE_FLOOR²) so that the torque turns smoothly through
 synchronism.
 
-YORP: a torque T_b along the body's z axis (its spin axis in the paper's configuration).
+YORP: a torque T_b along the body's z axis (its spin axis in the paper's configuration),
+computed by the host in the chosen convention (``perturbations.YORP_CONVENTIONS``,
+docs/physics.md §13.2); the kernels take its value as given.
 BYORP: an acceleration a_B of the relative motion along V/|V| (a force on the secondary
 F_B = m_s a_B; positive expands the orbit).
 """

@@ -364,9 +364,11 @@ def yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e, f_yorp=DEFA
         δE_YORP = 2π R_s³ L_⊙ f_Y / (3 c d² sqrt(1 − e_⊙²)).
 
     Units: m³ W / (m s⁻¹ m²) = W s = J. 1/(d² sqrt(1 − e_⊙²)) is the time average of 1/r² over
-    the heliocentric orbit, and the 2π makes it the work of the YORP torque
-    R_s³ L_⊙ f_Y/(3 c d² sqrt(1 − e_⊙²)) over one 2π turn: "per orbit" in the sense of the
-    paper, i.e. per mutual orbit for a secondary near synchronous rotation.
+    the heliocentric orbit. The paper reads it as the work of its YORP torque
+    R_s³ L_⊙ f_Y/(6 c d² sqrt(1 − e_⊙²)) over two rotations of the secondary per mutual orbit
+    (4π T); the same number is the work of the twice larger "one-turn" torque over one
+    rotation (2π T). Either way δE_YORP is this formula (docs/physics.md §13.2,
+    ``perturbations.YORP_CONVENTIONS``).
 
     Parameters
     ----------
@@ -386,8 +388,9 @@ def yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e, f_yorp=DEFA
     require_positive("heliocentric_a_au", heliocentric_a_au)
     require_range("heliocentric_e", heliocentric_e, 0.0, 1.0)
     require_positive("f_yorp", f_yorp)
-    from .perturbations import yorp_torque
-    return 2.0 * math.pi * yorp_torque(f_yorp, R, heliocentric_a_au * AU, heliocentric_e)
+    from .perturbations import YORP_CONVENTION, yorp_torque, yorp_turns_per_orbit
+    return (2.0 * math.pi * yorp_turns_per_orbit(YORP_CONVENTION)
+            * yorp_torque(f_yorp, R, heliocentric_a_au * AU, heliocentric_e, YORP_CONVENTION))
 
 
 def energy_budget(system, heliocentric_a_au, heliocentric_e, Q=DEFAULT_Q, f_yorp=DEFAULT_F_YORP,

@@ -264,6 +264,11 @@ def _parser():
                             "on --yorp-body")
         g.add_argument("--yorp-body", choices=("primary", "secondary"), default="secondary",
                        help="the body --yorp acts on (default secondary)")
+        g.add_argument("--yorp-convention", choices=tuple(_pert.YORP_CONVENTIONS),
+                       default=_pert.YORP_CONVENTION,
+                       help="which torque f_Y stands for: 'paper' (default; f_Y R^3 L/(6 c d^2 "
+                            "sqrt(1-e^2)), the paper's energy per orbit over two rotations) or "
+                            "'one-turn' (twice that; docs/physics.md §13.2)")
         g.add_argument("--byorp", type=float, default=None, metavar="B",
                        help="BYORP coefficient B in [-1, 1] (> 0 expands the orbit)")
         for kind, whose in (("tide", "the --tide body"), ("yorp", "the --yorp-body"),
@@ -609,7 +614,7 @@ def _perturbations(args):
                          radius=args.tide_radius, strength=args.strength))
     if args.yorp is not None:
         out.append(YORP(body=args.yorp_body, coefficient=args.yorp, radius=args.yorp_radius,
-                        strength=args.strength, **sun))
+                        strength=args.strength, convention=args.yorp_convention, **sun))
     if args.byorp is not None:
         out.append(BYORP(coefficient=args.byorp, radius=args.byorp_radius,
                          strength=args.strength, **sun))
@@ -635,6 +640,8 @@ def _check_perturbation_flags(args):
                          "lag or a constant Q, give one")
     if args.yorp is None and args.yorp_body != "secondary":
         raise ValueError("--yorp-body needs --yorp F_Y (the YORP coefficient, in [-1, 1])")
+    if args.yorp is None and args.yorp_convention != _pert.YORP_CONVENTION:
+        raise ValueError("--yorp-convention needs --yorp F_Y (the YORP coefficient, in [-1, 1])")
     if args.heliocentric is not None:
         a_au, e = args.heliocentric
         _check_range("--heliocentric A_AU", a_au, *HELIOCENTRIC_A_RANGE)
@@ -675,7 +682,7 @@ def perturbation_summary(items, system=None):
             rubble = " (rubble pile)" if p.k2 is None else ""
             parts.append(f"tide on the {p.body} (k2 {k2:.3g}{rubble}, {lag})")
         elif p.kind == "yorp":
-            parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g})")
+            parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g}, {p.convention} torque)")
         else:
             parts.append(f"BYORP (B {p.coefficient:g})")
     if not parts:
@@ -800,7 +807,8 @@ def _system(args):
 #: (--max-orbits), rtol1e-13, tilt5-0-0, sxy0-0.1, inc10; --model, --coordinates, --method and
 #: --indicator-space by their value alone (3d, apsidal, dop853, full); tides, YORP and BYORP:
 #: tide-secondary (--tide), k2 (--k2), dt600 (--time-lag), Q100 (--Q), yorp0.0005 (--yorp),
-#: yorp-primary (--yorp-body), byorp1e-3, str1e6 (--strength), helio1.1-0.2 (--heliocentric),
+#: yorp-primary (--yorp-body), yorp-one-turn (--yorp-convention), byorp1e-3, str1e6
+#: (--strength), helio1.1-0.2 (--heliocentric),
 #: Rtide150 (--tide-radius; Ryorp, Rbyorp likewise).
 #: --max-drift, --arch and output flags change no physics: not named.
 NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
@@ -810,7 +818,8 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""),
              ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"),
              ("indicator_space", ""), ("tide", "tide-"), ("k2", "k2"), ("time_lag", "dt"),
-             ("Q", "Q"), ("yorp", "yorp"), ("yorp_body", "yorp-"), ("byorp", "byorp"),
+             ("Q", "Q"), ("yorp", "yorp"), ("yorp_body", "yorp-"),
+             ("yorp_convention", "yorp-"), ("byorp", "byorp"),
              ("strength", "str"), ("heliocentric", "helio"), ("tide_radius", "Rtide"),
              ("yorp_radius", "Ryorp"), ("byorp_radius", "Rbyorp"))
 

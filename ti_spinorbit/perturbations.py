@@ -20,6 +20,16 @@ Decisions:
   catalogued body is); BYORP along the relative velocity. Both need the binary's
   heliocentric orbit: catalogued where known (``catalog.heliocentric_orbit``), else give
   ``heliocentric_a_au`` and ``heliocentric_e``.
+* The YORP torque has two conventions (:data:`YORP_CONVENTIONS`, docs/physics.md §13.2).
+  Naidu & Margot (2015) give the YORP energy per orbit δE_YORP = 2π R³ L_⊙ f_Y /
+  (3 c d² sqrt(1 − e_⊙²)) as the torque's work over TWO rotations of the secondary per
+  mutual orbit, so their torque is δE_YORP / 4π = f_Y R³ L_⊙ / (6 c d² sqrt(1 − e_⊙²)): the
+  Lambertian recoil (2/3)(L_⊙/4πd²c) πR² of the sunlight a sphere of radius R intercepts,
+  with lever arm R and efficiency f_Y. That is the default, ``"paper"``. ``"one-turn"``
+  reads δE_YORP as the work over ONE rotation, T = δE_YORP / 2π, twice as large: the
+  package's torque before the choice existed. A saved YORP without a convention (files
+  and checkpoints written before) is read back as ``"one-turn"``, the torque it was run
+  with.
 
 Importing this module does not import Taichi.
 """
@@ -59,6 +69,14 @@ SPIN_CHANGE_LIMIT = 10.0              # n per orbit
 ORBIT_CHANGE_LIMIT = 0.1              # relative change of a per orbit
 TIDE_FORCE_LIMIT = 0.1                # conservative tide / mutual gravity at pericentre
 HELIOCENTRIC_A_RANGE = (0.05, 1e4)    # AU
+#: YORP torque conventions: name -> (k, turns). The torque is T = f_Y R³ L_⊙ /
+#: (k c d² sqrt(1 − e_⊙²)) and ``turns`` the rotations of the body per mutual orbit whose
+#: work 2π turns T is the paper's δE_YORP (docs/physics.md §13.2).
+YORP_CONVENTIONS = {"paper": (6.0, 2), "one-turn": (3.0, 1)}
+#: The default convention: the torque of Naidu & Margot's prose (two rotations per orbit).
+YORP_CONVENTION = "paper"
+#: The convention of a saved YORP that records none (written before the choice existed).
+YORP_LEGACY_CONVENTION = "one-turn"
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
 UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.perturbations)"
 
@@ -69,12 +87,28 @@ def solar_radiation_constant():
     return L_SUN / (4.0 * math.pi * C_LIGHT)
 
 
-def yorp_torque(f_yorp, radius, distance, e):
-    """The YORP torque of Naidu & Margot (2015), f_Y R³ L_⊙ / (3 c d² sqrt(1 − e_⊙²)), N m,
-    for a body of ``radius`` (m) on a heliocentric orbit of semimajor axis ``distance`` (m)
-    and eccentricity ``e`` (docs/physics.md §13.2; its work over one turn is the paper's
-    δE_YORP, ``analytic.yorp_energy_per_orbit``). Inputs unchecked: the callers check them."""
-    return f_yorp * radius ** 3 * L_SUN / (3.0 * C_LIGHT * distance ** 2 * math.sqrt(1.0 - e ** 2))
+def yorp_torque(f_yorp, radius, distance, e, convention=YORP_CONVENTION):
+    """The YORP torque f_Y R³ L_⊙ / (k c d² sqrt(1 − e_⊙²)), N m, for a body of ``radius``
+    (m) on a heliocentric orbit of semimajor axis ``distance`` (m) and eccentricity ``e``;
+    k = 6 for ``convention="paper"`` (Naidu & Margot 2015: its work over two rotations is
+    their δE_YORP), k = 3 for ``"one-turn"`` (its work over one rotation is δE_YORP); see
+    :data:`YORP_CONVENTIONS` and docs/physics.md §13.2. Inputs unchecked (the callers check
+    them), except the convention's name."""
+    k = YORP_CONVENTIONS[_check_yorp_convention(convention)][0]
+    return f_yorp * radius ** 3 * L_SUN / (k * C_LIGHT * distance ** 2 * math.sqrt(1.0 - e ** 2))
+
+
+def yorp_turns_per_orbit(convention=YORP_CONVENTION):
+    """Rotations per mutual orbit over which the torque of ``convention`` does the paper's
+    δE_YORP: 2 for ``"paper"``, 1 for ``"one-turn"`` (δE_YORP = 2π × turns × T)."""
+    return YORP_CONVENTIONS[_check_yorp_convention(convention)][1]
+
+
+def _check_yorp_convention(convention):
+    if not isinstance(convention, str) or convention not in YORP_CONVENTIONS:
+        raise ValueError(f"YORP convention must be {' or '.join(map(repr, YORP_CONVENTIONS))} "
+                         f"(got {show(convention)})")
+    return convention
 
 
 def _check_body(body):
@@ -232,9 +266,12 @@ class YORP:
     """YORP torque on ``body`` about its spin (z) axis, the form Naidu & Margot (2015) use
     (docs/physics.md §13.2):
 
-        T = f_Y R³ L_⊙ / (3 c d² sqrt(1 − e_⊙²))    (N m),
+        T = f_Y R³ L_⊙ / (k c d² sqrt(1 − e_⊙²))    (N m),
 
-    positive ``coefficient`` f_Y spins the body up, negative spins it down.
+    k = 6 by default (``convention="paper"``: the paper's δE_YORP is the work of T over two
+    rotations per mutual orbit, 4πT) or k = 3 (``"one-turn"``: δE_YORP = 2πT, the torque
+    twice as large, as the package had it before the choice existed). Positive
+    ``coefficient`` f_Y spins the body up, negative spins it down.
 
     Parameters
     ----------
@@ -247,6 +284,9 @@ class YORP:
         The body's radius, m; default its volume-equivalent radius.
     strength : float
         Factor on the torque (default 1).
+    convention : {"paper", "one-turn"}
+        Which torque f_Y stands for (:data:`YORP_CONVENTIONS`; default ``"paper"``). Saved
+        with the object; a saved YORP without it is read back as ``"one-turn"``.
     """
 
     body: str = "secondary"
@@ -255,6 +295,7 @@ class YORP:
     heliocentric_e: Optional[float] = None
     radius: Optional[float] = None
     strength: float = 1.0
+    convention: str = YORP_CONVENTION
 
     kind = "yorp"
 
@@ -263,12 +304,19 @@ class YORP:
         _check_signed("YORP coefficient (f_Y)", self.coefficient, COEFFICIENT_LIMIT)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         _check_radius_and_strength(self)
+        _check_yorp_convention(self.convention)
 
     def torque(self, system):
-        """T × strength, N m (signed)."""
+        """T × strength, N m (signed), in this object's ``convention``."""
         d, e = _heliocentric(system, self.heliocentric_a_au, self.heliocentric_e)
         return yorp_torque(self.coefficient, body_radius(system, self.body, self.radius), d,
-                           e) * self.strength
+                           e, self.convention) * self.strength
+
+    def energy_per_orbit(self, system):
+        """The work of the torque over the convention's rotations per mutual orbit,
+        2π × turns × T, J (signed): the paper's δE_YORP × strength in either convention
+        (``analytic.yorp_energy_per_orbit`` with this body's radius)."""
+        return 2.0 * math.pi * yorp_turns_per_orbit(self.convention) * self.torque(system)
 
     def block(self, system):
         M, L, T = _scales(system)
@@ -456,12 +504,16 @@ def describe(perturbations):
 
 
 def from_description(items):
-    """The objects back from :func:`describe`'s list."""
+    """The objects back from :func:`describe`'s list. A YORP entry without ``convention``
+    (saved before the convention was recorded) gets :data:`YORP_LEGACY_CONVENTION`, the
+    torque it was integrated with."""
     out = []
     for d in items or ():
         d = dict(d)
         kind = d.pop("kind")
         if kind not in KINDS:
             raise ValueError(f"unknown perturbation kind {kind!r} (known: {', '.join(KINDS)})")
+        if kind == "yorp":           # written before the convention was recorded
+            d.setdefault("convention", YORP_LEGACY_CONVENTION)
         out.append(KINDS[kind](**d))
     return tuple(out)
