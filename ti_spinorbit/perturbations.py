@@ -88,9 +88,10 @@ def solar_radiation_constant():
 
 
 def yorp_torque(f_yorp, radius, distance, e, convention=YORP_CONVENTION):
-    """The YORP torque f_Y R³ L_⊙ / (k c d² sqrt(1 − e_⊙²)), N m, for a body of ``radius``
-    (m) on a heliocentric orbit of semimajor axis ``distance`` (m) and eccentricity ``e``;
-    k = 6 for ``convention="paper"`` (Naidu & Margot 2015: its work over two rotations is
+    """The YORP torque f_Y R³ L_⊙ / (k c d² sqrt(1 − e_⊙²)), N m.
+
+    For a body of ``radius`` (m) on a heliocentric orbit of semimajor axis ``distance`` (m)
+    and eccentricity ``e``; k = 6 for ``convention="paper"`` (Naidu & Margot 2015: its work over two rotations is
     their δE_YORP), k = 3 for ``"one-turn"`` (its work over one rotation is δE_YORP); see
     :data:`YORP_CONVENTIONS` and docs/physics.md §13.2. Inputs unchecked (the callers check
     them), except the convention's name."""
