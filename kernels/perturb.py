@@ -38,17 +38,12 @@ F_B = m_s a_B; positive expands the orbit).
 
 import taichi as ti
 
-# Columns of the perturbation block, relative to its start (the model's NPAR).
-Q_TIDE1 = 0        # tide on the primary: κ, Δt, 1/(2Q) (0: constant time lag)
-Q_TIDE2 = 3        # tide on the secondary
-Q_YORP1 = 6        # YORP torque on the primary, about its z axis
-Q_YORP2 = 7        # on the secondary
-Q_BYORP = 8        # BYORP acceleration of the relative motion along V
-NPERT = 9
-#: Accumulators after the model's state: W, then L_ext (x, y, z).
-NACC = 4
-#: Floor of the bulge's relative angular rate in the constant-Q lag (scaled: units of n).
-Q_RATE_FLOOR = 1e-3
+from ti_spinorbit.layout import perturbation as _L
+
+# The block's columns (relative to its start, the model's NPAR), the accumulators after the
+# state and the constant-Q rate floor are ti_spinorbit.layout's, shared with the host.
+Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = _L.Q_TIDE1, _L.Q_TIDE2, _L.Q_YORP1, _L.Q_YORP2, _L.Q_BYORP
+NPERT, NACC, Q_RATE_FLOOR = _L.NPERT, _L.NACC, _L.Q_RATE_FLOOR
 
 
 @ti.func

@@ -452,15 +452,6 @@ def test_a_perturbed_member_whose_accounting_fails_is_flagged_inaccurate():
 
 # ---- the objects' layout and input checks -----------------------------------------------------
 
-def test_host_layout_matches_the_kernels():
-    from ti_spinorbit import perturbations as host
-    from ti_spinorbit.kernels import perturb
-
-    for name in ("Q_TIDE1", "Q_TIDE2", "Q_YORP1", "Q_YORP2", "Q_BYORP", "NPERT", "NACC",
-                 "Q_RATE_FLOOR"):
-        assert getattr(host, name) == getattr(perturb, name), name
-
-
 @pytest.mark.parametrize("make, error, message", [
     (lambda: tso.Tides(k2=-1e-5), ValueError, "k2 must be a finite number > 0"),
     (lambda: tso.Tides(k2=50.0), ValueError, "k2 must lie in [1e-12, 10]"),

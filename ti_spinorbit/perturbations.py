@@ -42,15 +42,15 @@ import numpy as np
 
 from .constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, K2_MODELS, L_SUN
 from ._validate import require_positive_scalar, require_range, require_real, show
+from .layout import perturbation as _layout
 
-#: Layout of the kernels' perturbation block (``kernels/perturb.py``; kept here so this
-#: module does not import Taichi, and checked against it by the tests).
-Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP, NPERT = 0, 3, 6, 7, 8, 9
-#: Accumulator columns after the state in a perturbed kernel (work, L_ext x, y, z).
-NACC = 4
-#: Floor of the bulge's relative angular rate in the constant-Q lag, units of the system's n
-#: (``kernels/perturb.py``; the analytic rates use it too).
-Q_RATE_FLOOR = 1e-3
+#: The kernels' perturbation block, its accumulators (work, L_ext x, y, z) and the
+#: constant-Q rate floor (units of the system's n; the analytic rates use it too), from
+#: ti_spinorbit.layout, which the kernels read as well.
+Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = (_layout.Q_TIDE1, _layout.Q_TIDE2,
+                                               _layout.Q_YORP1, _layout.Q_YORP2,
+                                               _layout.Q_BYORP)
+NPERT, NACC, Q_RATE_FLOOR = _layout.NPERT, _layout.NACC, _layout.Q_RATE_FLOOR
 BODIES = ("primary", "secondary")
 #: Allowed ranges (closed), shared with the command line's flags.
 K2_RANGE = (1e-12, 10.0)
