@@ -235,3 +235,6 @@ def test_step_budget_is_bounded_for_every_accepted_run():
     assert cost.step_budget(est, 10.0) == int(cost.BUDGET_FACTOR * 1e5 + cost.BUDGET_FLOOR)
     assert cost.step_budget(est, 0.01) == int(cost.BUDGET_FACTOR * 1e4 + cost.BUDGET_FLOOR)
     assert math.isfinite(cost.step_budget(np.array([1e300]), 1e7))
+    # a member without an estimate (a NaN start, stopped at once) leaves the others' budget
+    assert cost.step_budget(np.array([300.0, np.nan]), 10.0) == cost.step_budget(est[:1], 10.0)
+    assert cost.check_cost("x", np.array([300.0, np.nan]), 10.0) == 3000.0

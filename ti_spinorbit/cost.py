@@ -90,7 +90,9 @@ def steps_per_orbit(par, y0, rtol, method="cash-karp"):
 def step_budget(estimate, orbits):
     """The per-member step budget (an int) of a run whose members' estimates (steps per
     orbit) are ``estimate`` over ``orbits`` orbits (scalar or per member)."""
-    worst = float(np.max(np.asarray(estimate) * np.maximum(np.asarray(orbits, float), 1.0)))
+    # a member whose start is not finite has no estimate (it stops as "non-finite" at once)
+    per_member = np.asarray(estimate, float) * np.maximum(np.asarray(orbits, float), 1.0)
+    worst = float(np.max(np.where(np.isfinite(per_member), per_member, 0.0), initial=0.0))
     budget = BUDGET_FACTOR * worst + BUDGET_FLOOR
     return int(min(budget, 2.0 ** 62))
 
@@ -98,7 +100,8 @@ def step_budget(estimate, orbits):
 def check_cost(what, estimate, orbits):
     """Warn (:class:`LongRunWarning`) when the run's estimated steps, the sum over members of
     ``estimate`` × ``orbits``, exceed :data:`LONG_RUN_STEPS`; returns that total."""
-    total = float(np.sum(np.asarray(estimate) * np.maximum(np.asarray(orbits, float), 0.0)))
+    per_member = np.asarray(estimate, float) * np.maximum(np.asarray(orbits, float), 0.0)
+    total = float(np.sum(np.where(np.isfinite(per_member), per_member, 0.0)))
     if total > LONG_RUN_STEPS:
         warnings.warn(f"{what}: an estimated {total:.2g} integration steps (above "
                       f"{LONG_RUN_STEPS:.0e}, roughly an hour of two CPU cores): fewer members "
