@@ -91,10 +91,10 @@ def yorp_torque(f_yorp, radius, distance, e, convention=YORP_CONVENTION):
     """The YORP torque f_Y R³ L_⊙ / (k c d² sqrt(1 − e_⊙²)), N m.
 
     For a body of ``radius`` (m) on a heliocentric orbit of semimajor axis ``distance`` (m)
-    and eccentricity ``e``; k = 6 for ``convention="paper"`` (Naidu & Margot 2015: its work over two rotations is
-    their δE_YORP), k = 3 for ``"one-turn"`` (its work over one rotation is δE_YORP); see
-    :data:`YORP_CONVENTIONS` and docs/physics.md §13.2. Inputs unchecked (the callers check
-    them), except the convention's name."""
+    and eccentricity ``e``; k = 6 for ``convention="paper"`` (Naidu & Margot 2015: its work
+    over two rotations is their δE_YORP), k = 3 for ``"one-turn"`` (its work over one
+    rotation is δE_YORP); see :data:`YORP_CONVENTIONS` and docs/physics.md §13.2. Inputs
+    unchecked (the callers check them), except the convention's name."""
     k = YORP_CONVENTIONS[_check_yorp_convention(convention)][0]
     return f_yorp * radius ** 3 * L_SUN / (k * C_LIGHT * distance ** 2 * math.sqrt(1.0 - e ** 2))
 

@@ -156,13 +156,12 @@ def build_members(system: SystemLike, theta_p, thetadot_p,
                          f"{theta_p.shape} and thetadot_p of shape {thetadot_p.shape}") from None
     index, theta_p, thetadot_p = (np.ravel(x) for x in (index, theta_p, thetadot_p))
     members = [systems[k] for k in index]
-    # one row and one vectorised start per distinct system, spread over its members
-    par = np.empty((len(index), len(systems[0].parameter_row(escape_distance))))
+    # one row and one vectorised start per system, spread over its members
+    par = _parameter_rows(systems, escape_distance)[index]
     y0 = np.empty((len(index), 30))
     for k, system in enumerate(systems):
         sel = np.flatnonzero(index == k)
         if len(sel):
-            par[sel] = system.parameter_row(escape_distance)
             y0[sel] = system.initial_states(np.radians(theta_p[sel]), thetadot_p[sel])
     if coordinates == "apsidal":
         y0, _ = _coords.apsidal_initial_states(members, par, y0, theta_p, thetadot_p, order)
