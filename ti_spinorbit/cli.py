@@ -480,12 +480,27 @@ def _check_output(flag, path, extensions):
                          f"{exc.strerror or exc})") from None
 
 
+def _has_display():
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def _choose_backend():
+    """The command line only writes figures to files: without a display it uses Matplotlib's
+    file backend (Agg) unless a file backend is already chosen. Only the command line does
+    this; the library leaves the session's backend alone."""
+    import matplotlib
+
+    if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg") and not _has_display():
+        matplotlib.use("Agg")
+
+
 def _check_plotting():
     """Matplotlib must load with the environment's backend before a run whose figure would
     otherwise fail at the end (an invalid MPLBACKEND raises at import)."""
     try:
         from .plotting import _pyplot
 
+        _choose_backend()
         _pyplot()
     except Exception as exc:  # noqa: BLE001 - any failure here would lose the figure later
         backend = os.environ.get("MPLBACKEND")

@@ -12,19 +12,12 @@ MEGNO_COLOR_RANGE = (0.0, 8.0)
 
 
 def _pyplot():
-    import matplotlib
-
-    if matplotlib.get_backend().lower() not in ("agg", "pdf", "svg") and not _has_display():
-        matplotlib.use("Agg")
+    """matplotlib.pyplot with the backend the session chose: a library never switches it
+    (in a notebook that would turn the inline figures off for the whole kernel); the
+    command line picks a file backend for itself (``cli._choose_backend``)."""
     import matplotlib.pyplot as plt
 
     return plt
-
-
-def _has_display():
-    import os
-
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
 #: Members up to which a section gets a legend (one entry per start); beyond it a colourbar of
