@@ -3,7 +3,7 @@
 what a plain compiled loop does).
 
 Written independently of the Taichi kernels: the right-hand side below is derived again from
-the planar equations of docs/physics.md §3.2–3.5 and the docstring of ``kernels/planar.py``
+the planar equations of docs/physics.md §3.2–3.5 and the docstring of ``kernels/planar_eom.py``
 (state y = [r, v_r, ℓ, λ, cos ψ_A, sin ψ_A, w1, cos ψ_B, sin ψ_B, w2], scaled units, G = 1),
 and only the member's parameter row (the Fourier coefficients of each body's Legendre terms,
 ``ti_spinorbit.planar.parameter_rows``) is shared. ``tests/test_experiments.py`` checks this RHS
@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _D
 
-# planar parameter row (kernels/planar.py layout; not imported, to stay independent)
+# planar parameter row (kernels/planar_eom.py layout; not imported, to stay independent)
 _MM, _INV_M, _K1, _F1, _K2, _F2 = 0, 1, 2, 3, 4, 5
 _P2, _Q2, _P3, _Q3, _P4, _Q4, _X = 6, 9, 12, 16, 20, 25, 30
 NSTATE = 10

@@ -190,7 +190,7 @@ RHS_PERTURBATION = 1e-12          # RHS-only loop: next argument y0 + this · f(
 # (3-D) scalar fadd/fsub/fmul/fdiv/sqrt, no vector operations (the 3-D count 4 % under the
 # hand count: LLVM shares a few products the count repeats).
 #
-# planar, kernels/planar.py                                                                     141
+# planar, kernels/planar_eom.py                                                                     141
 #   1/r 1 (the only division), start of V_r 2                                                     3
 #   per body (_series): cos, sin of 2ψ and 4ψ 10, P2 4, dP2/dψ 4, P4 8, dP4/dψ 9 = 35; ×2        70
 #   1/r², 1/r³ 2; order-2 terms into V_r 5, V_A 2, V_B 2                                         11
@@ -198,7 +198,7 @@ RHS_PERTURBATION = 1e-12          # RHS-only loop: next argument y0 + this · f(
 #     V_r 4, V_A 3, V_B 3                                                                        39
 #   rhs_member: dλ/dt 2, dψ_A/dt and dψ_B/dt 4, dv_r/dt 4, dℓ/dt 2, cos/sin rates 4,
 #     spins 2                                                                                    18
-# 3-D, kernels/eom.py + kernels/potential.py (G = 1 folds away)                                 799
+# 3-D, kernels/eom.py + kernels/mutual_gravity.py (G = 1 folds away)                                 799
 #   eom.rhs around the potential: Ω1 3, Ω2 = S I2⁻¹ Sᵀ w2 33, dR/dt 12, dV/dt 15,
 #     dw1/dt 15, dw2/dt 15 (3 divisions each), Ω2 − Ω1 3, dS/dt 27, dS1/dt 27                   150
 #   mutual: R·R 5, sqrt 1, 1/r 1, e 3, ∇(mA mB/r) 6                                              16
@@ -352,7 +352,7 @@ def method_unavailable(method):
 def run_point(par, y0, model, rtol, orbits, window=16, method=DEFAULT_METHOD):
     """Integrate the members (par, y0) for ``orbits`` with ``model`` and ``method``; one
     result row."""
-    from ti_spinorbit.kernels.ensemble import DONE
+    from ti_spinorbit.kernels.advance import DONE
 
     ens = make_ensemble(par, y0, model, rtol, method)
     n = len(par)
@@ -716,7 +716,7 @@ def random_planar_states(n, seed=1):
 def numba_rhs_mismatch(nb, kpar, q):
     """max over states and components of |f_numba − f_package| / max |f_package| of that
     component: the baseline's RHS against the planar kernels' (round-off: ~1e-16)."""
-    from ti_spinorbit.kernels import ensemble as K
+    from ti_spinorbit.kernels import advance as K
 
     f_pkg, f_nb = np.zeros_like(q), np.zeros_like(q)
     K.PLANAR.evaluate_rhs(kpar, q, f_pkg, 4, False)

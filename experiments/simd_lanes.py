@@ -6,7 +6,7 @@ Benchmark-only prototype: the package kernels are not changed. Three layouts of 
 
 scalar
     today's layout: one member per loop iteration (per thread task), state and parameters
-    of member i from (N, 10) and (N, 37) arrays, ``kernels/planar.rhs_member``.
+    of member i from (N, 10) and (N, 37) arrays, ``kernels/planar_eom.rhs_member``.
 unrolled L
     structure of arrays, (10, N) and (37, N), so that L consecutive members are contiguous;
     one loop iteration takes L members and runs the package's scalar ``rhs_member`` on each,
@@ -88,7 +88,7 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
     """Taichi kernels {(workload, variant, L): kernel(par, y, out, repeats)}."""
     import taichi as ti
 
-    from ti_spinorbit.kernels import planar as P
+    from ti_spinorbit.kernels import planar_eom as P
 
     nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
     NS, NP = P.NSTATE, P.NPAR
@@ -171,7 +171,7 @@ def build_kernels(lanes_list, ck_lanes=(), vern_lanes=()):
 
         @ti.func
         def rhs_lanes(PV, Y):
-            """kernels/planar.py's equations (order 4, no odd terms), every scalar an
+            """kernels/planar_eom.py's equations (order 4, no odd terms), every scalar an
             L-vector of members."""
             r, vr, ell = row(Y, P.Y_R), row(Y, P.Y_VR), row(Y, P.Y_L)
             ca, sa, cb, sb = row(Y, P.Y_CA), row(Y, P.Y_SA), row(Y, P.Y_CB), row(Y, P.Y_SB)

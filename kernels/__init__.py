@@ -4,8 +4,8 @@ Importing these modules defines Taichi functions and kernels but does not initia
 ``ti_spinorbit.runtime.ensure_init`` must run before the first launch.
 
 * ``tableau``     Butcher tableaux (data) and controller constants
-* ``potential``   fourth-order mutual potential, force, torques
+* ``mutual_gravity`` fourth-order mutual potential, force, torques
 * ``eom``         equations of motion, member-parameter layout, diagnostics
 * ``integrator``  generic embedded RK step, error norm, step-size controller
-* ``ensemble``    the window kernel, pericentre events, dense sampling
+* ``advance``     the window kernel, pericentre events, dense sampling
 """

@@ -26,7 +26,7 @@ from ti_spinorbit.bodies import ROW_LENGTH
 from ti_spinorbit.layout import spatial as _L
 
 from . import perturb
-from .potential import mat_t_vec, mat_vec, mutual, vec3, mat3
+from .mutual_gravity import mat_t_vec, mat_vec, mutual, vec3, mat3
 
 # The state offsets and the member parameter row (two body rows, then derived constants,
 # scaled units) are ti_spinorbit.layout's, shared with the host.

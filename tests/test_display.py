@@ -177,7 +177,7 @@ def test_a_loaded_result_prints_as_the_saved_one(kind, request, tmp_path):
 
 def test_chaotic_fraction_says_how_many_members_it_counts(chaos_map):
     """Inaccurate members are left out of the fraction (unless included): the repr says so."""
-    from ti_spinorbit.kernels.ensemble import INACCURATE
+    from ti_spinorbit.kernels.advance import INACCURATE
 
     status = chaos_map.status.copy()
     status.flat[0] = INACCURATE

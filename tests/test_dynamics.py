@@ -8,7 +8,7 @@ import ti_spinorbit as tso
 from ti_spinorbit import reference
 from ti_spinorbit.ensemble import Ensemble
 from ti_spinorbit.kernels import eom
-from ti_spinorbit.kernels.ensemble import COLLISION, DONE, ESCAPE, NONFINITE, RUNNING
+from ti_spinorbit.kernels.advance import COLLISION, DONE, ESCAPE, NONFINITE, RUNNING
 from ti_spinorbit.section import build_members
 
 DAY = 86400.0

@@ -7,7 +7,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import reference
-from ti_spinorbit.kernels import ensemble as K
+from ti_spinorbit.kernels import advance as K
 
 from conftest import lumpy_body, random_rotation
 import oracles
@@ -187,12 +187,12 @@ def test_kernel_rhs_equals_reference_rhs(kind, rng):
 
 
 def test_written_out_products_equal_taichis_bit_for_bit(rng):
-    """kernels/potential.py writes the 3x3 products out (mat_vec, mat_t_vec,
+    """kernels/mutual_gravity.py writes the 3x3 products out (mat_vec, mat_t_vec,
     rotate_diagonal) instead of Taichi's ``@``, which starts each sum from a computed zero and
     multiplies a diagonal matrix's zeros. The dropped terms are exact zeros, so on finite
     inputs the values must be Taichi's to the bit (signed zeros aside: none occur here)."""
     import taichi as ti
-    from ti_spinorbit.kernels.potential import mat3, mat_t_vec, mat_vec, rotate_diagonal, vec3
+    from ti_spinorbit.kernels.mutual_gravity import mat3, mat_t_vec, mat_vec, rotate_diagonal, vec3
 
     n = 64
     M = rng.normal(size=(n, 3, 3)) * 10.0 ** rng.integers(-8, 9, size=(n, 1, 1))

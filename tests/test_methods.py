@@ -198,7 +198,7 @@ def test_first_stage_is_evaluated_inside_the_integrator(members, monkeypatch, me
     right-hand-side kernel), and is counted once, as before: one step that lands on a tiny
     end time costs 1 (start) + (stages - 1) + 1 (the derivative at the end) evaluations, and
     the shadow adds its stages and end point but not its start."""
-    from ti_spinorbit.kernels import ensemble as K
+    from ti_spinorbit.kernels import advance as K
 
     ens = Ensemble(*members, rtol=1e-10, model="planar", method=method)
 

@@ -12,7 +12,7 @@ pytest.importorskip("numba")
 
 from ti_spinorbit import planar as PL  # noqa: E402
 from ti_spinorbit.ensemble import Ensemble  # noqa: E402
-from ti_spinorbit.kernels import ensemble as K  # noqa: E402
+from ti_spinorbit.kernels import advance as K  # noqa: E402
 from ti_spinorbit.section import build_members  # noqa: E402
 
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),

@@ -19,7 +19,7 @@ def test_wheel_contains_kernels_as_subpackage_and_catalogue(tmp_path):
     assert p.returncode == 0, p.stderr
     wheel, = tmp_path.glob("ti_spinorbit-*.whl")
     names = set(zipfile.ZipFile(wheel).namelist())
-    for f in ("ti_spinorbit/kernels/ensemble.py", "ti_spinorbit/kernels/potential.py",
+    for f in ("ti_spinorbit/kernels/advance.py", "ti_spinorbit/kernels/mutual_gravity.py",
               "ti_spinorbit/data/systems.json", "ti_spinorbit/cli.py"):
         assert f in names
     assert not any(n.startswith("kernels/") for n in names)   # no top-level "kernels" package

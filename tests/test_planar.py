@@ -1,4 +1,4 @@
-"""The planar model (kernels/planar.py) against the general 3-D model.
+"""The planar model (kernels/planar_eom.py) against the general 3-D model.
 
 Independent routes: the planar potential's coefficients come from moment-tensor contractions
 with Legendre polynomials (ti_spinorbit/planar.py), the 3-D kernel uses explicit monomial
@@ -13,7 +13,7 @@ import pytest
 import ti_spinorbit as tso
 from ti_spinorbit import planar as PL
 from ti_spinorbit.ensemble import Ensemble
-from ti_spinorbit.kernels import ensemble as K
+from ti_spinorbit.kernels import advance as K
 from ti_spinorbit.section import build_members
 
 

@@ -14,7 +14,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import accuracy, cli
-from ti_spinorbit.kernels.ensemble import (COLLISION, DONE, ESCAPE, INACCURATE, NONFINITE,
+from ti_spinorbit.kernels.advance import (COLLISION, DONE, ESCAPE, INACCURATE, NONFINITE,
                                            STATUS_NAMES, STEP_UNDERFLOW)
 
 from conftest import run_cli

@@ -82,7 +82,7 @@ def test_perturbed_runs_count_their_accumulator_columns(vh, monkeypatch, model, 
     """With tides, YORP or BYORP the records carry the work and external-angular-momentum
     accumulators (4 more columns), and the entry points' early check counts them: the width
     it sizes with equals the kernels' own record width of the perturbed variant."""
-    from ti_spinorbit.kernels import ensemble as K
+    from ti_spinorbit.kernels import advance as K
 
     kernels = K.kernels_for(model, perturbed=True)
     assert resources.record_width(vh, model, perturbed=True) == width == kernels.RECORD_WIDTH
@@ -160,7 +160,7 @@ def test_refusal_follows_the_available_memory(vh, monkeypatch):
                        r"0\.000977 GiB available; "):
         tso.time_series(vh, 0.0, 1.0, 50, samples_per_orbit=64)
     monkeypatch.setattr(_validate, "available_memory", lambda: 64 * GIB)
-    from ti_spinorbit.kernels.ensemble import DONE
+    from ti_spinorbit.kernels.advance import DONE
     assert tso.time_series(vh, 0.0, 1.0, 2, samples_per_orbit=4).status.tolist() == [DONE]
 
 

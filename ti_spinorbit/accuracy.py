@@ -66,7 +66,7 @@ def drift_limit(rtol, orbits, max_drift=None):
 
 def totals(diag):
     """Total energy (N,) and total angular-momentum vector (N, 3) from DIAG_FIELDS rows
-    (``kernels.ensemble``: three energies, then the orbit's, the primary's and the
+    (``kernels.advance``: three energies, then the orbit's, the primary's and the
     secondary's angular-momentum vectors, ...), scaled units."""
     return diag[:, :3].sum(1), diag[:, 3:6] + diag[:, 6:9] + diag[:, 9:12]
 

@@ -25,7 +25,7 @@ from ._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LENG
                         require_positive_scalar, require_real, show, _as_floats)
 from . import display as _display
 
-# Fixed orders of the monomials, shared with the kernels (kernels/potential.py unrolls them).
+# Fixed orders of the monomials, shared with the kernels (kernels/mutual_gravity.py unrolls them).
 EXPONENTS_2 = ((2, 0, 0), (0, 2, 0), (0, 0, 2))
 EXPONENTS_3 = tuple((l, m, 3 - l - m) for l in range(3, -1, -1) for m in range(3 - l, -1, -1))
 EXPONENTS_4 = tuple((l, m, 4 - l - m) for l in range(4, -1, -1) for m in range(4 - l, -1, -1))

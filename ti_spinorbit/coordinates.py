@@ -69,7 +69,7 @@ def true_acceleration(par, states, order=4):
     frame term V × Ω1 removed (docs/physics.md §4.3)."""
     from . import runtime
     from .kernels import eom
-    from .kernels import ensemble as K
+    from .kernels import advance as K
 
     runtime.ensure_init()
     par = np.ascontiguousarray(par, dtype=np.float64)

@@ -1,7 +1,7 @@
 """Ensemble driver: member table in, windows of kernel launches, drained buffers out.
 
 Data flow: ``BinarySystem`` rows + initial states (numpy, scaled units) -> :class:`Ensemble`
--> one ``kernels.ensemble.advance`` launch per window -> per-member event / sample lists and
+-> one ``kernels.advance.advance`` launch per window -> per-member event / sample lists and
 diagnostics -> :class:`RunOutput`, which the result classes of ``section`` turn into SI.
 
 Decisions:
@@ -53,7 +53,7 @@ class RunOutput:
     diag_end: np.ndarray              # (N, 14) at the final time reached
     t: np.ndarray                     # final time reached, scaled
     y: np.ndarray                     # final state, scaled (N, 30)
-    status: np.ndarray                # (N,) int, kernels.ensemble.STATUS_NAMES
+    status: np.ndarray                # (N,) int, kernels.advance.STATUS_NAMES
     counters: np.ndarray              # (N, 3) accepted, rejected, RHS calls
     launches: int = 0
     seconds: float = 0.0
@@ -78,7 +78,7 @@ class RunState:
     y: np.ndarray              # (N, nstate) kernel-layout state
     t: np.ndarray              # (N,) scaled time
     h: np.ndarray              # (N,) step proposal
-    status: np.ndarray         # (N,) int32, kernels.ensemble.STATUS_NAMES
+    status: np.ndarray         # (N,) int32, kernels.advance.STATUS_NAMES
     counters: np.ndarray       # (N, 3) int64 accepted, rejected, RHS calls
     yc: np.ndarray             # Kahan compensation of y
     tc: np.ndarray             # Kahan compensation of t
@@ -139,7 +139,7 @@ class Ensemble:
         Tolerances on the scaled state (error in tolerance units, max norm).
     model : {"auto", "planar", "3d"}
         Equations of motion: "planar" integrates the reduced planar state
-        (``kernels/planar.py``, about 3x cheaper per step), "3d" the general one; "auto"
+        (``kernels/planar_eom.py``, about 3x cheaper per step), "3d" the general one; "auto"
         (default) takes the planar model when every member qualifies
         (``ti_spinorbit.planar.qualifies``). Inputs and outputs are 3-D states either way.
     method : {"cash-karp", "dop853", "vern9"}
@@ -228,7 +228,7 @@ class Ensemble:
     def diagnostics(self, y=None, member=None) -> np.ndarray:
         """DIAG_FIELDS (energies, angular momenta, orthonormality) of 3-D states y (default:
         the current ones) belonging to members ``member`` (default 0..N-1), scaled units."""
-        from .kernels import ensemble as K
+        from .kernels import advance as K
 
         y = self.spatial(self.y) if y is None else \
             np.ascontiguousarray(y, dtype=np.float64).reshape(-1, 30)

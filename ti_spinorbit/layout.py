@@ -1,8 +1,8 @@
 """The layouts the kernels and the host share: state offsets, parameter columns, the
 perturbation block, record widths and status codes, in one place and without Taichi.
 
-The kernels (``kernels/eom.py``, ``kernels/planar.py``, ``kernels/perturb.py``,
-``kernels/ensemble.py``) take their offsets from here, and so does every host module that
+The kernels (``kernels/eom.py``, ``kernels/planar_eom.py``, ``kernels/perturb.py``,
+``kernels/advance.py``) take their offsets from here, and so does every host module that
 reads a state or a parameter row (cost estimates, shadow directions, observables), so a
 layout is written once and nothing has to be kept in step by hand.
 
@@ -13,7 +13,7 @@ layout is written once and nothing has to be kept in step by hand.
 (length a, time 1/n, mass m1 + m2; w = Γ/C), and a parameter row of the two bodies' rows
 (``bodies.ROW_LENGTH`` each) followed by the derived constants P_MRED ... P_ESCAPE.
 
-**Planar model** (``kernels/planar.py``; docs/physics.md §5): the 10-number state
+**Planar model** (``kernels/planar_eom.py``; docs/physics.md §5): the 10-number state
 [r, v_r, ℓ, λ, cos ψ_A, sin ψ_A, w1, cos ψ_B, sin ψ_B, w2] and a 37-column row of Fourier
 coefficients of the mutual potential (``ti_spinorbit.planar.parameter_rows``).
 
@@ -49,7 +49,7 @@ class spatial:
 
 
 class planar:
-    """The planar model's state offsets and parameter columns (``kernels/planar.py``)."""
+    """The planar model's state offsets and parameter columns (``kernels/planar_eom.py``)."""
 
     NSTATE = 10
     Y_R, Y_VR, Y_L, Y_LAM, Y_CA, Y_SA, Y_W1, Y_CB, Y_SB, Y_W2 = range(10)
@@ -92,7 +92,7 @@ STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non
 #: Counter columns of every member: accepted steps, rejected steps, right-hand-side calls.
 C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2
 
-#: The diagnostics' columns (``kernels/ensemble.py`` ``diagnostics``): three energies, the
+#: The diagnostics' columns (``kernels/advance.py`` ``diagnostics``): three energies, the
 #: orbit's, the primary's and the secondary's angular-momentum vectors, orthonormality errors.
 DIAG_FIELDS = ("E_orbit", "E_primary", "E_secondary",
                "L_orbit_x", "L_orbit_y", "L_orbit_z", "L_primary_x", "L_primary_y",

@@ -2,7 +2,7 @@
 ``if model == "planar"`` branches.
 
 * ``SPATIAL`` ("3d"): the general 30-number state (``kernels/eom.py``);
-* ``PLANAR`` ("planar"): the reduced 10-number state (``kernels/planar.py``), exact when both
+* ``PLANAR`` ("planar"): the reduced 10-number state (``kernels/planar_eom.py``), exact when both
   bodies are mirror-symmetric about their equators and the start is planar
   (:func:`ti_spinorbit.planar.qualifies`).
 
@@ -63,8 +63,8 @@ class Model:
         return 1 + self.nstate
 
     def kernels(self, method="cash-karp", perturbed=False):
-        """The Taichi kernel set (``kernels.ensemble.kernels_for``); imports Taichi."""
-        from .kernels import ensemble as K
+        """The Taichi kernel set (``kernels.advance.kernels_for``); imports Taichi."""
+        from .kernels import advance as K
         return K.kernels_for(self.name, method, perturbed)
 
     def qualifies(self, par, y0):

@@ -1,4 +1,4 @@
-"""Host side of the planar model (``kernels/planar.py``): when it applies, its parameter rows,
+"""Host side of the planar model (``kernels/planar_eom.py``): when it applies, its parameter rows,
 and conversions between the planar and the 3-D scaled states.
 
 Decision: the model is chosen per ensemble, not per member. ``Ensemble(model="auto")`` uses
@@ -82,7 +82,7 @@ def fourier_coefficients(row):
 
 
 def _cross_coefficients(jA, jB):
-    """(x0, xA, xB, xAB, xm) of the quadrupole-quadrupole term X (kernels/planar.py) from the
+    """(x0, xA, xB, xAB, xm) of the quadrupole-quadrupole term X (kernels/planar_eom.py) from the
     diagonal second moments (T200, T020, T002) of both bodies."""
     abar, alpha = 0.5 * (jA[0] + jA[1]), 0.5 * (jA[0] - jA[1])
     bbar, beta = 0.5 * (jB[0] + jB[1]), 0.5 * (jB[0] - jB[1])
@@ -94,8 +94,8 @@ def _cross_coefficients(jA, jB):
 
 
 def parameter_rows(par):
-    """Planar kernel rows (kernels/planar.py layout) from 3-D member rows (eom layout)."""
-    from .kernels import eom, planar as P
+    """Planar kernel rows (kernels/planar_eom.py layout) from 3-D member rows (eom layout)."""
+    from .kernels import eom, planar_eom as P
 
     par = np.atleast_2d(np.asarray(par, dtype=np.float64))
     out = np.zeros((len(par), P.NPAR))
@@ -123,8 +123,8 @@ def parameter_rows(par):
 
 
 def to_planar(y):
-    """3-D scaled states (..., 30) -> planar states (..., 10), layout of kernels/planar.py."""
-    from .kernels import eom, planar as P
+    """3-D scaled states (..., 30) -> planar states (..., 10), layout of kernels/planar_eom.py."""
+    from .kernels import eom, planar_eom as P
 
     y = np.asarray(y, dtype=np.float64)
     R = y[..., eom.Y_R:eom.Y_R + 3]                      # primary frame
@@ -149,7 +149,7 @@ def to_planar(y):
 
 def to_spatial(q):
     """Planar states (..., 10) -> 3-D scaled states (..., 30) in the primary's frame."""
-    from .kernels import eom, planar as P
+    from .kernels import eom, planar_eom as P
 
     q = np.asarray(q, dtype=np.float64)
     r, vr, ell, lam = q[..., P.Y_R], q[..., P.Y_VR], q[..., P.Y_L], q[..., P.Y_LAM]
@@ -173,7 +173,7 @@ def to_spatial(q):
 def shadow_direction():
     """Unit direction of the chaos-indicator shadow's initial offset: r, v_r, ℓ and the
     secondary's spin (the planar counterpart of the 3-D model's direction)."""
-    from .kernels import planar as P
+    from .kernels import planar_eom as P
 
     u = np.zeros(P.NSTATE)
     u[[P.Y_R, P.Y_VR, P.Y_L, P.Y_W2]] = 1.0

@@ -33,7 +33,7 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
         mass, N m (δV = −torque·δθ for an infinitesimal rotation of that body alone).
     """
     from .kernels import eom
-    from .kernels import ensemble as K
+    from .kernels import advance as K
     from .ensemble import _odd_columns
     from .bodies import ROW_LENGTH
     from .systems import G

@@ -102,7 +102,7 @@ def record_width(system, model="auto", perturbed=False):
     ``system`` is a list, not yet known); with ``perturbed`` (tides, YORP or BYORP) the
     records also carry the NACC work and external-angular-momentum accumulators (15, 35)."""
     from . import planar
-    from .kernels import ensemble as K
+    from .kernels import advance as K
     from .perturbations import NACC
     from .systems import BinarySystem
 

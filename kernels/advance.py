@@ -40,11 +40,11 @@ from ti_spinorbit.layout import (C_ACCEPTED, C_REJECTED, C_RHS, COLLISION, DIAG_
                                  ESCAPE, INACCURATE, NONFINITE, RECORD_WIDTH, RUNNING,
                                  STATUS_NAMES, STEP_BUDGET, STEP_UNDERFLOW)
 
-from . import eom, perturb, planar
+from . import eom, perturb, planar_eom
 from .eom import NSTATE
 from .controller import DEFAULT_CONTROLLER, NONFINITE_ERROR
 from .integrator import make_error_norm, make_primitives, stage_matrix_type
-from .potential import mutual, vec3
+from .mutual_gravity import mutual, vec3
 from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 
 # Status codes, record width, diagnostics and counter columns are ti_spinorbit.layout's.
@@ -453,7 +453,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
 
 #: The 3-D model's kernels (30-number state) and the planar model's (10 numbers), Cash-Karp.
 SPATIAL = make_kernels(eom)
-PLANAR = make_kernels(planar)
+PLANAR = make_kernels(planar_eom)
 _KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
 
 
@@ -463,7 +463,7 @@ def kernels_for(model, method=DEFAULT_METHOD, perturbed=False):
     compiles each on first launch)."""
     key = (model, check_method(method)) + (("perturbed",) if perturbed else ())
     if key not in _KERNEL_SETS:
-        _KERNEL_SETS[key] = make_kernels(planar if model == "planar" else eom, METHODS[method],
+        _KERNEL_SETS[key] = make_kernels(planar_eom if model == "planar" else eom, METHODS[method],
                                          DEFAULT_CONTROLLER, perturbed=perturbed)
     return _KERNEL_SETS[key]
 advance = SPATIAL.advance
