@@ -126,6 +126,14 @@ def require_callable(name, value):
     return value
 
 
+def require_bool(name, value):
+    """``value`` as a bool, or a one-line TypeError naming ``name``: a flag must be True or
+    False (a str such as "yes" is truthy and would be taken silently)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False (got {show(value)})")
+    return bool(value)
+
+
 def require_spin(name, value):
     """Spin rates in units of n (scalar or array): finite with |value| <= MAX_SPIN."""
     arr = _as_floats(name, value)

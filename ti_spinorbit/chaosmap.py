@@ -280,6 +280,11 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
+    if "initial_states" in section_kwargs:
+        raise TypeError("chaos_map takes a grid of starts (theta_p x thetadot_p, tilted with "
+                        "tilt=(roll, pitch)), not initial_states: for explicit states call "
+                        "surface_of_section(initial_states=..., indicators=True)")
+    launches = _launches(checkpoint, resume, overwrite_checkpoint, client)
     from .models import check_indicator_space
     indicator_space = check_indicator_space(indicator_space)
     tilt = _check_tilt(tilt, client, coordinates)
@@ -303,13 +308,13 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     fractions = []
     work = float(sum(shorter)) + float(orbits)        # progress: each length its share
     done = 0.0
-    with _progress.reporting(progress, "chaos_map") as report:
+    with launches.owned(), _progress.reporting(progress, "chaos_map") as report:
         for length in shorter:
             short = sections(client, system, grid_tp, grid_td, length, chunk_size=chunk_size, rtol=rtol,
                              indicators=True, model=model, max_drift=max_drift,
                              coordinates=coordinates,
                              progress=_progress.stage(report, done / work, length / work),
-                             **section_kwargs)
+                             **section_kwargs, **launches.next())
             done += float(length)
             fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length),
                                                short.status, include_inaccurate))
@@ -317,10 +322,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         section = sections(client, system, grid_tp, grid_td, orbits, chunk_size=chunk_size,
                            rtol=rtol, indicators=True,
                            progress=_progress.stage(report, done / work, orbits / work),
-                           model=model, checkpoint=checkpoint,
-                           resume=resume, overwrite_checkpoint=overwrite_checkpoint,
-                           max_drift=max_drift, coordinates=coordinates,
-                           **section_kwargs)
+                           model=model, max_drift=max_drift, coordinates=coordinates,
+                           **section_kwargs, **launches.next())
     classes = _classified(section, megno_chaotic, orbits)
     labels = classes.classification
     attitude_class = _attitude_classes(section, classes)
@@ -362,6 +365,19 @@ def _check_tilt(tilt, client, coordinates):
     return values
 
 
+def _launches(checkpoint, resume, overwrite, client):
+    """The checkpoints of a map's launches (every length: the evidence, then the map), in
+    ``checkpoint/launch-kkk`` (:class:`ti_spinorbit.checkpoint.Launches`), checked before any
+    work; none with a Dask client (refused there by the first launch)."""
+    from .checkpoint import Launches, check_path
+
+    checkpoint = check_path(checkpoint)
+    if client is not None and (checkpoint is not None or resume):
+        raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
+                         "would share one file); failed chunks are retried instead")
+    return Launches(checkpoint, resume, overwrite)
+
+
 def _fraction_lengths(orbits, fraction_orbits):
     """The shorter lengths of chaos_map's fraction-against-orbits evidence, ascending."""
     if fraction_orbits is None:
@@ -370,6 +386,10 @@ def _fraction_lengths(orbits, fraction_orbits):
     if np.any(~np.isfinite(values)) or np.any(values <= 0) or np.any(values >= float(orbits)):
         raise ValueError(f"fraction_orbits must hold lengths in (0, orbits) = (0, "
                          f"{float(orbits):g}) (got {show(fraction_orbits)})")
+    if np.unique(values).size != values.size:      # the same length twice is the same run
+        raise ValueError(f"fraction_orbits must hold distinct lengths (got "
+                         f"{show(fraction_orbits)}: a length given twice would be integrated "
+                         "twice for the same fraction)")
     return sorted(float(v) for v in values)
 
 
@@ -514,6 +534,7 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
+    launches = _launches(checkpoint, resume, overwrite_checkpoint, client)
     perturbations = check_perturbations(perturbations)
     section_kwargs["perturbations"] = perturbations
     if isinstance(system, str):
@@ -528,7 +549,15 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     starts = tp.size
     resources.check_memory("parameter_map", elongations.size * eccentricities.size * starts,
                            orbits, advice="use a coarser grid, fewer starts or fewer orbits")
-    grid = [factory(float(q), float(e)) for q in elongations for e in eccentricities]
+    grid = []
+    for q in elongations:
+        for e in eccentricities:
+            made = factory(float(q), float(e))
+            if not isinstance(made, BinarySystem):       # named before it is used
+                raise TypeError(f"factory system(a/b, e) must return a BinarySystem; at the "
+                                f"grid point (a/b, e) = ({q:g}, {e:g}) it returned "
+                                f"{type(made).__name__}")
+            grid.append(made)
     if not name:
         name = grid[0].name
     members = [s for s in grid for _ in range(starts)]
@@ -543,22 +572,21 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     by_length = []
     work = float(sum(shorter)) + float(orbits)        # progress: each length its share
     done = 0.0
-    with _progress.reporting(progress, "parameter_map") as report:
+    with launches.owned(), _progress.reporting(progress, "parameter_map") as report:
         for length in shorter:            # first, each dropped after use (as chaos_map)
             short = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
                              length, chunk_size=chunk_size, rtol=rtol, indicators=True,
                              model=model, max_drift=max_drift, coordinates=coordinates,
                              progress=_progress.stage(report, done / work, length / work),
-                             **section_kwargs)
+                             **section_kwargs, **launches.next())
             done += float(length)
             by_length.append(fractions_of(short, length)[2])
             del short
         section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
                            orbits, chunk_size=chunk_size, rtol=rtol, indicators=True,
                            progress=_progress.stage(report, done / work, orbits / work),
-                           model=model, checkpoint=checkpoint, resume=resume,
-                           overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
-                           coordinates=coordinates, **section_kwargs)
+                           model=model, max_drift=max_drift, coordinates=coordinates,
+                           **section_kwargs, **launches.next())
     seconds = started.seconds()
     labels, status, fraction = fractions_of(section, orbits)
     by_length = np.array(by_length + [fraction])

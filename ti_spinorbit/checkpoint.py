@@ -70,8 +70,10 @@ import zipfile
 import numpy as np
 
 FORMAT = "ti_spinorbit checkpoint"
-#: 3: the state holds the records files' SHA-256 digests and is checked on resume.
-FORMAT_VERSION = 3
+#: 3: the state holds the records files' SHA-256 digests and is checked on resume;
+#: 4: the input fingerprint is one digest per part (systems, initial states, integration
+#: times, perturbations), so that a refused resume names what changed.
+FORMAT_VERSION = 4
 STATE = "state.npz"
 #: The lock file and the holder's identity beside it.
 LOCK = "lock"
@@ -84,6 +86,8 @@ _PER_MEMBER = ("y", "t", "h", "status", "counters", "yc", "tc", "f", "next_sampl
 _DTYPES = {"status": np.int32, "counters": np.int64}   # the others are float64
 _RECORDS = ("events", "samples")
 _RECORDS_FILE = re.compile(r"records-\d{6,}\.npz$")
+#: The checkpoint of one launch of a multi-launch computation (:class:`Launches`).
+_LAUNCH_DIR = re.compile(r"launch-\d{3,}$")
 
 
 class CheckpointError(ValueError):
@@ -211,7 +215,18 @@ def _lock_class():
 
 
 def _is_checkpoint_file(name):
-    return name in (STATE, LOCK, OWNER) or _RECORDS_FILE.match(name) or ".tmp-" in name
+    return name in (STATE, LOCK, OWNER) or _RECORDS_FILE.match(name) or ".tmp-" in name \
+        or _LAUNCH_DIR.match(name)
+
+
+def _launch_dirs(path):
+    """The launch checkpoints (``launch-kkk`` directories) in ``path``, in order."""
+    try:
+        names = os.listdir(path)
+    except OSError:
+        return []
+    return sorted(os.path.join(path, n) for n in names
+                  if _LAUNCH_DIR.match(n) and os.path.isdir(os.path.join(path, n)))
 
 
 def _clean(path, names):
@@ -231,15 +246,22 @@ def _refuse_foreign(path):
 
 
 def holds_checkpoint(path):
-    """True when the directory ``path`` holds a checkpoint (a state file) of some run."""
-    return os.path.isfile(os.path.join(_fspath(path), STATE))
+    """True when the directory ``path`` holds a checkpoint of some run: a state file, or a
+    launch checkpoint (``launch-kkk``, :class:`Launches`) that holds one."""
+    path = _fspath(path)
+    return os.path.isfile(os.path.join(path, STATE)) or any(
+        os.path.isfile(os.path.join(d, STATE)) for d in _launch_dirs(path))
 
 
 def remove(path):
     """Delete a finished run's checkpoint: the files a run writes in ``path`` (state, records,
-    lock, temporary files), then the directory itself when nothing else is left in it."""
+    lock, temporary files; its launch checkpoints likewise), then the directory itself when
+    nothing else is left in it."""
     path = _fspath(path)
-    _clean(path, [n for n in os.listdir(path) if _is_checkpoint_file(n)])
+    for sub in _launch_dirs(path):
+        remove(sub)
+    _clean(path, [n for n in os.listdir(path) if _is_checkpoint_file(n)
+                  and not _LAUNCH_DIR.match(n)])
     with contextlib.suppress(OSError):
         os.rmdir(path)
 
@@ -313,8 +335,9 @@ def claim(path, resume=False, overwrite=False):
     path = _fspath(path)
     check_target(path, resume, overwrite)
     if resume and holds_checkpoint(path) and not _writable(path):
-        _check_finished(path)         # a read-only checkpoint of a finished run: read it
-        yield path
+        if os.path.isfile(os.path.join(path, STATE)):
+            _check_finished(path)     # a read-only checkpoint of a finished run: read it
+        yield path                    # (launch checkpoints: each launch checks its own)
         return
     try:
         os.makedirs(path, exist_ok=True)
@@ -343,6 +366,8 @@ def claim(path, resume=False, overwrite=False):
         _clean(path, [n for n in names if ".tmp-" in n])
         if not holds_checkpoint(path) or not resume:      # a fresh start: no stale records
             _clean(path, [STATE] + [n for n in names if _RECORDS_FILE.match(n)])
+            for sub in _launch_dirs(path):                 # nor stale launches
+                remove(sub)
         yield path
     finally:
         with contextlib.suppress(OSError):
@@ -424,10 +449,15 @@ def load(path, settings, fingerprint):
     if differ:
         raise CheckpointError(f"checkpoint {path!r} belongs to a run with other settings: "
                               + "; ".join(differ))
-    if header.get("fingerprint") != fingerprint:
-        raise CheckpointError(f"checkpoint {path!r} belongs to a run with other inputs (systems, "
-                              "initial conditions or integration time differ); delete it or use "
-                              "another checkpoint path")
+    saved = header.get("fingerprint")
+    if saved != fingerprint:
+        parts = sorted(fingerprint) if not isinstance(saved, dict) else \
+            [k for k in fingerprint if saved.get(k) != fingerprint[k]]
+        what = {"perturbations": "perturbations (tides, YORP, BYORP or their parameters)"}
+        raise CheckpointError(f"checkpoint {path!r} belongs to a run with other inputs ("
+                              + ", ".join(what.get(k, k) for k in parts) + " differ); resume "
+                              "with the run's own inputs, or delete it or use another "
+                              "checkpoint path")
     missing = [k for k in _ARRAYS + ("records_sha256",) if k not in arrays]
     if missing:
         raise _damaged(path, f"{STATE} lacks {', '.join(missing)}")
@@ -487,24 +517,47 @@ def load(path, settings, fingerprint):
 
 
 class Launches:
-    """Checkpoints of a computation made of several ensemble launches (overlap_threshold's
-    doubling, relaxed_libration's search): launch k checkpoints into ``DIR/launch-kkk``. The
-    launches of a computation are the same on every run of it, so resuming resumes each in
-    turn: a finished launch's checkpoint gives its result back without integrating, the
-    interrupted one continues, later ones start afresh. ``next()`` gives the keywords of the
-    next launch ({} without a directory)."""
+    """Checkpoints of a computation made of several ensemble launches: a chaos or parameter
+    map's lengths (the fraction-against-orbits evidence, then the map itself),
+    overlap_threshold's doubling, relaxed_libration's search and its convergence checks.
+    Launch k checkpoints into ``DIR/launch-kkk`` (an ordinary run checkpoint). The launches
+    of a computation are the same on every run of it (each follows from the inputs and the
+    launches before it), so resuming resumes each in turn: a finished launch's checkpoint
+    gives its result back without integrating, the interrupted one continues, later ones
+    start afresh. A resume therefore never recomputes a finished stage, and ends bit for bit
+    as an uninterrupted run.
+
+    The rules of a run checkpoint hold for ``DIR`` as a whole: it is checked when the object
+    is made (:func:`check_target`: no overwrite without ``overwrite``, no file, no foreign
+    directory), and :meth:`owned` holds ``DIR``'s lock for the whole computation, so that a
+    second computation on it is refused at once (:class:`CheckpointLocked`), and a fresh
+    start (no ``resume``) removes every earlier launch first. ``next()`` gives the keywords of
+    the next launch ({} without a directory)."""
 
     def __init__(self, directory, resume=False, overwrite=False):
         self.directory = None if directory is None else _fspath(directory)
         self.resume, self.overwrite, self.count = bool(resume), bool(overwrite), 0
-        if self.directory is not None and os.path.exists(self.directory) \
-                and not os.path.isdir(self.directory):
-            raise CheckpointError(f"checkpoint {self.directory!r} is a file, not a directory "
-                                  "of launch checkpoints; choose another path or delete it")
+        if self.directory is not None:
+            if os.path.exists(self.directory) and not os.path.isdir(self.directory):
+                raise CheckpointError(f"checkpoint {self.directory!r} is a file, not a "
+                                      "directory of launch checkpoints; choose another path "
+                                      "or delete it")
+            check_target(self.directory, self.resume, self.overwrite)
+
+    @contextlib.contextmanager
+    def owned(self):
+        """Hold ``DIR`` (its lock, :func:`claim`) while the launches run; nothing without a
+        directory."""
+        if self.directory is None:
+            yield self
+            return
+        with claim(self.directory, self.resume, self.overwrite):
+            yield self
 
     def next(self):
         if self.directory is None:
             return {}
         path = os.path.join(self.directory, f"launch-{self.count:03d}")
         self.count += 1
-        return {"checkpoint": path, "resume": self.resume, "overwrite_checkpoint": self.overwrite}
+        # DIR's own claim applied the overwrite rule to every launch at once
+        return {"checkpoint": path, "resume": self.resume, "overwrite_checkpoint": False}

@@ -114,13 +114,23 @@ class RunState:
 
 
 def check_tolerances(rtol, atol):
-    """Validate rtol/atol; returns floats (atol defaults to rtol)."""
+    """Validate rtol/atol; returns floats (atol defaults to rtol).
+
+    rtol in [1e-16, 1e-2]. atol is an absolute tolerance in the kernels' scaled units
+    (docs/physics.md §4.3, §5.2: lengths in a, velocities in a n, spins in n, attitudes
+    unitless), in which every state component is O(1): so atol in (0, 1e-2], the same ceiling
+    as rtol (a larger one lets the error be a sizeable fraction of the state), with no floor
+    above 0 (1e-15 and below are fine). 0 itself is refused: the planar run's out-of-plane
+    components are exactly 0, where a pure relative test divides by zero."""
     require_real("rtol", rtol)
     if atol is not None:
         require_real("atol", atol)
     require_range("rtol", rtol, 1e-16, 1e-2, low_open=False, high_open=False)
     atol = rtol if atol is None else atol
-    require_positive("atol", atol)
+    atol_max = 1e-2
+    if not 0.0 < float(atol) <= atol_max:          # NaN fails too
+        raise ValueError(f"atol must lie in (0, {atol_max:g}] (absolute tolerance on the "
+                         f"scaled state, whose components are O(1); got {float(atol):.12g})")
     return float(rtol), float(atol)
 
 
@@ -456,13 +466,17 @@ class Ensemble:
                         diag_start=self.diagnostics(), launches=0, seconds=0.0)
 
     def _fingerprint(self, t_stop):
-        """Digest of what determines a run's results (inputs at the start of the run)."""
+        """SHA-256 digests of what determines a run's results (inputs at the start of the
+        run), one per part, so that a refused resume can name the part that changed
+        (``checkpoint.load``)."""
         import hashlib
 
-        h = hashlib.sha256()
-        for a in (self.par, self._y_start, t_stop) + (() if self.prows is None else (self.prows,)):
-            h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
-        return h.hexdigest()
+        def digest(a):
+            return None if a is None else hashlib.sha256(
+                np.ascontiguousarray(a, dtype=np.float64).tobytes()).hexdigest()
+
+        return {"systems": digest(self.par), "initial states": digest(self._y_start),
+                "integration times": digest(t_stop), "perturbations": digest(self.prows)}
 
     def _spatial_records(self, chunks_per_member):
         """Every member's record chunks as (count, 31) 3-D rows (time, state), and apart the

@@ -46,7 +46,7 @@ import numpy as np
 from . import accuracy, analytic, compiling, resources
 from . import progress as _progress
 from .classify import horizontal_extent
-from ._validate import (require_count, require_positive,
+from ._validate import (require_bool, require_count, require_positive,
                         require_real, require_scalar, require_spin)
 from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
@@ -422,6 +422,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
         resources.check_memory(what, members, orbits, spo,
                                advice="use fewer orbits, candidates or samples per orbit")
 
+    converge = require_bool("converge", converge)
     if centre_tol is None:
         centre_tol = max(10.0 * float(xtol), 1e-5)
     require_positive("centre_tol", require_real("centre_tol", centre_tol))
@@ -439,7 +440,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
                   samples_per_orbit=samples_per_orbit, coarse_arm_points=coarse_arm_points,
                   max_extent=max_extent, max_drift=max_drift, section_kwargs=section_kwargs,
                   checkpoints=Launches(checkpoint, resume, overwrite_checkpoint))
-    with _progress.reporting(progress, "relaxed_libration") as report:
+    with search["checkpoints"].owned(), \
+            _progress.reporting(progress, "relaxed_libration") as report:
         # progress: each search its share of the work, ∝ its length (rtol/10: ~1.6x the steps)
         planned = [float(orbits)]
         while converge and planned[-1] * 2.0 <= cap * (1 + 1e-12):

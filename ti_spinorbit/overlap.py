@@ -343,7 +343,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     member_orbits = 0.0
     converged_at = None
     work = float(sum(lengths))          # progress: each length its share (all elongations)
-    with _progress.reporting(progress, "overlap_threshold") as report:
+    with launches.owned(), _progress.reporting(progress, "overlap_threshold") as report:
         for step, length in enumerate(lengths):
             # a connection seen at a shorter length is a fact (a trajectory crossed both levels):
             # only elongations still "separate" are integrated again, longer

@@ -20,7 +20,7 @@ import numpy as np
 from . import accuracy
 from . import coordinates as _coords
 from . import progress as _progress
-from ._validate import (_as_floats, require_count, require_finite,
+from ._validate import (_as_floats, require_bool, require_count, require_finite,
                         require_order, require_real, require_spin, show)
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
 from .systems import ESCAPE_DISTANCE, BinarySystem
@@ -679,8 +679,7 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
-    if not isinstance(states, (bool, np.bool_)):
-        raise TypeError(f"states must be True or False (got {show(states)})")
+    states = require_bool("states", states)
     perturbations = check_perturbations(perturbations)
     members, par, y0, tp, td = _members("time_series", system, theta_p, thetadot_p, orbits,
                                         escape_distance, coordinates, order, initial_states,

@@ -1,0 +1,262 @@
+"""Every stage of a multi-stage entry point is checkpointed (issue 22, §3): a chaos or
+parameter map's evidence lengths (orbits/4, orbits/2) and the map itself, overlap_threshold's
+doublings and relaxed_libration's search and convergence runs each checkpoint into
+``DIR/launch-kkk``. A run interrupted at any window of any stage resumes to a result equal
+bit for bit to an uninterrupted one, and a resume never integrates a finished stage again
+(no window of it is saved again).
+
+An interruption is a KeyboardInterrupt raised from the progress callback, which runs after
+every window's checkpoint is written (the state a kill -9 right after that write leaves);
+one test kills a CLI map with SIGKILL in its evidence phase. Tiny runs: 1991 VH, 2 × 3
+starts, 8 orbits, rtol 1e-8."""
+
+import dataclasses
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import ti_spinorbit as tso
+from ti_spinorbit import checkpoint as C
+
+from conftest import run_cli
+
+THETA, RATES = [0.0, 90.0], [0.8, 1.2, 1.6]
+MAP = dict(orbits=8, rtol=1e-8)
+
+
+class Interrupt:
+    """A progress callback that raises KeyboardInterrupt at its ``at``-th call."""
+
+    def __init__(self, at):
+        self.at, self.calls = at, 0
+
+    def __call__(self, fraction):
+        self.calls += 1
+        if self.calls == self.at:
+            raise KeyboardInterrupt
+
+
+@pytest.fixture
+def saves(monkeypatch):
+    """The launch directory of every window checkpoint written (checkpoint.save calls)."""
+    written = []
+    real = C.save
+
+    def spy(path, *args, **kwargs):
+        written.append(os.path.basename(os.fspath(path)))
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(C, "save", spy)
+    return written
+
+
+def arrays(result):
+    """Every array field of a result (nested results' arrays too), by name."""
+    out = {}
+    for f in dataclasses.fields(result):
+        x = getattr(result, f.name)
+        if isinstance(x, np.ndarray):
+            out[f.name] = x
+        elif dataclasses.is_dataclass(x):
+            out.update({f"{f.name}.{k}": v for k, v in arrays(x).items()})
+    return out
+
+
+def assert_same(a, b):
+    a, b = arrays(a), arrays(b)
+    assert a.keys() == b.keys()
+    for name in a:
+        np.testing.assert_array_equal(a[name], b[name], err_msg=name)
+
+
+def chaos(vh, **kw):
+    return tso.chaos_map(vh, THETA, RATES, **MAP, **kw)
+
+
+@pytest.fixture(scope="module")
+def whole(vh):
+    return chaos(vh, progress=False)
+
+
+@pytest.fixture(scope="module")
+def windows(vh, tmp_path_factory):
+    """Windows per stage of the map (counted from a checkpointed run's records files)."""
+    path = tmp_path_factory.mktemp("count") / "ck"
+    chaos(vh, checkpoint=path, progress=False)
+    return [len(list((path / f"launch-{k:03d}").glob("records-*.npz"))) for k in range(3)]
+
+
+def test_map_stages_each_have_their_checkpoint(vh, whole, windows, tmp_path):
+    again = chaos(vh, checkpoint=tmp_path / "ck", progress=False)
+    assert sorted(p.name for p in (tmp_path / "ck").iterdir() if p.is_dir()) == \
+        ["launch-000", "launch-001", "launch-002"]
+    assert all(w >= 1 for w in windows), windows
+    assert_same(again, whole)      # checkpointing changes nothing
+
+
+@pytest.mark.parametrize("where", ["first evidence length", "second evidence length",
+                                   "the map itself"])
+def test_map_interrupted_in_any_stage_resumes_bit_identical(vh, whole, windows, tmp_path,
+                                                            saves, where):
+    stage = ["first evidence length", "second evidence length", "the map itself"].index(where)
+    at = sum(windows[:stage]) + 1          # the first window of that stage
+    ckpt = tmp_path / "ck"
+    with pytest.raises(KeyboardInterrupt):
+        chaos(vh, checkpoint=ckpt, progress=Interrupt(at))
+    assert saves[-1] == f"launch-{stage:03d}"
+    done = {f"launch-{k:03d}": (ckpt / f"launch-{k:03d}" / C.STATE).read_bytes()
+            for k in range(stage)}
+    saves.clear()
+    resumed = chaos(vh, checkpoint=ckpt, resume=True, progress=False)
+    assert_same(resumed, whole)
+    # no finished stage was integrated again: none of its windows was saved, its state is
+    # byte for byte the one written before the interruption
+    assert not set(saves) & set(done), saves
+    for name, state in done.items():
+        assert (ckpt / name / C.STATE).read_bytes() == state
+    assert saves.count(f"launch-{stage:03d}") == windows[stage] - 1
+
+
+def test_map_interrupted_at_every_window_then_resumed_each_time(vh, whole, windows, tmp_path):
+    """Interrupted again at the first window of every resume: the run still ends as the
+    uninterrupted one (each resume makes one window of progress)."""
+    ckpt = tmp_path / "ck"
+    with pytest.raises(KeyboardInterrupt):
+        chaos(vh, checkpoint=ckpt, progress=Interrupt(1))
+    for _ in range(sum(windows) - 1):
+        try:
+            result = chaos(vh, checkpoint=ckpt, resume=True, progress=Interrupt(1))
+        except KeyboardInterrupt:
+            continue
+        break
+    else:
+        result = chaos(vh, checkpoint=ckpt, resume=True, progress=False)
+    assert_same(result, whole)
+
+
+def test_parameter_map_interrupted_in_its_evidence_resumes_bit_identical(tmp_path, saves):
+    kw = dict(elongations=[1.2], eccentricities=[0.05], orbits=6, thetadot_p=[0.9, 1.5],
+              theta_p=[0.0], rtol=1e-8)
+    whole = tso.parameter_map("1991 VH", progress=False, **kw)
+    ckpt = tmp_path / "ck"
+    with pytest.raises(KeyboardInterrupt):
+        tso.parameter_map("1991 VH", checkpoint=ckpt, progress=Interrupt(2), **kw)
+    assert saves[-1] in ("launch-000", "launch-001")
+    resumed = tso.parameter_map("1991 VH", checkpoint=ckpt, resume=True, progress=False, **kw)
+    assert_same(resumed, whole)
+
+
+def test_overlap_doubling_interrupted_in_a_longer_length_resumes(tmp_path, saves):
+    kw = dict(elongations=[1.05, 1.3], orbits=4, max_orbits=8, rtol=1e-8, centre_starts=3,
+              separatrix_starts=3)
+    whole = tso.overlap_threshold("1991 VH", progress=False, **kw)
+    ckpt = tmp_path / "ck"
+    full = []
+    tso.overlap_threshold("1991 VH", checkpoint=tmp_path / "count", progress=False, **kw)
+    full = sorted(p.name for p in (tmp_path / "count").iterdir() if p.is_dir())
+    assert len(full) >= 2, full          # the doubling ran a second length
+    first = len(list((tmp_path / "count" / "launch-000").glob("records-*.npz")))
+    with pytest.raises(KeyboardInterrupt):
+        tso.overlap_threshold("1991 VH", checkpoint=ckpt, progress=Interrupt(first + 1), **kw)
+    assert saves[-1] == "launch-001"
+    saves.clear()
+    resumed = tso.overlap_threshold("1991 VH", checkpoint=ckpt, resume=True, progress=False,
+                                    **kw)
+    assert "launch-000" not in saves
+    assert_same(resumed, whole)
+    np.testing.assert_array_equal(resumed.overlaps_by_length, whole.overlaps_by_length)
+
+
+def test_a_second_run_on_a_staged_checkpoint_is_refused_at_once(vh, tmp_path):
+    ckpt = tmp_path / "ck"
+    with pytest.raises(KeyboardInterrupt):
+        chaos(vh, checkpoint=ckpt, progress=Interrupt(1))
+    # not resuming: refused before any work, nothing touched
+    before = {p: p.read_bytes() for p in ckpt.rglob("*") if p.is_file()}
+    with pytest.raises(C.CheckpointExists, match="already holds a checkpoint"):
+        chaos(vh, checkpoint=ckpt, progress=False)
+    assert {p: p.read_bytes() for p in ckpt.rglob("*") if p.is_file()} == before
+    # while a computation holds the directory, a second one is refused at once
+    with C.Launches(ckpt, resume=True).owned():
+        t = time.perf_counter()
+        with pytest.raises(C.CheckpointLocked, match="locked by another run"):
+            chaos(vh, checkpoint=ckpt, resume=True, progress=False)
+        assert time.perf_counter() - t < 5.0
+
+
+def test_overwrite_replaces_every_stage_and_remove_deletes_them(vh, whole, tmp_path):
+    ckpt = tmp_path / "ck"
+    with pytest.raises(KeyboardInterrupt):
+        chaos(vh, checkpoint=ckpt, progress=Interrupt(1))
+    (ckpt / "launch-007").mkdir()      # a stale launch of some longer computation
+    assert C.holds_checkpoint(ckpt)
+    fresh = chaos(vh, checkpoint=ckpt, overwrite_checkpoint=True, progress=False)
+    assert_same(fresh, whole)
+    assert not (ckpt / "launch-007").exists()
+    C.remove(ckpt)
+    assert not ckpt.exists()
+
+
+def test_resume_refused_after_a_perturbation_changed_names_it(vh, tmp_path):
+    tide = tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6)
+    ckpt = tmp_path / "ck"
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=ckpt,
+                           perturbations=[tide], progress=False)
+    stronger = dataclasses.replace(tide, strength=2e6)
+    with pytest.raises(C.CheckpointError, match=r"other inputs \(perturbations \(tides, YORP, "
+                                                r"BYORP or their parameters\) differ\)"):
+        tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=ckpt,
+                               resume=True, perturbations=[stronger], progress=False)
+    with pytest.raises(C.CheckpointError, match=r"other inputs \(initial states differ\)"):
+        tso.surface_of_section(vh, 0.0, [1.1], orbits=2, rtol=1e-8, checkpoint=ckpt,
+                               resume=True, perturbations=[tide], progress=False)
+
+
+def test_map_inputs_that_are_refused_before_any_work(vh, tmp_path):
+    with pytest.raises(ValueError, match="fraction_orbits must hold distinct lengths"):
+        chaos(vh, fraction_orbits=[5, 5])
+    with pytest.raises(TypeError, match="chaos_map takes a grid of starts"):
+        chaos(vh, initial_states=[vh.tilted_start(0.0, 1.0, roll=1.0, pitch=0.0)])
+    with pytest.raises(TypeError, match="checkpoint must be a directory path"):
+        chaos(vh, checkpoint=123)
+    with pytest.raises(TypeError, match=r"converge must be True or False \(got 'yes'\)"):
+        tso.relaxed_libration(vh, converge="yes")
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(C.CheckpointError, match="is a file"):
+        chaos(vh, checkpoint=tmp_path / "file")
+
+
+CLI_MAP = ["map", "--system", "1991 VH", "--grid", "3", "3", "--orbits", "40", "--rtol",
+           "1e-9", "--out", "m.png", "--quiet"]
+
+
+def test_cli_map_killed_in_its_evidence_resumes_to_the_same_data(tmp_path):
+    """kill -9 while the map integrates its first evidence length; the same command with
+    --resume keeps that stage's windows and ends with the uninterrupted run's numbers."""
+    ref = tmp_path / "ref"
+    ref.mkdir()
+    assert run_cli(*CLI_MAP, cwd=ref).returncode == 0
+    run = tmp_path / "run"
+    run.mkdir()
+    cmd = [sys.executable, "-m", "ti_spinorbit", *CLI_MAP, "--checkpoint", "ck"]
+    p = subprocess.Popen(cmd, cwd=run, env=dict(os.environ, MPLBACKEND="Agg"),
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    first = run / "ck" / "launch-000"
+    deadline = time.time() + 240
+    while time.time() < deadline and len(list(first.glob("records-*.npz"))) < 2:
+        time.sleep(0.02)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    kept = len(list(first.glob("records-*.npz")))
+    assert kept >= 2 and not (run / "ck" / "launch-002").exists()
+    done = run_cli(*CLI_MAP, "--checkpoint", "ck", "--resume", cwd=run)
+    assert done.returncode == 0, done.stderr
+    a, b = tso.load(ref / "m.npz"), tso.load(run / "m.npz")
+    for name in ("megno", "lyapunov", "fraction_by_length", "status"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert not (run / "ck").exists()         # removed once the outputs are written
