@@ -42,6 +42,27 @@ def test_bad_inputs():
         overlap_threshold("1991 VH", elongations=[0.9])
 
 
+def test_eccentricity_with_a_factory_is_refused_not_ignored():
+    """A factory sets its systems' e: eccentricity= beside it was silently ignored."""
+    from ti_spinorbit import catalog
+
+    factory = lambda q: catalog.system("1991 VH", elongation=q)  # noqa: E731
+    with pytest.raises(TypeError, match=r"eccentricity=0\.3 applies to a catalogue name"):
+        overlap_threshold(factory, elongations=[1.1], eccentricity=0.3, orbits=2)
+    mixed = lambda q: catalog.system("1991 VH", elongation=q, eccentricity=q - 1.0)  # noqa: E731
+    with pytest.raises(ValueError, match="the same eccentricity"):
+        overlap_threshold(mixed, elongations=[1.1, 1.2], orbits=2)
+    with pytest.raises(TypeError, match="must return a BinarySystem"):
+        overlap_threshold(lambda q: "1991 VH", elongations=[1.1], orbits=2)
+
+
+def test_eccentricity_reaches_a_named_scan():
+    scan = overlap_threshold("1991 VH", elongations=[1.1], eccentricity=0.2, orbits=2,
+                             max_orbits=2, centre_starts=2, separatrix_starts=2)
+    assert scan.eccentricity == 0.2
+    assert scan.omega0_ro == pytest.approx(analytic.omega0_overlap(0.2), rel=1e-15)
+
+
 def test_overlap_vs_eccentricity_reports_per_e():
     from ti_spinorbit.overlap import overlap_vs_eccentricity
     ecc, first, analytic_ab, scans = overlap_vs_eccentricity(

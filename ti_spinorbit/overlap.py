@@ -199,6 +199,10 @@ SystemFactory = Callable[[float], BinarySystem]
 
 def _factory(system, eccentricity):
     if callable(system):
+        if eccentricity is not None:       # it would be ignored: the factory sets e itself
+            raise TypeError(f"eccentricity={show(eccentricity)} applies to a catalogue name; "
+                            "a factory builds its systems with their own eccentricity: set it "
+                            "in the factory")
         return system, "custom"
     name = system
     catalog.entry(name)  # raises for unknown names, listing the known ones
@@ -224,7 +228,8 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     elongations : array, optional
         a/b values (default 1.01 ... 1.15 in steps of 0.01).
     eccentricity : float, optional
-        Override the catalogue eccentricity (names only).
+        Override the catalogue eccentricity, in [0, 1) (names only: with a factory it is
+        refused, the factory sets e, the same for every elongation).
     orbits : float
         Orbits of the first (shortest) integration; longer ones find slower connections.
     max_orbits : float, optional
@@ -326,7 +331,15 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
         resources.check_memory("overlap_threshold", q.size * per_elongation, orbits,
                                advice="scan fewer elongations or starts, or fewer orbits")
     systems = [make(float(x)) for x in q]
+    if not all(isinstance(s, BinarySystem) for s in systems):
+        bad = next(s for s in systems if not isinstance(s, BinarySystem))
+        raise TypeError(f"system (a factory) must return a BinarySystem (got "
+                        f"{type(bad).__name__})")
     e = systems[0].e
+    if any(s.e != e for s in systems):   # one analytic threshold ω0^RO(e) for the whole scan
+        raise ValueError("system (a factory) must give every elongation the same eccentricity "
+                         f"(got {sorted({float(s.e) for s in systems})}); scan each e apart "
+                         "(overlap_vs_eccentricity)")
     # θ_p = 0 column for the centres; θ_p = 90° column for the connection
     centre_rates = np.linspace(0.6, 2.0, int(centre_starts))
     sep_rates = np.linspace(0.8, 1.8, int(separatrix_starts))
