@@ -63,12 +63,12 @@ def test_synthetic_traces_are_labelled_and_stable_under_subsampling(rng, subsamp
     thetadot = np.array([t[2] for t in traces])[:, subsample]
     cls = classify_points(np.mod(theta, 180.0), thetadot)
     for i, (name, _, _, label, p) in enumerate(traces):
-        assert cls.label[i] == label, (name, cls.order_ratio[i], cls.largest_gap_deg[i])
+        assert cls.classification[i] == label, (name, cls.order_ratio[i], cls.largest_gap_deg[i])
         if p is None:
             assert np.isnan(cls.resonance_p[i]), name
         else:
             assert cls.resonance_p[i] == p, name
-    regular = cls.label != "chaotic"
+    regular = cls.classification != "chaotic"
     assert np.all(cls.order_ratio[regular] < 0.5 * ORDER_RATIO_CHAOTIC)
     assert np.all(cls.order_ratio[~regular] > 2.0 * ORDER_RATIO_CHAOTIC)
     # the island about 0 wraps through 180°: centre 0, half extent the ellipse's 25°
@@ -77,7 +77,7 @@ def test_synthetic_traces_are_labelled_and_stable_under_subsampling(rng, subsamp
     assert cls.libration_centre_thetadot[1] == pytest.approx(1.5, abs=0.01)
     assert abs(cls.libration_centre_deg[2]) == pytest.approx(90.0, abs=0.5)
     assert cls.libration_half_extent_deg[2] == pytest.approx(20.0, abs=0.5)
-    assert np.all(np.isnan(cls.libration_centre_deg[cls.label != "resonant"]))
+    assert np.all(np.isnan(cls.libration_centre_deg[cls.classification != "resonant"]))
 
 
 def test_chain_round_the_circle_librates_but_gets_no_p():
@@ -89,7 +89,7 @@ def test_chain_round_the_circle_librates_but_gets_no_p():
     thetadot = 1.75 + np.where(k % 2 == 0, 0.05, -0.05) + 0.02 * np.sin(psi)
     for sub in (slice(None), slice(0, N // 2)):
         cls = classify_points(theta[sub], thetadot[sub])
-        assert cls.label[0] == "resonant" and np.isnan(cls.resonance_p[0])
+        assert cls.classification[0] == "resonant" and np.isnan(cls.resonance_p[0])
         assert cls.largest_gap_deg[0] == pytest.approx(60.0, abs=0.5)
 
 
@@ -97,7 +97,7 @@ def test_megno_overrides_only_beyond_its_thresholds(rng):
     traces = synthetic_traces(rng)
     theta = np.mod(np.array([t[1] for t in traces]), 180.0)
     thetadot = np.array([t[2] for t in traces])
-    geometric = classify_points(theta, thetadot).label
+    geometric = classify_points(theta, thetadot).classification
     names = [t[0] for t in traces]
     curve, island, fill = (names.index(s) for s in ("smooth curve", "island at 0", "random fill"))
     megno = np.full(len(traces), np.nan)
@@ -105,12 +105,12 @@ def test_megno_overrides_only_beyond_its_thresholds(rng):
     megno[fill] = 2.0       # regular: it circulates, so quasi-periodic
     megno[island] = 3.0     # grey zone: the points decide
     cls = classify_points(theta, thetadot, megno=megno)
-    assert cls.label[curve] == "chaotic"
-    assert cls.label[fill] == "quasi-periodic"
-    assert cls.label[island] == "resonant" and cls.resonance_p[island] == 1.5
+    assert cls.classification[curve] == "chaotic"
+    assert cls.classification[fill] == "quasi-periodic"
+    assert cls.classification[island] == "resonant" and cls.resonance_p[island] == 1.5
     others = np.isnan(megno)
-    assert list(cls.label[others]) == list(geometric[others])
-    assert list(cls.label_geometric) == list(geometric)
+    assert list(cls.classification[others]) == list(geometric[others])
+    assert list(cls.classification_geometric) == list(geometric)
     np.testing.assert_array_equal(cls.megno, megno)
 
 
@@ -121,10 +121,10 @@ def test_too_few_points_or_failed_members_are_undetermined(rng):
     theta[0, 40:] = np.nan                               # 40 points: too few
     thetadot[0, 40:] = np.nan
     cls = classify_points(theta, thetadot)
-    assert list(cls.label) == ["undetermined", "resonant"]
+    assert list(cls.classification) == ["undetermined", "resonant"]
     assert cls.count[0] == 40 and np.isfinite(cls.mean_thetadot[0])
     cls = classify_points(theta, thetadot, failed=[False, True])
-    assert list(cls.label) == ["undetermined", "undetermined"]
+    assert list(cls.classification) == ["undetermined", "undetermined"]
     assert isinstance(cls, SectionClassification)
     assert cls.counts()["undetermined"] == 2
 
@@ -173,7 +173,7 @@ def decoupled_center(omega0, e, p, theta0):
     return brentq(miss, grid[i], grid[i + 1], xtol=1e-12)
 
 
-def test_island_centers_match_an_independent_solver():
+def test_island_centres_match_an_independent_solver():
     """The 1:1 island of 1991 VH (a/b = 1.5, ω0,eff ≈ 1.03) is pushed far below 1 by the
     near-resonant forced libration; the 2:1 island sits above 2."""
     vh = tso.catalog.system("1991 VH")
@@ -211,7 +211,7 @@ def test_paper_starts_of_1991VH(vh_section):
     r = vh_section
     assert np.all(r.count >= 390)
     cls = classify_section(r)
-    assert list(cls.label) == ["resonant", "resonant", "chaotic", "resonant", "quasi-periodic",
+    assert list(cls.classification) == ["resonant", "resonant", "chaotic", "resonant", "quasi-periodic",
                                "resonant"]
     np.testing.assert_array_equal(cls.resonance_p, [1.0, 1.0, np.nan, 2.0, np.nan, 0.5])
     assert cls.order_ratio[2] > 2 * ORDER_RATIO_CHAOTIC
@@ -225,7 +225,7 @@ def test_paper_starts_of_1991VH(vh_section):
     centers = island_centres(r.systems[0])
     assert abs(cls.libration_centre_thetadot[3] - centers[2.0]) < 0.05
     assert abs(cls.libration_centre_thetadot[5] - centers[0.5]) < 0.02
-    assert cls.colors[:5] == [COLORS[k] for k in cls.label[:5]]
+    assert cls.colors[:5] == [COLORS[k] for k in cls.classification[:5]]
 
 
 def test_paper_starts_are_stable_under_subsampling(vh_section):
@@ -233,5 +233,5 @@ def test_paper_starts_are_stable_under_subsampling(vh_section):
     full = classify_section(r)
     for sub in (slice(0, 200), slice(None, None, 2)):
         half = classify_points(r.theta_p[:, sub], r.thetadot_p[:, sub], systems=r.systems)
-        assert list(half.label) == list(full.label)
+        assert list(half.classification) == list(full.classification)
         np.testing.assert_array_equal(half.resonance_p, full.resonance_p)

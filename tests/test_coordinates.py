@@ -319,7 +319,7 @@ INERTIAL_CHANGES = {(1.01, 1.15): "resonant 1", (1.01, 1.28): "resonant",
 def _classes(result):
     cls = classify_section(result)
     return [lab + (f" {p:g}" if lab == "resonant" and np.isfinite(p) else "")
-            for lab, p in zip(cls.label, cls.resonance_p)]
+            for lab, p in zip(cls.classification, cls.resonance_p)]
 
 
 @pytest.mark.parametrize("elongation", [1.01, 1.06])

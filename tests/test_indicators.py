@@ -61,5 +61,5 @@ def test_classification_uses_the_indicator():
     vh = tso.catalog.system("1991 VH")
     r = tso.surface_of_section(vh, 0.0, VH_STARTS, orbits=200, rtol=1e-10, indicators=True)
     cls = tso.classify_section(r)
-    assert list(cls.label) == ["resonant", "chaotic", "quasi-periodic"]
+    assert list(cls.classification) == ["resonant", "chaotic", "quasi-periodic"]
     np.testing.assert_array_equal(cls.megno, r.megno)

@@ -160,14 +160,13 @@ def test_catalogue_name_equals_the_system(vh):
     np.testing.assert_array_equal(ts.thetadot[0], ts.thetadot[1])
 
 
-def test_old_keyword_names_still_work_with_a_warning(vh):
-    with pytest.warns(DeprecationWarning, match=r"surface_of_section\(\): system_or_systems= is now system="):
-        old = tso.surface_of_section(system_or_systems=vh, theta_p=0.0, thetadot_p=1.0, orbits=1)
-    new = tso.surface_of_section(vh, 0.0, 1.0, 1)
-    np.testing.assert_array_equal(old.thetadot_p, new.thetadot_p)
-    with pytest.raises(TypeError, match="got both 'system' and its old name 'system_or_systems'"):
-        tso.surface_of_section(system=vh, system_or_systems=vh, theta_p=0.0, thetadot_p=1.0,
-                               orbits=1)
+def test_old_keyword_names_are_gone(vh):
+    """0.1.0 is unreleased: the renamed keywords have no shims (an old name is an unknown
+    keyword, refused in one line)."""
+    with pytest.raises(TypeError, match="system_or_systems"):
+        tso.surface_of_section(system_or_systems=vh, theta_p=0.0, thetadot_p=1.0, orbits=1)
+    with pytest.raises(TypeError, match="center_tol"):
+        tso.relaxed_libration(vh, center_tol=1e-3)
 
 
 def test_multi_launch_checkpoints_resume_to_the_same_result(vh, tmp_path):
@@ -186,20 +185,13 @@ def test_multi_launch_checkpoints_resume_to_the_same_result(vh, tmp_path):
 
 
 # ---- one vocabulary ------------------------------------------------------------------------------
-def test_old_attribute_names_are_read_only_aliases(chaos_map, parameter_map, overlap_scan,
-                                                    relaxed_libration, section):
-    from ti_spinorbit.classify import classify_section
-
-    np.testing.assert_array_equal(chaos_map.mean_spin, chaos_map.mean_thetadot)
-    np.testing.assert_array_equal(parameter_map.labels, parameter_map.classification)
-    d = overlap_scan.decisions[0]
-    assert (d.center_1, d.center_3_2, d.center_3_2_found) == (d.centre_1, d.centre_3_2,
-                                                              d.centre_3_2_found)
-    assert relaxed_libration.center_thetadot_p == relaxed_libration.centre_thetadot_p
-    cls = classify_section(section)
-    np.testing.assert_array_equal(cls.label, cls.classification)
-    with pytest.raises(AttributeError):
-        chaos_map.mean_spin = chaos_map.mean_thetadot
+def test_old_attribute_names_are_gone(chaos_map, parameter_map, overlap_scan,
+                                      relaxed_libration):
+    """No alias properties: one name per field (format-1 files are renamed on load)."""
+    for result, old in ((chaos_map, "mean_spin"), (parameter_map, "labels"),
+                        (overlap_scan.decisions[0], "center_1"),
+                        (relaxed_libration, "center_thetadot_p")):
+        assert not hasattr(result, old), old
 
 
 def test_format_1_archives_with_old_names_load(chaos_map, tmp_path):

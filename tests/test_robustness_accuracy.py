@@ -151,8 +151,8 @@ def test_a_nan_in_any_sample_makes_the_member_non_finite():
 
 
 def test_classification_leaves_inaccurate_members_undetermined(loose):
-    assert list(tso.classify_section(loose).label) == ["undetermined"] * 2
-    labels = tso.classify_section(loose, include_inaccurate=True, min_points=8).label
+    assert list(tso.classify_section(loose).classification) == ["undetermined"] * 2
+    labels = tso.classify_section(loose, include_inaccurate=True, min_points=8).classification
     assert "undetermined" not in list(labels)
 
 

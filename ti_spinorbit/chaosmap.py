@@ -36,8 +36,8 @@ from .systems import BinarySystem
 from . import display as _display
 from .attitude import CLASS_UNIT as ATTITUDE_CLASS
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
-from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, alias,
-                      renamed_keywords, unit)
+from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result,
+                      unit)
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 #: Default starts per (a/b, e) of a parameter map: θ_p ∈ {0°, 90°} × θ̇_p/n in the 1:1-3:2 band.
@@ -162,7 +162,6 @@ class ChaosMap(Result, _display.Readable):
     # tides / YORP / BYORP in the equations of every member (docs/physics.md §13)
     perturbations: tuple = unit(PERTURBATIONS, default=())
 
-    mean_spin = alias("mean_thetadot")      # old name (read-only)
 
     @property
     def attitude_class_names(self):
@@ -468,7 +467,6 @@ class ParameterMap(Result, _display.Readable):
     def member_orbits_per_second(self) -> float:
         return float(self.orbits * self.megno.size / self.seconds) if self.seconds else float("nan")
 
-    labels = alias("classification")        # old name (read-only)
 
     def plot(self, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=True, title=None):
         """pcolormesh of the chaotic fraction over (e, a/b) with the analytic overlap line and
@@ -478,7 +476,6 @@ class ParameterMap(Result, _display.Readable):
         return plot_parameter_map(self, ax=ax, contours=contours, colorbar=colorbar, title=title)
 
 
-@renamed_keywords(factory_or_name="system")
 def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
                   elongations, eccentricities, orbits, thetadot_p=PARAMETER_MAP_THETADOT_P,
                   theta_p=PARAMETER_MAP_THETA_P, rtol=1e-10, megno_chaotic=4.0,

@@ -90,7 +90,6 @@ import numpy as np
 
 from ._validate import require_count, require_positive, require_range
 from .analytic import _decoupled_half_orbit
-from .results import alias, renamed_keywords
 
 #: Paper colour convention (Naidu & Margot 2015, Figs. 4–5 and 7–9).
 COLORS = {"resonant": "red", "chaotic": "blue", "quasi-periodic": "green"}
@@ -153,12 +152,6 @@ class SectionClassification:
     parameters: dict = field(default_factory=dict, repr=False)
 
     COLORS: ClassVar[Dict[str, str]] = COLORS
-
-    # the old vocabulary, read-only (docs/design.md "Vocabulary")
-    label = alias("classification")
-    label_geometric = alias("classification_geometric")
-    libration_center_deg = alias("libration_centre_deg")
-    libration_center_thetadot = alias("libration_centre_thetadot")
 
     @property
     def colors(self):
@@ -401,7 +394,6 @@ def _resonance_p(center_deg, center_thetadot, low, high, centers, tolerance_deg)
 
 
 # ---- entry points ---------------------------------------------------------------------------
-@renamed_keywords(center_tolerance_deg="centre_tolerance_deg")
 def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, *,
                     libration_gap_deg=LIBRATION_GAP_DEG, order_ratio_chaotic=ORDER_RATIO_CHAOTIC,
                     megno_chaotic=MEGNO_CHAOTIC, megno_regular=MEGNO_REGULAR,
@@ -435,7 +427,7 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
         ... and only if its largest empty arc is at least this many times the second largest
         (one island, or a chain inside one island, rather than a chain round the circle).
     geometric : bool
-        Compute the order ratio (and ``label_geometric``) for every member. False skips it
+        Compute the order ratio (and ``classification_geometric``) for every member. False skips it
         where MEGNO already decides (chaos maps: the order ratio costs ~10 ms per member of
         single-threaded NumPy, more than integrating it); those members get NaN and
         "undetermined" there, their ``label`` is unchanged.
@@ -511,7 +503,6 @@ def classify_points(theta_p, thetadot_p, systems=None, megno=None, failed=None, 
                                  megno=megno_arr, parameters=params, **out)
 
 
-@renamed_keywords(center_tolerance_deg="centre_tolerance_deg")
 def classify_section(result, megno=None, island_shift=True, include_inaccurate=False,
                      **thresholds):
     """Classify every member of a :class:`~ti_spinorbit.section.SectionResult`.
@@ -566,7 +557,3 @@ def _systems_per_member(systems, n):
         raise ValueError(f"systems must give one system per member ({n}), got {len(systems)}")
     return [systems] * n
 
-
-# the old vocabulary (docs/design.md "Vocabulary")
-CENTER_TOLERANCE_DEG = CENTRE_TOLERANCE_DEG
-island_centers = island_centres

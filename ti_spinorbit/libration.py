@@ -52,7 +52,7 @@ from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
-from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, unit
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
@@ -239,12 +239,6 @@ class RelaxedLibration(Result, _display.Readable):
 
         return plot_libration(self, ax=ax, title=title, search=search)
 
-    # the old vocabulary, read-only (docs/design.md "Vocabulary")
-    center_thetadot_p = alias("centre_thetadot_p")
-    centers_by_length = alias("centres_by_length")
-    center_rtol_check = alias("centre_rtol_check")
-    center_tol = alias("centre_tol")
-
     def evidence(self):
         """Lines: centre and amplitude against orbits and tolerance, and the verdict."""
         if not self.convergence_checked:
@@ -290,7 +284,6 @@ def _arm_window(x, extent, best, points):
     return np.concatenate([left, [best], right])
 
 
-@renamed_keywords(center_tol="centre_tol")
 def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=None,
                       zoom_candidates=33, xtol=1e-6, max_iterations=10,
                       samples_per_orbit=256, coarse_arm_points=3,

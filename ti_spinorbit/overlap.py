@@ -54,7 +54,7 @@ from .libration import section_extent
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
-from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, alias, renamed_keywords, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, unit
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
@@ -87,11 +87,6 @@ class OverlapDecision:
     megno_overlap: Optional[bool] = unit('bool', default=None)
     #: orbits of the run this decision comes from
     orbits: float = unit(ORBITS, default=float("nan"))
-
-    # the old vocabulary, read-only (docs/design.md "Vocabulary")
-    center_1 = alias("centre_1")
-    center_3_2 = alias("centre_3_2")
-    center_3_2_found = alias("centre_3_2_found")
 
 
 @dataclass(repr=False)
@@ -209,7 +204,6 @@ def _factory(system, eccentricity):
     return (lambda q: catalog.system(name, elongation=q, eccentricity=eccentricity)), name
 
 
-@renamed_keywords(system_name_or_factory="system", center_starts="centre_starts")
 def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                       eccentricity=None, orbits=1000, rtol=1e-10, centre_starts=48,
                       separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,

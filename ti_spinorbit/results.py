@@ -159,38 +159,4 @@ class Result:
         raise NotImplementedError(f"{type(self).__name__}.plot")
 
 
-def alias(new):
-    """A read-only property giving attribute ``new`` under an old name (kept so that code and
-    tests written against the old vocabulary keep working; files are upgraded by io)."""
-    return property(lambda self: getattr(self, new), doc=f"Old name of ``{new}`` (read-only).")
-
-
-def deprecated_keyword(function, kwargs, old, new):
-    """Move ``kwargs[old]`` to ``kwargs[new]`` with a DeprecationWarning (an old keyword name
-    of an entry point); TypeError when both are given."""
-    import warnings
-
-    if old in kwargs:
-        if new in kwargs:
-            raise TypeError(f"{function}() got both {new!r} and its old name {old!r}")
-        warnings.warn(f"{function}(): {old}= is now {new}=", DeprecationWarning, stacklevel=3)
-        kwargs[new] = kwargs.pop(old)
-    return kwargs
-
-
-def renamed_keywords(**old_to_new):
-    """Decorator: an entry point still takes its old keyword names (``old=new`` pairs) with a
-    DeprecationWarning; positional use is unchanged."""
-    import functools
-
-    def wrap(function):
-        @functools.wraps(function)
-        def inner(*args, **kwargs):
-            for old, new in old_to_new.items():
-                deprecated_keyword(function.__name__, kwargs, old, new)
-            return function(*args, **kwargs)
-        return inner
-    return wrap
-
-
 __all__ = ["Status", "STATUS_NAMES", "Result", "unit", "units"]

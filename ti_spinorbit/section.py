@@ -28,7 +28,7 @@ from . import display as _display
 from .initial import ROW_UNIT as STATE_ROW
 from .attitude import CLASS_UNIT as ATTITUDE_CLASS
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations, perturbation_rows
-from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, renamed_keywords, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, unit
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -318,7 +318,6 @@ class SectionResult(Result, _display.Readable):
         return plot_section(self, ax=ax, colors=colors, **kwargs)
 
 
-@renamed_keywords(system_or_systems="system")
 def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
                        rtol=1e-12, atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
                        escape_distance=ESCAPE_DISTANCE, indicators=False,
@@ -643,7 +642,6 @@ class TimeSeriesResult(Result, _display.Readable):
         return numbers, (t, de, dl, parts)
 
 
-@renamed_keywords(system_or_systems="system")
 def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
                 samples_per_orbit=64, rtol=1e-12, atol=None, order=4,
                 window_orbits=DEFAULT_WINDOW_ORBITS, escape_distance=ESCAPE_DISTANCE,
