@@ -3,6 +3,7 @@
 Each error names the parameter, the value received and the allowed range, so a researcher
 can fix the call without reading the source."""
 
+import difflib
 import math
 import numbers
 import os
@@ -28,6 +29,12 @@ MAX_PRIMARY_SPIN = 1e5
 #: Densities, kg/m^3: from silica aerogel (~1, anything lower is a unit mistake) to five
 #: times osmium.
 MIN_DENSITY, MAX_DENSITY = 1.0, 1e5
+#: Bulk densities (m1 + m2)/(V1 + V2) that ``BinarySystem(orbital_period=)`` may imply, kg/m^3:
+#: from a tenth of water (below the most porous comet nuclei and trans-Neptunian binaries
+#: measured, 200-600) to just above osmium (22 590, the densest natural material). Their
+#: ratio, 250, is below 24² = 576, so a period typed in hours for days, or seconds for hours
+#: (3600²), always lands outside.
+MIN_BULK_DENSITY, MAX_BULK_DENSITY = 100.0, 25000.0
 #: Lengths of a body (semi-axes, radius, bounding radius), m: a millimetre to ten solar radii.
 MIN_LENGTH, MAX_LENGTH = 1e-3, 1e10
 #: Mass of a body, kg: a microgram to 5e4 solar masses.
@@ -45,16 +52,32 @@ MIN_MOMENT_RATIO = 1e-6
 def show(value, limit=80):
     """A one-line, bounded text of ``value`` for error messages: short sequences as lists,
     long arrays by their shape, text cut at ``limit`` characters."""
-    if isinstance(value, np.ndarray):
-        if value.size > 8:
-            return f"array of shape {value.shape}"
-        text = repr(value.tolist())
-    elif isinstance(value, (list, tuple)) and len(value) > 8:
-        return f"{type(value).__name__} of length {len(value)}"
-    else:
-        text = repr(value)
+    try:
+        if isinstance(value, np.ndarray):
+            if value.size > 8:
+                return f"array of shape {value.shape}"
+            text = repr(value.tolist())
+        elif isinstance(value, (list, tuple)) and len(value) > 8:
+            return f"{type(value).__name__} of length {len(value)}"
+        else:
+            text = repr(value)
+    except RecursionError:          # e.g. [[[...]]] nested thousands deep, from a JSON file
+        return f"a {type(value).__name__} nested too deeply to show"
     text = " ".join(text.split())
     return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def refuse_unknown_keys(mapping, valid, where):
+    """Raise ValueError on the first key of ``mapping`` not in ``valid``, naming it, ``where``
+    it is (e.g. "'secondary'") and the nearest valid key (``difflib.get_close_matches``), or
+    the valid keys when none is near: a misspelt key is refused rather than ignored."""
+    for key in mapping:
+        if key not in valid:
+            close = difflib.get_close_matches(str(key), list(valid), n=1, cutoff=0.6)
+            hint = (f"did you mean {close[0]!r}?" if close else
+                    f"the keys are {', '.join(map(repr, valid))}")
+            raise ValueError(f"unknown key {show(key)} in {where}: {hint} (unknown keys are "
+                             "refused, not ignored)")
 
 
 def _fmt(x):

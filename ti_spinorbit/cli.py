@@ -304,7 +304,8 @@ def _parser():
                        description="List the catalogued systems (Naidu & Margot 2015, Table 1).",
                        epilog=_help_epilog("systems"),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    s.add_argument("--show", metavar="NAME", help="print one system's parameters")
+    s.add_argument("--show", metavar="NAME", help="print one system's parameters (a "
+                                                   "catalogued name, or a .json system file)")
     s.add_argument("--out", default=None, help="also write the descriptions (SI) to this .json")
     s.add_argument("--quiet", action="store_true", help="print nothing (with --out)")
 
@@ -583,6 +584,9 @@ def _check_system_flags(args):
     if name is None or args.command == "figures":
         return
     flag = "--show" if args.command == "systems" else "--system"
+    if flag == "--show" and _is_system_file(name):
+        _read_system_file(name, flag)
+        return
     if flag == "--system" and _is_system_file(name):
         system = _file_system(args)
         _check_derived(args, system)
@@ -748,13 +752,11 @@ def _is_system_file(value):
 def _file_system(args):
     """The BinarySystem of a --system .json (BinarySystem.describe() output, as written by
     'ti-spinorbit systems --show NAME --out PATH', or the one-item list 'systems --out'
-    writes), with --eccentricity applied. --elongation and --density are refused: they
-    rebuild a catalogued secondary by the catalogue's prescription (docs/physics.md §7),
-    which a file of your own system does not follow."""
+    writes), with --eccentricity applied; read by BinarySystem.from_file's rules (unknown
+    keys and derived entries that disagree with the inputs are refused). --elongation and
+    --density are refused: they rebuild a catalogued secondary by the catalogue's
+    prescription (docs/physics.md §7), which a file of your own system does not follow."""
     import dataclasses
-    import json
-
-    from .systems import BinarySystem
 
     path = args.system
     for dest, flag in (("elongation", "--elongation"), ("density", "--density")):
@@ -765,22 +767,7 @@ def _file_system(args):
     if getattr(args, "elongations", None) is not None:
         raise ValueError(f"--system: overlap scans the catalogue's elongation prescription, so "
                          f"it needs a catalogued system name (got the file {path!r})")
-    try:
-        with open(path) as f:
-            d = json.load(f)
-    except FileNotFoundError:
-        raise ValueError(f"--system: no such file {path!r} (a catalogued name, or a .json "
-                         "written by 'ti-spinorbit systems --show NAME --out PATH')") from None
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise ValueError(f"--system: cannot read {path!r} as JSON ({_one_line(exc)[:200]})") \
-            from None
-    if isinstance(d, list) and len(d) == 1:
-        d = d[0]
-    try:
-        system = BinarySystem.from_description(d)
-    except (TypeError, ValueError, KeyError, AttributeError) as exc:
-        raise ValueError(f"--system: {path!r} is not a system description "
-                         f"(BinarySystem.describe() output): {_one_line(exc)[:300]}") from None
+    system = _read_system_file(path, "--system")
     e = getattr(args, "eccentricity", None)
     if e is not None and e != system.e:
         contact = system.primary.bounding_radius + system.secondary.bounding_radius
@@ -791,6 +778,18 @@ def _file_system(args):
         system = dataclasses.replace(system, e=float(e))
         object.__setattr__(system, "density_scale", scale)    # not an __init__ argument
     return system
+
+
+def _read_system_file(path, flag):
+    """BinarySystem.from_file for the command line: every error one line naming ``flag``
+    (--system, --show) and the file."""
+    from .systems import read_system_file
+
+    try:
+        return read_system_file(path, flag)
+    except FileNotFoundError as exc:
+        raise ValueError(f"{exc} (a catalogued name, or a .json written by 'ti-spinorbit "
+                         "systems --show NAME --out PATH')") from None
 
 
 def _catalogue_name(system):
@@ -1121,7 +1120,8 @@ def _cmd_systems(args):
     from . import catalog
 
     if args.show:
-        system = catalog.system(args.show)
+        system = _read_system_file(args.show, "--show") if _is_system_file(args.show) \
+            else catalog.system(args.show)
         if args.out:
             from .files import write_json     # atomic: a killed write leaves no partial file
 

@@ -20,9 +20,10 @@ from typing import Optional
 
 import numpy as np
 
-from ._validate import (MAX_MASS_RATIO, MAX_PRIMARY_SPIN, MAX_SEMIMAJOR_AXIS, MIN_LENGTH,
-                        MIN_MOMENT_RATIO, require_finite, require_positive_scalar, require_range,
-                        require_real, show)
+from ._validate import (MAX_BULK_DENSITY, MAX_MASS, MAX_MASS_RATIO, MAX_PRIMARY_SPIN,
+                        MAX_SEMIMAJOR_AXIS, MIN_BULK_DENSITY, MIN_LENGTH, MIN_MASS,
+                        MIN_MOMENT_RATIO, refuse_unknown_keys, require_finite,
+                        require_positive_scalar, require_range, require_real, show)
 from .bodies import Body
 from . import display as _display
 
@@ -82,13 +83,22 @@ class BinarySystem(_display.Readable):
         42912 s for Didymos-Dimorphos. When given, both bodies' masses (hence densities; shapes
         unchanged) are multiplied by one factor ``density_scale`` = (P_Kepler / P)² so that
         the Keplerian period 2π sqrt(a³ / (G (m1 + m2))) equals it; the mass ratio and ω0 are
-        unchanged. Not stored: the scaled bodies are, with ``density_scale``.
+        unchanged. The period must imply a bulk density (m1 + m2) / (V1 + V2) in
+        [100, 25000] kg/m³ (``MIN_BULK_DENSITY``, ``MAX_BULK_DENSITY``: a tenth of water to
+        just above osmium), so P lies in [2π sqrt(a³ / (G 25000 V)), 2π sqrt(a³ / (G 100 V))],
+        V = V1 + V2; the error names that range and the implied density (a period in the wrong
+        unit, e.g. 1 s or 1e20 s, lands outside). V of an ellipsoid is (4/3)π abc; of a
+        general :class:`Body`, that of the uniform ellipsoid with its second moments,
+        semi-axes sqrt(5 T^200 / m) etc. (docs/physics.md §7.5). Not stored: the scaled
+        bodies are, with ``density_scale``.
 
     Attributes
     ----------
     density_scale : float
         The factor ``orbital_period`` applied to both bodies' masses and densities (1.0 when
-        the bodies were used as given); shown by :meth:`describe`.
+        the bodies were used as given); shown by ``repr``. :meth:`describe` does not write
+        it (the masses it writes are already scaled, and nothing could check it on reading),
+        so a system read back has 1.0; it takes no part in ``==``.
 
     Warns
     -----
@@ -103,7 +113,7 @@ class BinarySystem(_display.Readable):
     e: float
     primary_spin_period: Optional[float] = None
     name: str = "binary"
-    density_scale: float = field(default=1.0, init=False)
+    density_scale: float = field(default=1.0, init=False, compare=False)
 
     def __post_init__(self):
         for label, body in (("primary", self.primary), ("secondary", self.secondary)):
@@ -289,7 +299,11 @@ class BinarySystem(_display.Readable):
         return np.asarray(x, dtype=np.float64) / factor
 
     def describe(self) -> dict:
-        """All inputs with units, for saved files and plots."""
+        """All inputs with units, for saved files and plots, and the derived entries
+        ``mean_motion_rad_s``, ``mass_ratio``, ``omega0``, ``orbital_period_h`` (and each
+        body's ``bounding_radius_m``, for an ellipsoid its largest semi-axis), which
+        :meth:`from_description` checks against the inputs rather than reads.
+        ``density_scale`` is not written: the masses written already carry it."""
         def body(b):
             d = {"name": b.name, "mass_kg": b.mass, "bounding_radius_m": b.bounding_radius}
             if hasattr(b, "semi_axes"):
@@ -298,8 +312,7 @@ class BinarySystem(_display.Readable):
         return {"name": self.name, "primary": body(self.primary), "secondary": body(self.secondary),
                 "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
                 "mean_motion_rad_s": self.mean_motion, "mass_ratio": self.mass_ratio,
-                "omega0": self.omega0, "orbital_period_h": self.orbital_period / 3600.0,
-                "density_scale": self.density_scale}
+                "omega0": self.omega0, "orbital_period_h": self.orbital_period / 3600.0}
 
     @classmethod
     def from_description(cls, d: dict) -> "BinarySystem":
@@ -317,56 +330,235 @@ class BinarySystem(_display.Readable):
           exact because an ellipsoid's integrals depend on nothing else.
 
         A general body described by :meth:`describe` alone (no semi-axes, no integrals)
-        cannot be rebuilt: ValueError. Derived entries (mean motion, mass ratio, ω0) are
-        recomputed, not read.
-        """
-        from .bodies import Ellipsoid
+        cannot be rebuilt: ValueError.
 
+        Nothing is ignored. A key that :meth:`describe` and :func:`ti_spinorbit.io.save` do
+        not write (``SYSTEM_KEYS``, and ``BODY_KEYS`` in each body) is refused, naming it
+        and the nearest valid key. Derived entries are recomputed from the inputs and
+        checked, never read: ``mean_motion_rad_s``, ``mass_ratio``, ``orbital_period_h``
+        (from ``a_m`` and the masses), ``omega0`` (from the secondary's shape) and an
+        ellipsoid's ``bounding_radius_m`` (its largest semi-axis) must agree with the
+        recomputed value to a relative ``DERIVED_RTOL`` = 1e-9 (ω0 also to 1e-9 absolute),
+        else ValueError naming the entry, both values and the inputs to edit instead; each
+        may be left out (delete them after editing the inputs). ``semi_axes_m`` given with
+        ``integrals`` must describe the same ellipsoid to 1e-9. ``density_scale`` (written by
+        earlier versions) may only be 1: nothing scales a description's masses. The
+        entries and rules: docs/physics.md §7.5.
+        """
         if not isinstance(d, dict):
             raise TypeError(f"system description must be a dict from BinarySystem.describe() "
                             f"(got {type(d).__name__})")
+        refuse_unknown_keys(d, SYSTEM_KEYS, "the system description")
         missing = [k for k in ("primary", "secondary", "a_m", "e") if k not in d]
         if missing:
             raise ValueError(f"system description lacks {', '.join(map(repr, missing))} "
                              f"(has {', '.join(map(repr, d))}); expected BinarySystem.describe() output")
-
-        def body(label, b):
-            for key in ("mass_kg", "bounding_radius_m"):
-                if key not in b:
-                    raise ValueError(f"{label} description lacks {key!r} (has {', '.join(map(repr, b))})")
-            name = b.get("name", "body")
-            ellipsoid = None
-            if b.get("semi_axes_m") is not None:
-                ellipsoid = Ellipsoid(*b["semi_axes_m"], mass=b["mass_kg"], name=name)
-            if b.get("integrals") is None:
-                if ellipsoid is None:
-                    raise ValueError(
-                        f"{label} {name!r} is a general Body: its description needs 'integrals' "
-                        "({'l,m,n': T^lmn}, as written by ti_spinorbit.io.save) or 'semi_axes_m'; "
-                        "describe() alone does not hold its inertia integrals")
-                return ellipsoid
-            integrals = {}
-            for key, value in b["integrals"].items():
-                try:
-                    lmn = tuple(int(i) for i in key.split(","))
-                except (AttributeError, ValueError):
-                    raise ValueError(f"{label} integrals: key {key!r} is not 'l,m,n'") from None
-                integrals[lmn] = float(value)
-            general = Body(float(b["mass_kg"]), integrals, float(b["bounding_radius_m"]), name)
-            if ellipsoid is not None and np.array_equal(ellipsoid.as_row(), general.as_row()) \
-                    and ellipsoid.bounding_radius == general.bounding_radius:
-                return ellipsoid
-            return general
-
+        mismatches = []           # derived entries that disagree, all named in one message
+        primary = _body_from(d["primary"], "primary", mismatches)
+        secondary = _body_from(d["secondary"], "secondary", mismatches)
         period = d.get("primary_spin_period_s")
-        system = cls(body("primary", d["primary"]), body("secondary", d["secondary"]),
-                     float(d["a_m"]), float(d["e"]),
-                     primary_spin_period=None if period is None else float(period),
+        system = cls(primary, secondary, require_real("a_m", d["a_m"]), require_real("e", d["e"]),
+                     primary_spin_period=None if period is None else
+                     require_real("primary_spin_period_s", period),
                      name=d.get("name", "binary"))
-        scale = d.get("density_scale", 1.0)
-        require_positive_scalar("density_scale", scale, 0.0, math.inf, "")
-        object.__setattr__(system, "density_scale", float(scale))
+        _check_derived_entries(d, system, mismatches)
+        if "density_scale" in d:
+            scale = require_real("density_scale", d["density_scale"])
+            if scale != 1.0:
+                raise ValueError(
+                    f"density_scale is {scale:.12g}, but a description's masses are used as they "
+                    "are and nothing scales them (it recorded a factor BinarySystem("
+                    "orbital_period=) had already applied to mass_kg, and cannot be checked): "
+                    "delete density_scale, and edit the bodies' mass_kg to change the densities")
         return system
+
+    @classmethod
+    def from_file(cls, path) -> "BinarySystem":
+        """The system in a JSON file: one :meth:`describe` object, as written by
+        ``ti-spinorbit systems --show NAME --out PATH`` (a one-item list, as ``systems
+        --out`` writes, is accepted), read with every check of :meth:`from_description`
+        (unknown keys, derived entries). The command line's ``--system PATH.json`` reads
+        files this way.
+
+        Raises
+        ------
+        FileNotFoundError
+            No file at ``path``.
+        ValueError
+            One line naming ``path`` and the file: not JSON (or a key given twice in one
+            object), JSON nested too deeply, not a JSON object, or a description
+            :meth:`from_description` refuses.
+        """
+        return read_system_file(path, "path")
+
+
+#: Keys of a system description (BinarySystem.describe() output; "density_scale" only as
+#: earlier versions wrote it, 1) and of each of its bodies (io.describe_system adds
+#: "integrals"): any other key is refused, not ignored.
+SYSTEM_KEYS = ("name", "primary", "secondary", "a_m", "e", "primary_spin_period_s",
+               "mean_motion_rad_s", "mass_ratio", "omega0", "orbital_period_h", "density_scale")
+BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals")
+#: Relative tolerance of a derived entry against its value recomputed from the inputs: the
+#: package writes them unrounded (JSON keeps every bit), so only an edit differs.
+DERIVED_RTOL = 1e-9
+
+
+def _body_from(b, label, mismatches):
+    """A body of a system description (see BinarySystem.from_description); a derived
+    bounding_radius_m that disagrees is added to ``mismatches``."""
+    from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, Ellipsoid
+
+    if not isinstance(b, dict):
+        raise TypeError(f"{label} must be an object with the keys {', '.join(BODY_KEYS)} "
+                        f"(got {show(b)})")
+    refuse_unknown_keys(b, BODY_KEYS, repr(label))
+    axes, integrals = b.get("semi_axes_m"), b.get("integrals")
+    needed = ("mass_kg",) if axes is not None and integrals is None else \
+        ("mass_kg", "bounding_radius_m")
+    for key in needed:
+        if key not in b:
+            raise ValueError(f"{label} description lacks {key!r} (has {', '.join(map(repr, b))})")
+    name = b.get("name", "body")
+    mass = require_real(f"{label} mass_kg", b["mass_kg"])
+    ellipsoid = None
+    if axes is not None:
+        if not isinstance(axes, (list, tuple)) or len(axes) != 3:
+            raise TypeError(f"{label} semi_axes_m must be a list [a, b, c] of three lengths in m "
+                            f"(got {show(axes)})")
+        try:
+            ellipsoid = Ellipsoid(*axes, mass=mass, name=name)
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"{label}: {exc}") from None
+    if integrals is None:
+        if ellipsoid is None:
+            raise ValueError(
+                f"{label} {name!r} is a general Body: its description needs 'integrals' "
+                "({'l,m,n': T^lmn}, as written by ti_spinorbit.io.save) or 'semi_axes_m'; "
+                "describe() alone does not hold its inertia integrals")
+        if "bounding_radius_m" in b:
+            given = require_real(f"{label} bounding_radius_m", b["bounding_radius_m"])
+            derived = ellipsoid.bounding_radius
+            if not math.isclose(given, derived, rel_tol=DERIVED_RTOL):
+                mismatches.append(f"{label} bounding_radius_m is {given:.12g} in the "
+                                  f"description, but its semi_axes_m give {derived:.12g} (an "
+                                  "ellipsoid's is its largest semi-axis)")
+        return ellipsoid
+    if not isinstance(integrals, dict):
+        raise TypeError(f"{label} integrals must be an object {{'l,m,n': T^lmn}} "
+                        f"(got {show(integrals)})")
+    table = {}
+    for key, value in integrals.items():
+        try:
+            lmn = tuple(int(i) for i in key.split(","))
+        except (AttributeError, ValueError):
+            raise ValueError(f"{label} integrals: key {show(key)} is not 'l,m,n'") from None
+        table[lmn] = require_real(f"{label} integrals[{key!r}]", value)
+    try:
+        general = Body(mass, table, require_real(f"{label} bounding_radius_m",
+                                                 b["bounding_radius_m"]), name)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{label}: {exc}") from None
+    if ellipsoid is None:
+        return general
+    if np.array_equal(ellipsoid.as_row(), general.as_row()) \
+            and ellipsoid.bounding_radius == general.bounding_radius:
+        return ellipsoid
+    longest = ellipsoid.semi_axes[0]
+    keys = EXPONENTS_2 + EXPONENTS_3 + EXPONENTS_4
+    for k, want, have in zip(keys, ellipsoid.as_row()[1:], general.as_row()[1:]):
+        if abs(want - have) > DERIVED_RTOL * mass * longest ** sum(k):
+            raise ValueError(
+                f"{label} semi_axes_m {show(list(axes))} and mass_kg make T^{''.join(map(str, k))}"
+                f" = {want:.12g} for a uniform ellipsoid, but its integrals give {have:.12g}: "
+                "the integrals are read and semi_axes_m only checked; delete semi_axes_m or "
+                "make the two agree")
+    return general
+
+
+def _check_derived_entries(d, system, bad):
+    """Refuse derived entries of a description that disagree with ``system`` rebuilt from
+    its inputs (BinarySystem.from_description), with those already in ``bad``, in one
+    message."""
+    masses = "a_m and the bodies' mass_kg"
+    derived = (("mean_motion_rad_s", system.mean_motion, masses, 0.0),
+               ("mass_ratio", system.mass_ratio, "the bodies' mass_kg", 0.0),
+               ("omega0", system.omega0, "the secondary's semi_axes_m or integrals", DERIVED_RTOL),
+               ("orbital_period_h", system.orbital_period / 3600.0, masses, 0.0))
+    for key, value, inputs, atol in derived:
+        if key in d:
+            given = require_real(key, d[key])
+            if not math.isclose(given, value, rel_tol=DERIVED_RTOL, abs_tol=atol):
+                bad.append(f"{key} is {given:.12g} in the description, but {inputs} give "
+                           f"{value:.12g}")
+    if bad:
+        it = "it is" if len(bad) == 1 else "they are"
+        raise ValueError(f"{'; '.join(bad)}: {it} derived from the inputs, never read: edit "
+                         "those inputs instead (derived entries are optional: delete those "
+                         "that no longer match)")
+
+
+class _DuplicateKey(ValueError):
+    pass
+
+
+def _object_without_duplicates(pairs):
+    """json object_pairs_hook: a key given twice in one object is refused (json keeps the
+    last one silently)."""
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(f"key {show(key)} is given twice in one object (JSON would "
+                                "keep the last silently)")
+        out[key] = value
+    return out
+
+
+_JSON_KINDS = {dict: "object", list: "array", str: "string", int: "number", float: "number",
+               bool: "true/false", type(None): "null"}
+
+
+def read_system_file(path, what="path"):
+    """The BinarySystem of a system file (BinarySystem.from_file), every error one line
+    starting with ``what`` (the parameter, or the command line's flag: "--system") and
+    naming the file."""
+    import json
+    import os
+
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"{what} must be a file path (str or os.PathLike), got {show(path)}")
+    p = os.fsdecode(os.fspath(path))
+    try:
+        with open(p, encoding="utf-8") as f:
+            d = json.load(f, object_pairs_hook=_object_without_duplicates)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{what}: no such file {p!r}") from None
+    except RecursionError:
+        raise ValueError(f"{what}: {p!r} holds JSON nested too deeply to read; a system file "
+                         "is one JSON object (BinarySystem.describe() output, as 'ti-spinorbit "
+                         "systems --show NAME --out PATH' writes)") from None
+    except _DuplicateKey as exc:
+        raise ValueError(f"{what}: {p!r}: {exc}") from None
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"{what}: cannot read {p!r} as JSON "
+                         f"({' '.join(str(exc).split())[:200]})") from None
+    if isinstance(d, list) and len(d) == 1 and isinstance(d[0], dict):
+        d = d[0]                                    # the one-item list 'systems --out' writes
+    if isinstance(d, list) and len(d) > 1 and all(isinstance(x, dict) for x in d):
+        raise ValueError(f"{what}: {p!r} holds a list of {len(d)} system descriptions; give a "
+                         "file of one ('ti-spinorbit systems --show NAME --out PATH' writes one)")
+    if not isinstance(d, dict):
+        kind = _JSON_KINDS.get(type(d), type(d).__name__)
+        raise ValueError(f"{what}: {p!r} holds a JSON {kind}, not an object; a system file is "
+                         "one JSON object (BinarySystem.describe() output, as 'ti-spinorbit "
+                         "systems --show NAME --out PATH' writes)")
+    try:
+        return BinarySystem.from_description(d)
+    except RecursionError:
+        raise ValueError(f"{what}: {p!r} holds a value nested too deeply") from None
+    except (TypeError, ValueError, KeyError, AttributeError) as exc:
+        text = " ".join(str(exc).split())
+        raise ValueError(f"{what}: {p!r}: {text if len(text) <= 1000 else text[:997] + '...'}") \
+            from None
 
 
 def _scaled_body(body: Body, factor: float) -> Body:
@@ -385,6 +577,17 @@ def _scaled_body(body: Body, factor: float) -> Body:
 _dataclass_init = BinarySystem.__init__
 
 
+def _volume(body: Body) -> float:
+    """A body's volume, m³, for its bulk density: (4/3)π abc of an ellipsoid; of a general
+    Body, that of the uniform ellipsoid with its second moments (semi-axes sqrt(5 T^200 / m),
+    sqrt(5 T^020 / m), sqrt(5 T^002 / m))."""
+    from .bodies import EXPONENTS_2
+
+    axes = getattr(body, "semi_axes", None) or \
+        [math.sqrt(5.0 * body.integral(*k) / body.mass) for k in EXPONENTS_2]
+    return 4.0 / 3.0 * math.pi * axes[0] * axes[1] * axes[2]
+
+
 def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, name="binary",
                       *, orbital_period=None):
     if orbital_period is None:
@@ -395,15 +598,30 @@ def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, 
         if not isinstance(body, Body):
             raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body), "
                             f"got {type(body).__name__}")
-    require_positive_scalar("a", a, MIN_LENGTH, MAX_SEMIMAJOR_AXIS, "m")
-    kepler = 2.0 * math.pi * math.sqrt(float(a) ** 3 / (G * (primary.mass + secondary.mass)))
-    factor = (kepler / float(orbital_period)) ** 2
-    try:
-        scaled = [_scaled_body(b, factor) for b in (primary, secondary)]
-    except ValueError as exc:
-        raise ValueError(f"orbital_period {float(orbital_period):.6g} s needs densities x "
-                         f"{factor:.6g} (Keplerian period of the given bodies {kepler:.6g} s), "
-                         f"which makes a body's {' '.join(str(exc).split())}") from None
+    a_m = require_positive_scalar("a", a, MIN_LENGTH, MAX_SEMIMAJOR_AXIS, "m")
+    period, total = float(orbital_period), primary.mass + secondary.mass
+    kepler = 2.0 * math.pi * math.sqrt(a_m ** 3 / (G * total))
+    ratio = kepler / period
+    factor = ratio * ratio                    # a product overflows to inf, ** 2 would raise
+    volume = _volume(primary) + _volume(secondary)
+    if volume > 0.0:
+        implied = factor * total / volume
+        if not MIN_BULK_DENSITY <= implied <= MAX_BULK_DENSITY:
+            def period_of(density):
+                return 2.0 * math.pi * math.sqrt(a_m ** 3 / (G * density * volume))
+            raise ValueError(
+                f"orbital_period must lie in [{period_of(MAX_BULK_DENSITY):.6g}, "
+                f"{period_of(MIN_BULK_DENSITY):.6g}] s for these bodies at a = {a_m:g} m, the "
+                f"periods of a bulk density (m1 + m2)/(V1 + V2) in [{MIN_BULK_DENSITY:g}, "
+                f"{MAX_BULK_DENSITY:g}] kg/m^3 (got {period:.6g} s, which implies "
+                f"{implied:.3g} kg/m^3)")
+    for label, body in (("primary", primary), ("secondary", secondary)):
+        mass = body.mass * factor
+        if not MIN_MASS <= mass <= MAX_MASS:
+            raise ValueError(
+                f"orbital_period {period:.6g} s scales both masses by {factor:.6g}, which makes "
+                f"the {label}'s {mass:.6g} kg, outside [{MIN_MASS:g}, {MAX_MASS:g}] kg")
+    scaled = [_scaled_body(b, factor) for b in (primary, secondary)]
     _dataclass_init(self, *scaled, a, e, primary_spin_period, name)
     object.__setattr__(self, "density_scale", factor)
 
