@@ -29,6 +29,8 @@ QUICK = [
     ("time_series 2x200x256", "time_series", dict(members=2, orbits=200, samples_per_orbit=256)),
     ("time_series 3d 2x300x256", "time_series", dict(members=2, orbits=300, samples_per_orbit=256,
                                                     model="3d")),
+    ("time_series states 2x200x256", "time_series", dict(members=2, orbits=200,
+                                                         samples_per_orbit=256, states=True)),
     ("energy (CLI) 300x256", "energy", dict(orbits=300, samples_per_orbit=256)),
     ("chaos_map 16x16x100", "chaos_map", dict(grid=16, orbits=100)),
     ("parameter_map 2x2x24x300", "parameter_map", dict(grid=2, orbits=300)),
@@ -45,6 +47,10 @@ FULL = [
      dict(members=16, orbits=4000, samples_per_orbit=40)),
     ("time_series 3d 4x500x64", "time_series", dict(members=4, orbits=500, samples_per_orbit=64,
                                                    model="3d")),
+    ("time_series states 4x2000x64", "time_series", dict(members=4, orbits=2000,
+                                                         samples_per_orbit=64, states=True)),
+    ("time_series 3d states 4x1000x64", "time_series",
+     dict(members=4, orbits=1000, samples_per_orbit=64, model="3d", states=True)),
     ("energy (CLI) 2000x256", "energy", dict(orbits=2000, samples_per_orbit=256)),
     ("chaos_map 32x32x200", "chaos_map", dict(grid=32, orbits=200)),
     ("chaos_map 128x128x10", "chaos_map", dict(grid=128, orbits=10)),
@@ -105,7 +111,8 @@ def run_case(entry, kw):
                                    model=kw.get("model", "auto"))
         elif entry == "time_series":
             tso.time_series(vh, 0.0, np.linspace(0.9, 1.3, members), orbits,
-                            samples_per_orbit=kw["samples_per_orbit"], model=kw.get("model", "auto"))
+                            samples_per_orbit=kw["samples_per_orbit"], model=kw.get("model", "auto"),
+                            states=kw.get("states", False))
         elif entry == "energy":
             out = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"memory_estimate_{os.getpid()}")
             status = cli.main(["energy", "--quiet", "--orbits", f"{orbits:g}", "--samples-per-orbit",

@@ -110,7 +110,8 @@ API_CASES = [
     ("section-rtol-large", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, rtol=0.1), ValueError,
      r"^rtol must lie in \[1e-16, 0.01\] \(got 0.1\)"),
     ("section-atol-negative", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, atol=-1), ValueError,
-     r"^atol must be a finite number > 0 \(got -1\)"),
+     r"^atol must lie in \(0, 0.01\] \(absolute tolerance on the scaled state, whose "
+     r"components are O\(1\); got -1\)$"),
     ("section-nan-theta", lambda vh: tso.surface_of_section(vh, NAN, 1.0, 1), ValueError,
      r"^theta_p must be finite"),
     ("section-inf-thetadot", lambda vh: tso.surface_of_section(vh, 0, INF, 1), ValueError,

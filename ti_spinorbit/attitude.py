@@ -93,10 +93,18 @@ def _euler(M):
     return np.degrees(np.stack([roll, pitch, yaw], axis=-1))
 
 
+def _angle(sine, cosine):
+    """Angle (degrees) from |a × b| and a · b: atan2 keeps full relative precision at every
+    angle, where arccos of the dot product loses all digits below ~1e-8 rad (cos θ = 1 − θ²/2
+    rounds to 1) and arcsin those near 90°."""
+    return np.degrees(np.arctan2(sine, cosine))
+
+
 def pole_tilt(y):
     """Angle (degrees) between the secondary's short body axis (its pole) and the orbit
-    normal."""
-    return np.degrees(np.arccos(np.clip(relative_attitude(y)[..., 2, 2], -1.0, 1.0)))
+    normal: atan2(|n × p|, n · p) with p the pole in the orbit frame (accurate near 0)."""
+    p = relative_attitude(y)[..., :, 2]               # the pole's orbit-frame components
+    return _angle(np.hypot(p[..., 0], p[..., 1]), p[..., 2])
 
 
 def body_angular_momentum(y):
@@ -115,8 +123,8 @@ def spin_axis_angle(y, system):
     body = np.einsum("...ji,...j->...i", S, w2) * (moments.max() / moments)   # ∝ body ω
     omega = np.einsum("...ij,...j->...i", S, body)
     normal = orbit_frame(y)[..., :, 2]
-    cosang = np.sum(_unit(omega) * normal, axis=-1)
-    return np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
+    u = _unit(omega)
+    return _angle(np.linalg.norm(np.cross(u, normal), axis=-1), np.sum(u * normal, axis=-1))
 
 
 def dynamic_inertia(y, system):
@@ -155,7 +163,7 @@ def classify(samples, system, *, tilt_angle=TILT_ANGLE, npa_angle=NPA_ANGLE):
             raise ValueError(f"samples of member {k} hold {len(s)} finite states; classify "
                              "needs at least 2")
         l = body_angular_momentum(s)
-        off_axis = np.degrees(np.arccos(np.clip(np.abs(l[:, 2]), 0.0, 1.0)))
+        off_axis = _angle(np.hypot(l[:, 0], l[:, 1]), np.abs(l[:, 2]))  # npa_angle (shadowed)
         long_axis_mode = modes and np.min(dynamic_inertia(s, system)) < 1.0
         if np.max(off_axis) > npa_angle or long_axis_mode:
             out[k] = TUMBLING
@@ -172,7 +180,7 @@ def npa_angle(y):
     """Angle (degrees) between the secondary's spin angular momentum and its short body axis
     (either direction): 0 for rotation about the short axis."""
     l = body_angular_momentum(y)
-    return np.degrees(np.arccos(np.clip(np.abs(l[..., 2]), 0.0, 1.0)))
+    return _angle(np.hypot(l[..., 0], l[..., 1]), np.abs(l[..., 2]))
 
 
 def classify_crossings(synchronous, max_tilt, max_npa, *, tilt_angle=TILT_ANGLE,

@@ -1302,8 +1302,20 @@ def _cmd_libration(args):
            f" (limit {result.max_drift:.1e})",
            *("  " + line for line in result.evidence()),
            f"wrote {out} and {data}")
-    return _accuracy_status(args, np.array([_status_code(result.status)]),
+    code = _accuracy_status(args, np.array([_status_code(result.status)]),
                             np.array([result.energy_drift]), result.max_drift, "trajectories")
+    if not result.converged:     # on stderr even with --quiet: it qualifies the amplitude
+        allowed = getattr(args, "allow_inaccurate", False)
+        why = result.message or (f"search window not below --xtol {result.xtol:g} or section "
+                                 f"extent at the centre {result.extent:.3g} deg too wide")
+        print(f"ti-spinorbit libration: not converged ({why}); the amplitude "
+              f"{result.amplitude:.4f} deg is not final, results written"
+              + ("" if allowed else f"; raise --orbits/--max-orbits or tighten --rtol, or "
+                                    f"--allow-inaccurate to accept (exit status "
+                                    f"{EXIT_INACCURATE})"), file=sys.stderr)
+        if not allowed:
+            code = EXIT_INACCURATE
+    return code
 
 
 def psi_phase(psi_a):

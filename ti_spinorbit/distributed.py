@@ -63,10 +63,29 @@ class ChunkError(RuntimeError):
         self.members = members
 
 
+def check_client(client):
+    """``client`` if it is a ``dask.distributed.Client`` (or None), else a one-line TypeError
+    naming what was given: raised before any work, not as an AttributeError from inside the
+    run (``client.nthreads``, ``client.submit``)."""
+    if client is None:
+        return None
+    try:
+        from distributed import Client
+    except ImportError:
+        Client = None
+    if Client is not None and isinstance(client, Client):
+        return client
+    hint = "" if Client is not None else \
+        " (dask is not installed: pip install ti-spinorbit[dask])"
+    raise TypeError(f"client must be a dask.distributed.Client or None, not "
+                    f"{type(client).__name__}{hint}")
+
+
 def sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_size=None,
              **kwargs) -> section.SectionResult:
     """``surface_of_section`` in this process when ``client`` is None, else
     :func:`run_sections` on the cluster behind ``client`` (same arguments, same result)."""
+    check_client(client)
     if client is None:
         return section.surface_of_section(system_or_systems, theta_p, thetadot_p, orbits,
                                           **kwargs)
@@ -110,6 +129,7 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         Members in input order; ``seconds`` is the wall time of the whole run, ``systems``
         the flat member list of this process.
     """
+    check_client(client)
     from distributed import as_completed
 
     started = time.perf_counter()
@@ -253,5 +273,5 @@ def _join(arrays):
     return np.concatenate(arrays, axis=0)
 
 
-__all__ = ["run_sections", "sections", "concatenate", "ChunkError", "CHUNKS_PER_WORKER",
+__all__ = ["run_sections", "sections", "check_client", "concatenate", "ChunkError", "CHUNKS_PER_WORKER",
            "DEFAULT_RETRIES"]

@@ -32,6 +32,9 @@ import numpy as np
 
 from ._validate import show
 
+#: |R × V| / (|R| |V|) at or below which V counts as parallel to R (the orbit normal is then
+#: rounding noise): :meth:`InitialState.kicked` applies only radial kicks there.
+_DEGENERATE_NORMAL = 64 * np.finfo(np.float64).eps
 #: Largest |AᵀA − 1| entry of an attitude matrix, and largest ||q| − 1| of a quaternion: a
 #: rotation typed with 12 significant digits passes, a scaled or sheared matrix does not.
 ORTHONORMAL_TOLERANCE = 1e-9
@@ -128,7 +131,7 @@ def _attitude(name, value):
     return A
 
 
-@dataclass(frozen=True, repr=False)
+@dataclass(frozen=True, repr=False, eq=False)
 class InitialState:
     """One start of the full two-body problem (SI units, inertial frame; module docstring).
 
@@ -143,6 +146,11 @@ class InitialState:
 
     Checked on construction: shapes, finiteness, orthonormal with det +1. What needs the
     bodies (no contact, a bound orbit) is checked by :meth:`check` and by every entry point.
+
+    Two states are equal (``==``) when every field is equal element by element (attitudes
+    as matrices, so a quaternion and its matrix give equal states); comparing with anything
+    else is ``NotImplemented`` (so ``state == 3`` is False). States are immutable (frozen,
+    read-only arrays) and hashable, consistently with ``==``.
     """
 
     R: np.ndarray
@@ -160,6 +168,17 @@ class InitialState:
             object.__setattr__(self, name, v)
         if not np.linalg.norm(self.R) > 0:
             raise ValueError("R must be a non-zero separation (m) (got R = 0)")
+
+    def __eq__(self, other):
+        if not isinstance(other, InitialState):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, name), getattr(other, name))
+                   for name in _FIELDS)
+
+    def __hash__(self):
+        # the floats' own hashes (hash(0.0) == hash(-0.0)), as == compares them; every
+        # element is finite (checked on construction), so equal states hash alike
+        return hash(tuple(self.to_row().tolist()))
 
     # ---- checks that need the bodies ---------------------------------------------------------
     def check(self, system, name="initial state"):
@@ -225,9 +244,24 @@ class InitialState:
         ``dv`` = (radial, along-track, normal) in m/s, in the orbit frame of this state
         (:func:`orbit_frame`); a DART-like deflection is mostly along-track and negative. The
         bodies' attitudes and spins are unchanged (a kick at a later time: integrate to it,
-        take ``InitialState.from_scaled(system, y)`` of the state reached, kick that)."""
+        take ``InitialState.from_scaled(system, y)`` of the state reached, kick that).
+
+        When V is parallel to R (a radial orbit, or V = 0) the orbit plane is undefined, so
+        are the along-track and normal directions: a purely radial kick ``(dv_r, 0, 0)`` is
+        still well defined (V + dv_r R/|R|) and is applied; any other is refused (ValueError
+        naming ``dv``)."""
         dv = _finite("dv", dv, (3,))
-        return InitialState(R=self.R, V=self.V + orbit_frame(self.R, self.V) @ dv,
+        radial = self.R / np.linalg.norm(self.R)
+        h = np.linalg.norm(np.cross(self.R, self.V))
+        if h > _DEGENERATE_NORMAL * np.linalg.norm(self.R) * np.linalg.norm(self.V):
+            change = orbit_frame(self.R, self.V) @ dv
+        elif dv[1] == 0.0 and dv[2] == 0.0:
+            change = dv[0] * radial          # radial: needs no orbit plane
+        else:
+            raise ValueError(f"dv = {show(dv.tolist())} m/s has along-track/normal components, "
+                             "but V is parallel to R (|R x V| = 0: no orbit plane), so only a "
+                             "radial kick dv = (dv_r, 0, 0) is defined for this state")
+        return InitialState(R=self.R, V=self.V + change,
                             primary_attitude=self.primary_attitude, primary_omega=self.primary_omega,
                             secondary_attitude=self.secondary_attitude,
                             secondary_omega=self.secondary_omega)

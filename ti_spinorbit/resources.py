@@ -24,6 +24,15 @@ series, planar and 3-D, which is what :data:`ROW_BYTES` uses. A member costs
 array per window with records). With many members and few orbits the integration itself can
 be the peak (window buffers of ``window_orbits + 4`` rows per member): the estimate is the
 larger of the two phases.
+
+A time series with ``states=True`` keeps 30 SI numbers per sample more. They are made after
+the observables, when ``derive``'s temporaries are gone: alive then are the records (31), the
+derived and result columns (about 35) and the state rows, per member and stacked (2 x 30),
+which is :data:`STATES_ROW_BYTES` (measured 1 010 bytes per row), plus the scaled copy and
+temporaries of the member being converted (:data:`STATES_MEMBER_ROW_BYTES` per row of the
+largest member). That third phase stays below the observables' peak (measured: the peak RSS
+of a states=True series is that of the same series without states), so the states are not
+counted as a second set of rows of ``ROW_BYTES`` each (that was 2.1 x the measured peak).
 """
 
 import math
@@ -47,6 +56,11 @@ RUN_MEMBER_BYTES = 2500.0
 CHUNK_BYTES = 160.0
 #: Window buffer rows per member besides the window's own records (ensemble.Ensemble.run).
 BUFFER_SLACK = 4
+#: Bytes per sample row alive while a time series' ``states`` are built (module docstring;
+#: measured 1 010 with tracemalloc for planar and 3-D runs).
+STATES_ROW_BYTES = 1010.0
+#: Bytes per row of the member whose state rows are being converted, on top (measured 170).
+STATES_MEMBER_ROW_BYTES = 170.0
 
 
 def record_rows(orbits, samples_per_orbit=None):
@@ -59,11 +73,13 @@ def record_rows(orbits, samples_per_orbit=None):
     return rows
 
 
-def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16, width=31):
+def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16, width=31,
+                   states=False):
     """Peak memory, bytes, of an entry point integrating ``members`` members for ``orbits``
     initial orbits each (a scalar, or an array with one value per member), with
     ``samples_per_orbit`` dense samples per orbit (a time series) or none (a section): its
-    records, the observables derived from them and the per-member state.
+    records, the observables derived from them and the per-member state; ``states``: a time
+    series that also keeps the SI state at every sample (``time_series(states=True)``).
 
     Counts only, no arrays of that size are made, so absurd requests cost nothing."""
     members = float(members)
@@ -82,16 +98,22 @@ def estimate_bytes(members, orbits, samples_per_orbit=None, window_orbits=16, wi
     buffer_rows = window_orbits + BUFFER_SLACK + \
         (math.ceil(window_orbits * samples_per_orbit) + BUFFER_SLACK if samples_per_orbit else 1)
     running = (buffer_rows * width * 8 + RUN_MEMBER_BYTES) * members + total_rows * width * 8
-    return max(derived, running) + chunks
+    # with states: after the observables, the state rows of every sample (module docstring)
+    kept = 0.0
+    if states and samples_per_orbit is not None:
+        largest = float(np.max(rows)) if np.ndim(rows) else float(rows)
+        kept = STATES_ROW_BYTES * total_rows + STATES_MEMBER_ROW_BYTES * largest \
+            + MEMBER_BYTES * members
+    return max(derived, running, kept) + chunks
 
 
 def check_memory(what, members, orbits, samples_per_orbit=None, window_orbits=16,
                  advice="use fewer members or orbits, or sample less densely", available=None,
-                 width=31):
+                 width=31, states=False):
     """:func:`~ti_spinorbit._validate.require_memory` for :func:`estimate_bytes`: raises
     InsufficientMemoryError (a ValueError and a MemoryError) with "<what> needs X GiB, Y GiB
     available; <advice>". Returns the estimate in bytes."""
-    nbytes = estimate_bytes(members, orbits, samples_per_orbit, window_orbits, width)
+    nbytes = estimate_bytes(members, orbits, samples_per_orbit, window_orbits, width, states)
     return require_memory(what, nbytes, advice, available=available)
 
 
@@ -135,4 +157,4 @@ def describe(nbytes):
 
 
 __all__ = ["estimate_bytes", "check_memory", "member_count", "record_rows", "ROW_BYTES",
-           "MEMBER_BYTES"]
+           "MEMBER_BYTES", "STATES_ROW_BYTES"]

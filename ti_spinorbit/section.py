@@ -62,7 +62,7 @@ def _check_run_inputs(rtol, atol, order, progress, window_orbits):
 
 
 def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None,
-               model="auto", perturbed=False):
+               model="auto", perturbed=False, states=False):
     """Refuse a run whose estimated peak memory (``resources.estimate_bytes``) exceeds what
     is available, from the input sizes alone: before any member is built. Inputs that do
     not broadcast are left to :func:`build_members`, which names them."""
@@ -73,7 +73,8 @@ def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None
     n = None if systems is None else resources.member_count(systems, theta_p, thetadot_p)
     if n is not None:
         resources.check_memory(what, n, orbits, samples_per_orbit,
-                               width=resources.record_width(system, model, perturbed))
+                               width=resources.record_width(system, model, perturbed),
+                               states=states)
 
 
 def _system_argument(system):
@@ -191,15 +192,17 @@ def state_members(system: SystemLike, initial_states, escape_distance=ESCAPE_DIS
 
 
 def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordinates, order,
-             initial_states, samples_per_orbit=None, model="auto", perturbed=False):
+             initial_states, samples_per_orbit=None, model="auto", perturbed=False,
+             states=False):
     """The member table of an entry point, from (θ_p, θ̇_p) or from ``initial_states``,
-    after the memory check (``perturbed``: the records carry the accumulators too)."""
+    after the memory check (``perturbed``: the records carry the accumulators too;
+    ``states``: a time series keeping the state rows, ``resources.estimate_bytes``)."""
     if initial_states is None:
         if theta_p is None and thetadot_p is None:     # one None: build_members names it
             raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
                             "initial_states=[InitialState, ...]")
         check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit, model,
-                   perturbed)
+                   perturbed, states)
         return build_members(system, theta_p, thetadot_p, escape_distance, coordinates, order)
     if theta_p is not None or thetadot_p is not None:
         raise ValueError(f"{what}: give theta_p and thetadot_p or initial_states, not both")
@@ -209,7 +212,8 @@ def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordin
     count = 1 if not isinstance(initial_states, (list, tuple, np.ndarray)) else len(initial_states)
     if count == 0:
         raise ValueError("initial_states must hold at least one InitialState")
-    check_size(what, system, np.zeros(count), 0.0, orbits, samples_per_orbit, "3d", perturbed)
+    check_size(what, system, np.zeros(count), 0.0, orbits, samples_per_orbit, "3d", perturbed,
+               states)
     return state_members(system, initial_states, escape_distance)
 
 
@@ -681,8 +685,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     perturbations = check_perturbations(perturbations)
     members, par, y0, tp, td = _members("time_series", system, theta_p, thetadot_p, orbits,
                                         escape_distance, coordinates, order, initial_states,
-                                        samples_per_orbit * (2 if states else 1), model,
-                                        bool(perturbations))
+                                        samples_per_orbit, model, bool(perturbations),
+                                        states)
     ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
                    perturbation_rows=perturbation_rows(members, perturbations))
     with _progress.reporting(progress, "time_series") as report:
