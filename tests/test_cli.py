@@ -407,7 +407,8 @@ def test_default_names_carry_the_perturbations(argv, stem):
     (["--byorp", "1e-3", "--heliocentric", "1", "1"],
      "--heliocentric E must lie in [0, 1) (got 1)"),
     (["--system", "test", "--yorp", "1e-3"],
-     "--yorp: no heliocentric orbit is catalogued for 'test': pass --heliocentric A_AU E"),
+     "--yorp: 'test' has no heliocentric orbit: pass --heliocentric A_AU E, or give the "
+     "system file heliocentric_a_au and heliocentric_e"),
     (["--tide", "both"], "argument --tide: invalid choice: 'both'"),
     (["--tide-radius", "150"], "--tide-radius needs --tide primary|secondary"),
     (["--yorp-radius", "150"], "--yorp-radius needs --yorp (the YORP coefficient)"),

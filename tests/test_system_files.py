@@ -72,8 +72,11 @@ def python_error(path, error=ValueError):
     (lambda d: d.update(primary_spin_period=9000.0), "primary_spin_period",
      "the system description", "did you mean 'primary_spin_period_s'?"),
     (lambda d: d.update(eccentricity=0.1), "eccentricity", "the system description",
+     "did you mean 'e'?"),
+    (lambda d: d.update(zzz=0.1), "zzz", "the system description",
      "the keys are 'name', 'primary', 'secondary', 'a_m', 'e', 'primary_spin_period_s', "
-     "'mean_motion_rad_s', 'mass_ratio', 'omega0', 'orbital_period_h', 'density_scale'"),
+     "'heliocentric_a_au', 'heliocentric_e', 'mean_motion_rad_s', 'mass_ratio', 'omega0', "
+     "'orbital_period_h', 'density_scale'"),
     (lambda d: d["secondary"].update(mass=1e11), "mass", "'secondary'", "did you mean 'mass_kg'?"),
     (lambda d: d["primary"].update(semi_axes=[600, 600, 600]), "semi_axes", "'primary'",
      "did you mean 'semi_axes_m'?"),
@@ -168,7 +171,7 @@ def test_an_ellipsoids_bounding_radius_is_derived_and_all_mismatches_are_named_a
     longer = tso.BinarySystem(vh.primary, tso.Ellipsoid(320.0, *vh.secondary.semi_axes[1:],
                                                         mass=vh.secondary.mass,
                                                         name=vh.secondary.name), vh.a, vh.e,
-                              name=vh.name)
+                              name=vh.name, heliocentric_orbit=vh.heliocentric_orbit)
     expected = (f"--system: '{path}': secondary bounding_radius_m is "
                 f"{vh.secondary.bounding_radius:.12g} in the description, but its semi_axes_m "
                 "give 320 (an ellipsoid's is its largest semi-axis); omega0 is "

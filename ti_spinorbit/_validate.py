@@ -35,6 +35,22 @@ MIN_DENSITY, MAX_DENSITY = 1.0, 1e5
 #: ratio, 250, is below 24² = 576, so a period typed in hours for days, or seconds for hours
 #: (3600²), always lands outside.
 MIN_BULK_DENSITY, MAX_BULK_DENSITY = 100.0, 25000.0
+#: Semimajor axis of a binary's heliocentric orbit, AU: inside Mercury's orbit to the
+#: inner Oort cloud.
+HELIOCENTRIC_A_RANGE = (0.05, 1e4)
+
+
+def check_heliocentric(a_au, e, names=("heliocentric_a_au", "heliocentric_e")):
+    """(a in AU, e) of a heliocentric orbit as floats, each checked and named, or ValueError;
+    both None gives (None, None), one of them alone is refused."""
+    if (a_au is None) != (e is None):
+        raise ValueError(f"give both {names[0]} (AU) and {names[1]}, or neither")
+    if a_au is None:
+        return None, None
+    return (require_positive_scalar(names[0], a_au, *HELIOCENTRIC_A_RANGE, "AU"),
+            float(require_range(names[1], require_real(names[1], e), 0.0, 1.0)))
+
+
 #: Lengths of a body (semi-axes, radius, bounding radius), m: a millimetre to ten solar radii.
 MIN_LENGTH, MAX_LENGTH = 1e-3, 1e10
 #: Mass of a body, kg: a microgram to 5e4 solar masses.
@@ -67,13 +83,23 @@ def show(value, limit=80):
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
+#: Words for a system file's keys -> the key (refuse_unknown_keys' suggestion).
+KEY_SYNONYMS = {"eccentricity": "e", "ecc": "e", "a": "a_m", "semimajor_axis": "a_m",
+                "semimajor_axis_m": "a_m", "mass": "mass_kg", "radius": "bounding_radius_m",
+                "semi_axes": "semi_axes_m", "axes": "semi_axes_m"}
+
+
 def refuse_unknown_keys(mapping, valid, where):
     """Raise ValueError on the first key of ``mapping`` not in ``valid``, naming it, ``where``
     it is (e.g. "'secondary'") and the nearest valid key (``difflib.get_close_matches``), or
     the valid keys when none is near: a misspelt key is refused rather than ignored."""
     for key in mapping:
         if key not in valid:
-            close = difflib.get_close_matches(str(key), list(valid), n=1, cutoff=0.6)
+            # words people type for a key, which spelling similarity would map elsewhere
+            # ("eccentricity" is nearest to "heliocentric_e")
+            named = KEY_SYNONYMS.get(str(key).lower())
+            close = [named] if named in valid else \
+                difflib.get_close_matches(str(key), list(valid), n=1, cutoff=0.6)
             hint = (f"did you mean {close[0]!r}?" if close else
                     f"the keys are {', '.join(map(repr, valid))}")
             raise ValueError(f"unknown key {show(key)} in {where}: {hint} (unknown keys are "

@@ -84,7 +84,8 @@ def _system(key, d, e, elongation, secondary_density):
         primary = Ellipsoid(*p["semi_axes_m"], p["density"], name="test primary")
         secondary = Ellipsoid(*d["secondary_semi_axes_m"], d["rho_s"], name="test secondary")
         return BinarySystem(primary, secondary, d["a_m"], e,
-                            primary_spin_period=d["primary_spin_period_h"] * HOUR, name="test")
+                            primary_spin_period=d["primary_spin_period_h"] * HOUR, name="test",
+                            heliocentric_orbit=heliocentric_orbit(key))
     q = d["elongation"] if elongation is None else elongation
     require_range("elongation", q, 1.0, 10.0, high_open=False)
     rho_s = d["rho_s"] if secondary_density is None else secondary_density
@@ -96,7 +97,8 @@ def _system(key, d, e, elongation, secondary_density):
     mass_s = rho_s * 4.0 / 3.0 * math.pi * d["ab"] * c_s
     primary = Sphere(d["R_p"], d["rho_p"], name=f"{key} primary")
     secondary = Ellipsoid(a_s, b_s, c_s, mass=mass_s, name=f"{key} secondary")
-    return BinarySystem(primary, secondary, d["a_m"], e, name=key)
+    return BinarySystem(primary, secondary, d["a_m"], e, name=key,
+                        heliocentric_orbit=heliocentric_orbit(key))
 
 
 def secondary_spin_period(name):

@@ -684,7 +684,10 @@ def _check_perturbation_flags(args):
             p.block(system)
         except ValueError as exc:
             text = _one_line(exc).replace("pass heliocentric_a_au (AU) and heliocentric_e to "
-                                          "YORP / BYORP", "pass --heliocentric A_AU E")
+                                          "YORP / BYORP, or give the system "
+                                          "heliocentric_orbit=(a_AU, e)",
+                                          "pass --heliocentric A_AU E, or give the system "
+                                          "file heliocentric_a_au and heliocentric_e")
             text = text.replace("pass radius= (m) to the perturbation", f"give {flag}-radius M")
             raise ValueError(f"{flag}: {text}") from None
 

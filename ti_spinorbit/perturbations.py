@@ -41,7 +41,9 @@ from typing import Optional
 import numpy as np
 
 from .constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, K2_MODELS, L_SUN
-from ._validate import require_positive_scalar, require_range, require_real, show
+from ._validate import HELIOCENTRIC_A_RANGE as _HELIOCENTRIC_A_RANGE
+from ._validate import (check_heliocentric, require_positive_scalar, require_range,
+                        require_real, show)
 from .layout import perturbation as _layout
 
 #: The kernels' perturbation block, its accumulators (work, L_ext x, y, z) and the
@@ -68,7 +70,7 @@ COEFFICIENT_LIMIT = 1.0               # |f_Y|, |B|
 SPIN_CHANGE_LIMIT = 10.0              # n per orbit
 ORBIT_CHANGE_LIMIT = 0.1              # relative change of a per orbit
 TIDE_FORCE_LIMIT = 0.1                # conservative tide / mutual gravity at pericentre
-HELIOCENTRIC_A_RANGE = (0.05, 1e4)    # AU
+HELIOCENTRIC_A_RANGE = _HELIOCENTRIC_A_RANGE   # AU (ti_spinorbit._validate)
 #: YORP torque conventions: name -> (k, turns). The torque is T = f_Y R³ L_⊙ /
 #: (k c d² sqrt(1 − e_⊙²)) and ``turns`` the rotations of the body per mutual orbit whose
 #: work 2π turns T is the paper's δE_YORP (docs/physics.md §13.2).
@@ -139,16 +141,14 @@ def body_radius(system, body, radius=None):
 
 
 def _heliocentric(system, a_au, e):
-    """(d in m, e_⊙) of the binary's heliocentric orbit: given, or catalogued."""
+    """(d in m, e_⊙) of the binary's heliocentric orbit: given to the perturbation, else the
+    system's own (``BinarySystem.heliocentric_orbit``; never looked up by name)."""
     if a_au is None:
-        from .catalog import heliocentric_orbit
-        try:
-            orbit = heliocentric_orbit(getattr(system, "name", ""))
-        except (TypeError, ValueError):      # a system of your own: not in the catalogue
-            orbit = None
+        orbit = getattr(system, "heliocentric_orbit", None)
         if orbit is None:
-            raise ValueError(f"no heliocentric orbit is catalogued for {system.name!r}: pass "
-                             "heliocentric_a_au (AU) and heliocentric_e to YORP / BYORP")
+            raise ValueError(f"{system.name!r} has no heliocentric orbit: pass "
+                             "heliocentric_a_au (AU) and heliocentric_e to YORP / BYORP, or "
+                             "give the system heliocentric_orbit=(a_AU, e)")
         a_au, e = orbit
     return a_au * AU, (0.0 if e is None else e)
 
@@ -398,13 +398,7 @@ def _check_signed(name, value, limit):
 
 
 def _check_heliocentric(a_au, e):
-    if a_au is not None:
-        require_positive_scalar("heliocentric_a_au", a_au, *HELIOCENTRIC_A_RANGE, "AU")
-    if e is not None:
-        require_real("heliocentric_e", e)
-        require_range("heliocentric_e", e, 0.0, 1.0)
-    if (a_au is None) != (e is None):
-        raise ValueError("give both heliocentric_a_au (AU) and heliocentric_e, or neither")
+    check_heliocentric(a_au, e)
 
 
 def check_perturbations(perturbations):

@@ -16,14 +16,15 @@ The state is fully 3-D even though these starts are planar.
 import math
 import warnings
 from dataclasses import dataclass, field
-from typing import Optional
+from typing import Optional, Tuple
 
 import numpy as np
 
 from ._validate import (MAX_BULK_DENSITY, MAX_MASS, MAX_MASS_RATIO, MAX_PRIMARY_SPIN,
                         MAX_SEMIMAJOR_AXIS, MIN_BULK_DENSITY, MIN_LENGTH, MIN_MASS,
-                        MIN_MOMENT_RATIO, refuse_unknown_keys, require_finite,
-                        require_positive_scalar, require_range, require_real, show)
+                        MIN_MOMENT_RATIO, check_heliocentric, refuse_unknown_keys,
+                        require_finite, require_positive_scalar, require_range, require_real,
+                        show)
 from .bodies import Body
 from . import display as _display
 
@@ -77,7 +78,13 @@ class BinarySystem(_display.Readable):
         spherical primary); negative for retrograde spin. Its rate 2π/|P| may be at most
         1e5 n (``MAX_PRIMARY_SPIN``): |P| >= orbital period / 1e5.
     name : str
-        Label used in plots and saved files.
+        Label used in plots and saved files. Only a label: nothing is looked up by it.
+    heliocentric_orbit : (float, float), optional
+        (a in AU, e) of the binary's heliocentric orbit, a in [0.05, 1e4] AU
+        (``HELIOCENTRIC_A_RANGE``), 0 <= e < 1: the distance from the Sun that YORP and
+        BYORP use (:mod:`ti_spinorbit.perturbations`). The catalogue fills it where the
+        orbit is known (``catalog.heliocentric_orbit``); None (default) for a system of your
+        own, whatever its name, until you give it.
     orbital_period : float, optional
         Observed orbital period of the mutual orbit, s (positive, finite), e.g. 11.92 h =
         42912 s for Didymos-Dimorphos. When given, both bodies' masses (hence densities; shapes
@@ -113,6 +120,7 @@ class BinarySystem(_display.Readable):
     e: float
     primary_spin_period: Optional[float] = None
     name: str = "binary"
+    heliocentric_orbit: Optional[Tuple[float, float]] = None
     density_scale: float = field(default=1.0, init=False, compare=False)
 
     def __post_init__(self):
@@ -125,6 +133,13 @@ class BinarySystem(_display.Readable):
         require_range("e", self.e, 0.0, 1.0)
         if not isinstance(self.name, str):
             raise TypeError(f"name must be a string (got {show(self.name)})")
+        if self.heliocentric_orbit is not None:
+            orbit = self.heliocentric_orbit
+            if not isinstance(orbit, (tuple, list)) or len(orbit) != 2:
+                raise TypeError(f"heliocentric_orbit must be (a in AU, e) or None (got "
+                                f"{show(orbit)})")
+            object.__setattr__(self, "heliocentric_orbit", check_heliocentric(
+                *orbit, names=("heliocentric_orbit a", "heliocentric_orbit e")))
         ratio = self.primary.mass / self.secondary.mass
         if not 1.0 / MAX_MASS_RATIO <= ratio <= MAX_MASS_RATIO:
             raise ValueError(f"mass ratio m1/m2 must lie in [{1 / MAX_MASS_RATIO:g}, "
@@ -312,7 +327,9 @@ class BinarySystem(_display.Readable):
         return {"name": self.name, "primary": body(self.primary), "secondary": body(self.secondary),
                 "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
                 "mean_motion_rad_s": self.mean_motion, "mass_ratio": self.mass_ratio,
-                "omega0": self.omega0, "orbital_period_h": self.orbital_period / 3600.0}
+                "omega0": self.omega0, "orbital_period_h": self.orbital_period / 3600.0,
+                **({} if self.heliocentric_orbit is None else
+                   dict(zip(("heliocentric_a_au", "heliocentric_e"), self.heliocentric_orbit)))}
 
     @classmethod
     def from_description(cls, d: dict) -> "BinarySystem":
@@ -360,7 +377,10 @@ class BinarySystem(_display.Readable):
         system = cls(primary, secondary, require_real("a_m", d["a_m"]), require_real("e", d["e"]),
                      primary_spin_period=None if period is None else
                      require_real("primary_spin_period_s", period),
-                     name=d.get("name", "binary"))
+                     name=d.get("name", "binary"),
+                     heliocentric_orbit=None if "heliocentric_a_au" not in d and
+                     "heliocentric_e" not in d else
+                     check_heliocentric(d.get("heliocentric_a_au"), d.get("heliocentric_e")))
         _check_derived_entries(d, system, mismatches)
         if "density_scale" in d:
             scale = require_real("density_scale", d["density_scale"])
@@ -396,7 +416,8 @@ class BinarySystem(_display.Readable):
 #: earlier versions wrote it, 1) and of each of its bodies (io.describe_system adds
 #: "integrals"): any other key is refused, not ignored.
 SYSTEM_KEYS = ("name", "primary", "secondary", "a_m", "e", "primary_spin_period_s",
-               "mean_motion_rad_s", "mass_ratio", "omega0", "orbital_period_h", "density_scale")
+               "heliocentric_a_au", "heliocentric_e", "mean_motion_rad_s", "mass_ratio",
+               "omega0", "orbital_period_h", "density_scale")
 BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals")
 #: Relative tolerance of a derived entry against its value recomputed from the inputs: the
 #: package writes them unrounded (JSON keeps every bit), so only an edit differs.
@@ -589,9 +610,10 @@ def _volume(body: Body) -> float:
 
 
 def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, name="binary",
-                      *, orbital_period=None):
+                      heliocentric_orbit=None, *, orbital_period=None):
     if orbital_period is None:
-        return _dataclass_init(self, primary, secondary, a, e, primary_spin_period, name)
+        return _dataclass_init(self, primary, secondary, a, e, primary_spin_period, name,
+                               heliocentric_orbit)
     require_real("orbital_period", orbital_period)
     require_positive_scalar("orbital_period", orbital_period, 0.0, math.inf, "s")
     for label, body in (("primary", primary), ("secondary", secondary)):
@@ -622,7 +644,7 @@ def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, 
                 f"orbital_period {period:.6g} s scales both masses by {factor:.6g}, which makes "
                 f"the {label}'s {mass:.6g} kg, outside [{MIN_MASS:g}, {MAX_MASS:g}] kg")
     scaled = [_scaled_body(b, factor) for b in (primary, secondary)]
-    _dataclass_init(self, *scaled, a, e, primary_spin_period, name)
+    _dataclass_init(self, *scaled, a, e, primary_spin_period, name, heliocentric_orbit)
     object.__setattr__(self, "density_scale", factor)
 
 
