@@ -29,6 +29,7 @@ from . import progress as _progress
 from ._validate import (_as_floats, require_positive, require_real,
                         require_spin, show)
 from .classify import MIN_POINTS, classify_section
+from .convergence import run_lengths
 from .coordinates import check_coordinates
 from .distributed import sections
 from .section import INDICATOR_SPACE, SectionResult, check_orbits
@@ -304,31 +305,26 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     started = compiling.Stopwatch()          # compile time left out of seconds
     # the shorter lengths first, each dropped after its fraction: the peak memory stays
     # that of the map itself
-    fractions = []
-    work = float(sum(shorter)) + float(orbits)        # progress: each length its share
-    done = 0.0
+    lengths = shorter + [float(orbits)]
+
+    def stage(k, length, share):
+        section = sections(client, system, grid_tp, grid_td, length, chunk_size=chunk_size,
+                           rtol=rtol, indicators=True, model=model, max_drift=max_drift,
+                           coordinates=coordinates, progress=share, **section_kwargs,
+                           **launches.next())
+        if k == len(lengths) - 1:
+            return section                # the map itself
+        return _chaotic_fraction(_labels(section, megno_chaotic, length), section.status,
+                                 include_inaccurate)   # the section is dropped at once
+
     with launches.owned(), _progress.reporting(progress, "chaos_map") as report:
-        for length in shorter:
-            short = sections(client, system, grid_tp, grid_td, length, chunk_size=chunk_size, rtol=rtol,
-                             indicators=True, model=model, max_drift=max_drift,
-                             coordinates=coordinates,
-                             progress=_progress.stage(report, done / work, length / work),
-                             **section_kwargs, **launches.next())
-            done += float(length)
-            fractions.append(_chaotic_fraction(_labels(short, megno_chaotic, length),
-                                               short.status, include_inaccurate))
-            del short
-        section = sections(client, system, grid_tp, grid_td, orbits, chunk_size=chunk_size,
-                           rtol=rtol, indicators=True,
-                           progress=_progress.stage(report, done / work, orbits / work),
-                           model=model, max_drift=max_drift, coordinates=coordinates,
-                           **section_kwargs, **launches.next())
+        *fractions, section = run_lengths(lengths, stage, report).outcomes
     classes = _classified(section, megno_chaotic, orbits)
     labels = classes.classification
     attitude_class = _attitude_classes(section, classes)
     seconds = started.seconds()
     full = _chaotic_fraction(labels, section.status, include_inaccurate)
-    evidence = fraction_evidence(shorter + [float(orbits)], fractions + [full])
+    evidence = fraction_evidence(lengths, fractions + [full])
     shape = tp.shape
     return ChaosMap(
         theta_p=theta_p, thetadot_p=thetadot_p, megno=section.megno.reshape(shape),
@@ -566,31 +562,25 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
                                    for j in range(shape[1])] for i in range(shape[0])])
 
     started = compiling.Stopwatch()          # compile time left out of seconds
-    by_length = []
-    work = float(sum(shorter)) + float(orbits)        # progress: each length its share
-    done = 0.0
-    with launches.owned(), _progress.reporting(progress, "parameter_map") as report:
-        for length in shorter:            # first, each dropped after use (as chaos_map)
-            short = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
-                             length, chunk_size=chunk_size, rtol=rtol, indicators=True,
-                             model=model, max_drift=max_drift, coordinates=coordinates,
-                             progress=_progress.stage(report, done / work, length / work),
-                             **section_kwargs, **launches.next())
-            done += float(length)
-            by_length.append(fractions_of(short, length)[2])
-            del short
+    lengths = shorter + [float(orbits)]
+
+    def stage(k, length, share):
         section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
-                           orbits, chunk_size=chunk_size, rtol=rtol, indicators=True,
-                           progress=_progress.stage(report, done / work, orbits / work),
+                           length, chunk_size=chunk_size, rtol=rtol, indicators=True,
                            model=model, max_drift=max_drift, coordinates=coordinates,
-                           **section_kwargs, **launches.next())
+                           progress=share, **section_kwargs, **launches.next())
+        # the shorter lengths first, each dropped after its fractions (as chaos_map)
+        return section if k == len(lengths) - 1 else fractions_of(section, length)[2]
+
+    with launches.owned(), _progress.reporting(progress, "parameter_map") as report:
+        *by_length, section = run_lengths(lengths, stage, report).outcomes
     seconds = started.seconds()
     labels, status, fraction = fractions_of(section, orbits)
     by_length = np.array(by_length + [fraction])
     with np.errstate(invalid="ignore"):
         steps = np.diff(by_length, axis=0)
     monotone = np.all(~(steps < 0), axis=0)          # NaN steps do not count as drops
-    lengths = np.array(shorter + [float(orbits)])
+    lengths = np.array(lengths)
     message = (f"chaotic fraction at {', '.join(f'{L:g}' for L in lengths)} orbits: "
                + ("never decreases at any grid point" if monotone.all() else
                   f"decreases at {int((~monotone).sum())} of {monotone.size} grid points "

@@ -48,6 +48,7 @@ from . import progress as _progress
 from .classify import horizontal_extent
 from ._validate import (require_bool, require_count, require_positive,
                         require_real, require_scalar, require_spin)
+from .convergence import run_lengths
 from .ensemble import check_tolerances
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
@@ -441,30 +442,35 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
             planned.append(planned[-1] * 2.0)
         tight_work = planned[-1] * 10 ** 0.2 if converge and len(planned) > 1 else 0.0
         work = sum(planned) + tight_work
-        base = _search(system, orbits, rtol, candidates,
-                       progress=_progress.stage(report, 0.0, planned[0] / work), **search)
-        if not converge:
-            return base
-        started = compiling.Stopwatch(already=base.seconds)   # compile time left out
-        # the checks start bracketed around the centre found: the coarse scan is not repeated
-        spacing = float(np.max(np.diff(base.candidates[0])))
-        bracket = base.centre_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
-        lengths, centres, amplitudes = [float(orbits)], [base.centre_thetadot_p], [base.amplitude]
-        in_orbits = False
-        last = base
-        while lengths[-1] * 2.0 <= cap * (1 + 1e-12):
+        # the base search, then the doublings until centre and amplitude stop changing
+        started = bracket = None
+
+        def stage(k, length, share):
+            nonlocal started, bracket
+            if k == 0:
+                base = _search(system, length, rtol, candidates, progress=share, **search)
+                started = compiling.Stopwatch(already=base.seconds)   # compile time left out
+                # the checks start bracketed around the centre found: the coarse scan is not
+                # repeated
+                spacing = float(np.max(np.diff(base.candidates[0])))
+                bracket = base.centre_thetadot_p + spacing * np.linspace(-4.0, 4.0, 9)
+                return base
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)   # summarised in the message
-                last = _search(system, lengths[-1] * 2.0, rtol, bracket,
-                               progress=_progress.stage(report, sum(lengths) / work,
-                                                        2.0 * lengths[-1] / work), **search)
-            lengths.append(lengths[-1] * 2.0)
-            centres.append(last.centre_thetadot_p)
-            amplitudes.append(last.amplitude)
-            if abs(centres[-1] - centres[-2]) <= centre_tol and \
-                    abs(amplitudes[-1] - amplitudes[-2]) <= amplitude_tol:
-                in_orbits = True
-                break
+                return _search(system, length, rtol, bracket, progress=share, **search)
+
+        def settled(a, b):
+            return abs(b.centre_thetadot_p - a.centre_thetadot_p) <= centre_tol and \
+                abs(b.amplitude - a.amplitude) <= amplitude_tol
+
+        ladder = run_lengths(planned, stage, report, settled, extra_work=tight_work)
+        base = ladder.outcomes[0]
+        if not converge:
+            return base
+        lengths = ladder.lengths
+        centres = [r.centre_thetadot_p for r in ladder.outcomes]
+        amplitudes = [r.amplitude for r in ladder.outcomes]
+        in_orbits = ladder.settled
         tight = float(rtol) / 10.0
         in_tol, c_tol, a_tol = False, float("nan"), float("nan")
         if tight >= 1e-16 and len(lengths) > 1:

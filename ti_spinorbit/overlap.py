@@ -51,6 +51,7 @@ from ._validate import (_as_floats, require_count, require_range,
                         require_scalar, show)
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
+from .convergence import run_lengths
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
@@ -348,44 +349,42 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     geo_rows, megno_rows = [], []
     first_sec = None
     member_orbits = 0.0
-    converged_at = None
-    work = float(sum(lengths))          # progress: each length its share (all elongations)
+
+    def stage(step, length, share):
+        """One length: the elongations still "separate" (a connection seen at a shorter
+        length is a fact, a trajectory crossed both levels) integrated again, longer."""
+        nonlocal first_sec, member_orbits
+        todo = [k for k in range(q.size) if decisions[k] is None or not decisions[k].overlap]
+        if todo:
+            members, theta0, rates = [], [], []
+            for k in todo:
+                members += [systems[k]] * per
+                theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
+                rates += list(centre_rates) + list(sep_rates)
+            sec = sections(client, members, np.array(theta0), np.array(rates),
+                           orbits=length, progress=share, **run, **launches.next())
+            member_orbits += len(members) * float(length)
+            first_sec = sec if first_sec is None else first_sec
+            for j, k in enumerate(todo):
+                block = slice(j * per, (j + 1) * per)
+                decisions[k] = _decide(float(q[k]), systems[k], sec, block, centre_rates,
+                                       sep_rates, libration_limit, include_inaccurate)
+                decisions[k].orbits = float(length)
+                runs[k] = (sec, block)
+        geo_rows.append([d.overlap for d in decisions])
+        megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
+                           for d in decisions])
+        # a "separate" elongation where the MEGNO criterion already sees one chaotic layer is
+        # a slow connection the trajectories have not completed yet
+        return geo_rows[-1], any(d.megno_overlap and not d.overlap for d in decisions)
+
+    def settled(previous, current):
+        """The decisions no longer change with length, and none is still pending."""
+        return current[0] == previous[0] and not current[1]
+
     with launches.owned(), _progress.reporting(progress, "overlap_threshold") as report:
-        for step, length in enumerate(lengths):
-            # a connection seen at a shorter length is a fact (a trajectory crossed both levels):
-            # only elongations still "separate" are integrated again, longer
-            todo = [k for k in range(q.size) if decisions[k] is None or not decisions[k].overlap]
-            previous = [None if d is None else d.overlap for d in decisions]
-            if todo:
-                members, theta0, rates = [], [], []
-                for k in todo:
-                    members += [systems[k]] * per
-                    theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
-                    rates += list(centre_rates) + list(sep_rates)
-                share = _progress.stage(report, float(sum(lengths[:step])) / work,
-                                        float(length) / work)
-                sec = sections(client, members, np.array(theta0), np.array(rates),
-                               orbits=length, progress=share, **run,
-                               **launches.next())
-                member_orbits += len(members) * float(length)
-                first_sec = sec if first_sec is None else first_sec
-                for j, k in enumerate(todo):
-                    block = slice(j * per, (j + 1) * per)
-                    decisions[k] = _decide(float(q[k]), systems[k], sec, block, centre_rates,
-                                           sep_rates, libration_limit, include_inaccurate)
-                    decisions[k].orbits = float(length)
-                    runs[k] = (sec, block)
-            geo_rows.append([d.overlap for d in decisions])
-            megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
-                               for d in decisions])
-            # converged: the decisions no longer change with length, and no elongation is still
-            # "separate" where the MEGNO criterion already sees one chaotic layer (a slow
-            # connection the trajectories have not completed yet)
-            pending = [d.megno_overlap and not d.overlap for d in decisions]
-            if step > 0 and [d.overlap for d in decisions] == previous and not any(pending):
-                converged_at = float(length)
-                report(1.0)
-                break
+        ladder = run_lengths(lengths, stage, report, settled)
+    converged_at = ladder.lengths[-1] if ladder.settled else None
     overlaps = np.array([d.overlap for d in decisions])
     first = next((float(x) for x, o in zip(q, overlaps) if o), None)
     megno_first = next((float(x) for x, d in zip(q, decisions) if d.megno_overlap), None)
