@@ -336,3 +336,24 @@ def test_raw_markup_is_found():
     ax.set_ylabel("theta_p")
     ax.set_title("ω0^RO")
     assert sorted(plotting.raw_markup(fig)) == ["theta_p", "ω0^RO"]
+
+
+def test_a_loaded_overlap_scan_answers_as_the_fresh_one(tmp_path):
+    """No hidden state: a scan whose longer lengths integrated only some elongations plots
+    the same largest ⟨Y⟩ per elongation after save and load (each decision keeps it)."""
+    from ti_spinorbit.plotting import overlap_megno
+
+    scan = tso.overlap_threshold("1991 VH", elongations=[1.02, 1.3], orbits=4, max_orbits=8,
+                                 centre_starts=4, separatrix_starts=4, rtol=1e-8,
+                                 progress=False)
+    assert not [k for k in vars(scan) if k.startswith("_")]
+    tso.save(scan, tmp_path / "scan.npz")
+    loaded = tso.load(tmp_path / "scan.npz")
+    fresh = overlap_megno(scan)
+    np.testing.assert_array_equal(overlap_megno(loaded), fresh)
+    assert loaded.evidence() == scan.evidence() and repr(loaded) == repr(scan)
+    # each value is the largest finite <Y> of its elongation's block in its decision's run
+    assert np.all(np.isfinite(fresh)) and np.all(fresh >= 0)
+    first, block = scan.section_block(0)
+    if scan.decisions[0].orbits == scan.lengths[0]:
+        assert fresh[0] == np.nanmax(first.megno[block])

@@ -88,6 +88,9 @@ class OverlapDecision:
     megno_overlap: Optional[bool] = unit('bool', default=None)
     #: orbits of the run this decision comes from
     orbits: float = unit(ORBITS, default=float("nan"))
+    #: largest finite ⟨Y⟩ among this elongation's trajectories in that run (NaN: none, or
+    #: no indicators; None in files written before it was kept)
+    max_megno: Optional[float] = unit('1', default=None)
 
 
 @dataclass(repr=False)
@@ -151,11 +154,9 @@ class OverlapScan(Result, _display.Readable):
         return not self.converged
 
     def section_block(self, k):
-        """(SectionResult, member slice) of elongation k in the run its decision comes from
-        (only on a scan just computed; a loaded scan has ``sections`` = the first run)."""
-        runs = getattr(self, "_runs", None)
-        if runs:
-            return runs[k]
+        """(SectionResult, member slice) of elongation k in the first run (``sections``,
+        every elongation; longer runs integrate only the elongations still separate and are
+        not kept: each decision keeps what it needs, ``OverlapDecision.max_megno``)."""
         per = self.sections.count.size // len(self.elongations)
         return self.sections, slice(k * per, (k + 1) * per)
 
@@ -345,7 +346,6 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     lengths = _lengths(orbits, max_orbits)
     t0 = compiling.Stopwatch()           # compile time left out of seconds
     decisions = [None] * q.size
-    runs = [None] * q.size
     geo_rows, megno_rows = [], []
     first_sec = None
     member_orbits = 0.0
@@ -370,7 +370,6 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                 decisions[k] = _decide(float(q[k]), systems[k], sec, block, centre_rates,
                                        sep_rates, libration_limit, include_inaccurate)
                 decisions[k].orbits = float(length)
-                runs[k] = (sec, block)
         geo_rows.append([d.overlap for d in decisions])
         megno_rows.append([-1 if d.megno_overlap is None else int(d.megno_overlap)
                            for d in decisions])
@@ -402,7 +401,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
         if waiting:
             message += (f"; the MEGNO criterion already connects at a/b = "
                         f"{', '.join(waiting)}")
-    n_inaccurate = sum(accuracy.count(sec.status[block], "inaccurate") for sec, block in runs)
+    n_inaccurate = sum(d.inaccurate for d in decisions)   # each in the run it comes from
     scan = OverlapScan(rtol=float(rtol), name=name, eccentricity=e, elongations=q, overlaps=overlaps,
                        decisions=decisions, first_overlap=first, omega0_ro=w_ro,
                        elongation_ro=float(analytic.elongation_from_omega0(w_ro)),
@@ -418,7 +417,6 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                        megno_first_overlap=megno_first, member_orbits=member_orbits,
                        coordinates=coordinates, method=first_sec.method,
                        perturbations=perturbations)
-    scan._runs = runs
     return scan
 
 
@@ -501,7 +499,15 @@ def _decide(q, system, sec, block, centre_rates, sep_rates, libration_limit,
         else float("nan"),
         inaccurate=accuracy.count(sec.status[idx], "inaccurate"),
         max_energy_drift=float(np.nanmax(sec.energy_drift[idx], initial=0.0)),
-        megno_overlap=megno_connects(lo, hi, np.where(usable, megno, np.nan), c1, c32))
+        megno_overlap=megno_connects(lo, hi, np.where(usable, megno, np.nan), c1, c32),
+        max_megno=_max_megno(sec, idx))
+
+
+def _max_megno(sec, idx):
+    """Largest finite ⟨Y⟩ among the members ``idx`` of ``sec`` (NaN when none is finite)."""
+    megno = np.full(len(idx), np.nan) if sec.megno is None else \
+        np.asarray(sec.megno[idx], dtype=np.float64)
+    return float(np.nanmax(megno)) if np.isfinite(megno).any() else float("nan")
 
 
 def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):

@@ -281,18 +281,20 @@ def plot_parameter_map(pmap, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=
 
 
 def overlap_megno(scan):
-    """Largest finite ⟨Y⟩ among each elongation's trajectories (NaN where unknown: no
-    indicators, or the sections were not saved)."""
+    """Largest finite ⟨Y⟩ among each elongation's trajectories in the run its decision comes
+    from (``OverlapDecision.max_megno``; for files written before it was kept, from the
+    first run's sections), NaN where unknown: no indicators, or nothing saved."""
     import numpy as np
 
     out = np.full(len(scan.elongations), np.nan)
-    if scan.sections is None or scan.sections.megno is None:
-        return out
-    for k in range(len(out)):
-        sec, block = scan.section_block(k)
-        megno = np.asarray(sec.megno[block], dtype=np.float64)
-        if np.isfinite(megno).any():
-            out[k] = np.nanmax(megno)
+    for k, d in enumerate(scan.decisions):
+        if d.max_megno is not None:
+            out[k] = d.max_megno
+        elif scan.sections is not None and scan.sections.megno is not None:
+            sec, block = scan.section_block(k)
+            megno = np.asarray(sec.megno[block], dtype=np.float64)
+            if np.isfinite(megno).any():
+                out[k] = np.nanmax(megno)
     return out
 
 
