@@ -20,7 +20,7 @@ import numpy as np
 import ti_spinorbit as tso
 
 scan = tso.overlap_threshold("1991 VH", elongations=np.array([1.02, 1.04, 1.06, 1.08]),
-                             orbits=100, max_orbits=200, center_starts=8, separatrix_starts=8,
+                             orbits=100, max_orbits=200, centre_starts=8, separatrix_starts=8,
                              rtol=1e-10)
 print(scan)
 print("first overlap at a/b =", scan.first_overlap)

@@ -357,3 +357,32 @@ def test_a_loaded_overlap_scan_answers_as_the_fresh_one(tmp_path):
     first, block = scan.section_block(0)
     if scan.decisions[0].orbits == scan.lengths[0]:
         assert fresh[0] == np.nanmax(first.megno[block])
+
+
+def test_a_result_kind_is_declared_once_and_archives_read_it(tmp_path):
+    """A new result class needs no entry in io: its class statement registers the kind,
+    save and load work, and its SHAPES guard loading; a kind taken twice is refused."""
+    from ti_spinorbit.results import FLOAT, KINDS, Result, unit
+
+    @dataclasses.dataclass(repr=False)
+    class Toy(Result, kind="toy_result"):
+        SHAPES = {"values": (("n",), FLOAT)}
+        values: np.ndarray = unit("deg")
+        orbits: float = unit("orbital periods", default=1.0)
+
+    try:
+        assert KINDS["toy_result"] is Toy and Toy.kind == "toy_result"
+        toy = Toy(values=np.array([1.0, 2.5]))
+        tso.save(toy, tmp_path / "toy.npz")
+        back = tso.load(tmp_path / "toy.npz")
+        assert type(back) is Toy
+        np.testing.assert_array_equal(back.values, toy.values)
+        with pytest.raises(TypeError, match="result kind 'toy_result' is already Toy's"):
+            class Other(Result, kind="toy_result"):
+                pass
+        bad = Toy(values=np.array([[1.0]]))          # against its SHAPES
+        tso.save(bad, tmp_path / "bad.npz")
+        with pytest.raises(tso.io.ArchiveError, match="'values' has shape"):
+            tso.load(tmp_path / "bad.npz")
+    finally:
+        KINDS.pop("toy_result", None)

@@ -274,10 +274,17 @@ def test_overwrite_checkpoint_replaces_it(vh, ckpt, entry):
         assert_same(result, again)
     else:
         np.testing.assert_array_equal(result.megno, again.megno)
-    with np.load(ckpt / C.STATE) as d:
-        launches = json.loads(str(d["header"]))["launches"]
-    assert sorted(f for f in os.listdir(ckpt) if f.startswith("records-")) == \
-        [f"records-{k:06d}.npz" for k in range(launches)]        # no records of the old run
+    # a map checkpoints each of its lengths in launch-kkk: the old run's files in the
+    # directory itself go, and each launch holds only its own records
+    folders = [ckpt] if entry == "section" else sorted(ckpt.glob("launch-*"))
+    if entry != "section":
+        assert len(folders) == 3 and not (ckpt / C.STATE).exists()
+        assert not [f for f in os.listdir(ckpt) if f.startswith("records-")]
+    for folder in folders:
+        with np.load(folder / C.STATE) as d:
+            launches = json.loads(str(d["header"]))["launches"]
+        assert sorted(f for f in os.listdir(folder) if f.startswith("records-")) == \
+            [f"records-{k:06d}.npz" for k in range(launches)]    # no records of the old run
 
 
 def test_cli_refuses_overwrite_and_overwrites_on_request(ckpt, tmp_path):

@@ -260,3 +260,15 @@ def test_cli_map_killed_in_its_evidence_resumes_to_the_same_data(tmp_path):
     for name in ("megno", "lyapunov", "fraction_by_length", "status"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
     assert not (run / "ck").exists()         # removed once the outputs are written
+
+
+def test_a_single_run_and_a_staged_checkpoint_are_not_confused(vh, tmp_path):
+    single, staged = tmp_path / "single", tmp_path / "staged"
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=single,
+                           progress=False)
+    with pytest.raises(C.CheckpointError, match="holds a single run's checkpoint"):
+        chaos(vh, checkpoint=single, resume=True, progress=False)
+    chaos(vh, checkpoint=staged, progress=False)
+    with pytest.raises(C.CheckpointError, match=r"holds the launches \(launch-kkk\)"):
+        tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=staged,
+                               resume=True, progress=False)

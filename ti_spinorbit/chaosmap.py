@@ -39,6 +39,7 @@ from .attitude import CLASS_UNIT as ATTITUDE_CLASS
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result,
                       unit)
+from .results import FLOAT as _F, INTEGER as _I, BOOL as _B, TEXT as _S
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 #: Default starts per (a/b, e) of a parameter map: θ_p ∈ {0°, 90°} × θ̇_p/n in the 1:1-3:2 band.
@@ -113,7 +114,7 @@ def _mean_thetadot(section):
 
 
 @dataclass(repr=False)
-class ChaosMap(Result, _display.Readable):
+class ChaosMap(Result, _display.Readable, kind="chaos_map"):
     """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
     (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
 
@@ -125,6 +126,17 @@ class ChaosMap(Result, _display.Readable):
     members in the same C order); ``seconds`` wall time of the launch; ``coordinates`` the
     spin coordinate of ``thetadot_p`` and ``mean_thetadot`` ("inertial" or "apsidal",
     docs/physics.md §6.7)."""
+
+    # what a loaded file's arrays must look like (Result.SHAPES; k lengths)
+    SHAPES = {
+        "theta_p": (("theta_p",), _F), "thetadot_p": (("thetadot_p",), _F),
+        **{k: (("theta_p", "thetadot_p"), _F) for k in (
+            "megno", "lyapunov", "mean_thetadot", "energy_drift", "angmom_drift", "max_tilt")},
+        "status": (("theta_p", "thetadot_p"), _I),
+        "attitude_class": (("theta_p", "thetadot_p"), _I),
+        "classification": (("theta_p", "thetadot_p"), _S),
+        "fraction_lengths": (("k",), _F), "fraction_by_length": (("k",), _F),
+        "tilt": ((2,), _F)}
 
     theta_p: np.ndarray = unit('deg')
     thetadot_p: np.ndarray = unit(SPIN)
@@ -415,7 +427,7 @@ def _inaccurate_code():
 
 
 @dataclass(repr=False)
-class ParameterMap(Result, _display.Readable):
+class ParameterMap(Result, _display.Readable, kind="parameter_map"):
     """Chaotic fraction over elongation a/b × eccentricity e.
 
     ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
@@ -427,6 +439,21 @@ class ParameterMap(Result, _display.Readable):
     ``inaccurate`` the count of "inaccurate" starts per (a/b, e), excluded from
     ``chaotic_fraction`` unless ``include_inaccurate``; ``coordinates`` the spin coordinate
     of ``thetadot_p`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
+
+    # what a loaded file's arrays must look like (Result.SHAPES; k lengths)
+    SHAPES = {
+        "elongations": (("elongations",), _F), "eccentricities": (("eccentricities",), _F),
+        "theta_p": (("start",), _F), "thetadot_p": (("start",), _F),
+        "omega0": (("elongations",), _F),
+        "chaotic_fraction": (("elongations", "eccentricities"), _F),
+        **{k: (("elongations", "eccentricities", "start"), _F)
+           for k in ("megno", "energy_drift", "angmom_drift")},
+        "classification": (("elongations", "eccentricities", "start"), _S),
+        "status": (("elongations", "eccentricities", "start"), _I),
+        "inaccurate": (("elongations", "eccentricities"), _I),
+        "fraction_monotone": (("elongations", "eccentricities"), _B),
+        "fraction_lengths": (("k",), _F),
+        "fraction_by_length": (("k", "elongations", "eccentricities"), _F)}
 
     elongations: np.ndarray = unit('1 (a/b)')
     eccentricities: np.ndarray = unit('1')

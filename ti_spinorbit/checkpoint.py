@@ -422,6 +422,10 @@ def load(path, settings, fingerprint):
     if not holds_checkpoint(path):
         _refuse_foreign(path)
         return None            # killed before its first state: start afresh
+    if not os.path.isfile(os.path.join(path, STATE)):
+        raise CheckpointError(f"checkpoint {path!r} holds the launches (launch-kkk) of a "
+                              "computation of several launches (a map, scan or libration "
+                              "search), not a single run's checkpoint; use another path")
     arrays = _read(os.path.join(path, STATE), STATE, ("header", "records_sha256") + _ARRAYS)
     try:
         header = json.loads(str(arrays.pop("header")))
@@ -543,6 +547,11 @@ class Launches:
                                       "directory of launch checkpoints; choose another path "
                                       "or delete it")
             check_target(self.directory, self.resume, self.overwrite)
+            if self.resume and os.path.isfile(os.path.join(self.directory, STATE)):
+                raise CheckpointError(
+                    f"checkpoint {self.directory!r} holds a single run's checkpoint "
+                    f"({STATE}), not the launches of a computation of several; resume it "
+                    "with the entry point that wrote it, or use another path")
 
     @contextlib.contextmanager
     def owned(self):

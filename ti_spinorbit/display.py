@@ -253,21 +253,31 @@ def _libration(r):
     return "RelaxedLibration", lines
 
 
-_SUMMARIES = {"Body": _body, "BinarySystem": _system, "SectionResult": _section,
-              "TimeSeriesResult": _time_series, "ChaosMap": _chaos_map,
-              "ParameterMap": _parameter_map, "OverlapScan": _overlap,
-              "RelaxedLibration": _libration}
+#: Summaries of the inputs, by class name (a class or one of its bases).
+_SUMMARIES = {"Body": _body, "BinarySystem": _system}
+#: Summaries of results, by the kind each result class declares (``Result.kind``).
+_RESULT_SUMMARIES = {"section": _section, "time_series": _time_series,
+                     "chaos_map": _chaos_map, "parameter_map": _parameter_map,
+                     "overlap_scan": _overlap, "relaxed_libration": _libration}
+
+
+def _summary_of(obj):
+    kind = getattr(type(obj), "kind", "")
+    if kind in _RESULT_SUMMARIES:
+        return _RESULT_SUMMARIES[kind]
+    return next((_SUMMARIES[c.__name__] for c in type(obj).__mro__ if c.__name__ in _SUMMARIES),
+                None)
 
 
 def summary(obj):
     """(title, lines): each line a list of (label, value) strings."""
-    for cls in type(obj).__mro__:
-        if cls.__name__ in _SUMMARIES:
-            title, lines = _SUMMARIES[cls.__name__](obj)
-            if getattr(obj, "perturbations", None):     # tides / YORP / BYORP in the equations
-                lines = list(lines) + [[("perturbations", _perturbations(obj.perturbations))]]
-            return title, lines
-    raise TypeError(f"no summary for {type(obj).__name__}")
+    summarise = _summary_of(obj)
+    if summarise is None:
+        raise TypeError(f"no summary for {type(obj).__name__}")
+    title, lines = summarise(obj)
+    if getattr(obj, "perturbations", None):     # tides / YORP / BYORP in the equations
+        lines = list(lines) + [[("perturbations", _perturbations(obj.perturbations))]]
+    return title, lines
 
 
 def _perturbations(items):

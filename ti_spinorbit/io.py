@@ -42,6 +42,7 @@ import zipfile
 import numpy as np
 
 from . import perturbations, runtime
+from . import results as _results
 from .files import atomic_write
 from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 
@@ -66,29 +67,21 @@ ARCHIVE_UNITS = {"status_names": "name", "system_index": "index into metadata sy
 
 
 def _kinds():
-    """kind name -> result class (imported here: io must not import the heavy modules first)."""
-    from .chaosmap import ChaosMap, ParameterMap
-    from .libration import RelaxedLibration
-    from .overlap import OverlapScan
-    from .section import SectionResult, TimeSeriesResult
-
-    return {"section": SectionResult, "time_series": TimeSeriesResult, "chaos_map": ChaosMap,
-            "parameter_map": ParameterMap, "overlap_scan": OverlapScan,
-            "relaxed_libration": RelaxedLibration}
+    """kind name -> result class (:data:`ti_spinorbit.results.KINDS`, which every result
+    class fills by declaring its kind; the package imports them all)."""
+    return _results.KINDS
 
 
 def _record_types():
     """Small dataclasses stored as JSON records inside a result (name -> class)."""
-    from .overlap import OverlapDecision
-
-    return {"OverlapDecision": OverlapDecision}
+    return _results.RECORDS
 
 
 def kind_of(result):
     """The archive kind of a result object ("section", "chaos_map", ...), or TypeError."""
-    for kind, cls in _kinds().items():
-        if type(result) is cls:
-            return kind
+    kind = getattr(type(result), "kind", "")
+    if kind and _kinds().get(kind) is type(result):
+        return kind
     raise TypeError(f"cannot save a {type(result).__name__}: save() takes one of "
                     f"{', '.join(c.__name__ for c in _kinds().values())}")
 
@@ -506,59 +499,8 @@ def _decode(block, arrays, prefix, systems):
 
 
 # ---- what a loaded result must look like -------------------------------------------------
-#: Per kind: field -> (dimensions, dtype kinds). Dimensions are names bound by the first
-#: array that has them (``n`` members, ``w`` crossings, ``s`` samples, ``k`` lengths, ...) or
-#: fixed sizes; dtype kinds as ``numpy.dtype.kind`` ("f" float, "iu" integer, "b" bool,
-#: "UO" text). A field not listed (or None) is not checked; a listed one that does not fit
-#: makes :func:`load` refuse the file, naming the field, instead of failing later in repr,
-#: plot or to_xarray.
-_F, _I, _B, _S = "f", "iu", "b", "UO"
-_SECTION = {
-    **{k: (("n", "w"), _F) for k in ("theta_p", "thetadot_p", "t", "r", "a", "e",
-                                      "apsidal_rate")},
-    **{k: (("n",), _I) for k in ("count", "status", "accepted", "rejected", "rhs_calls",
-                                  "stop_status")},
-    **{k: (("n",), _F) for k in ("energy_drift", "angmom_drift", "initial_theta_p",
-                                  "initial_thetadot_p", "megno", "lyapunov", "max_tilt",
-                                  "max_npa_angle")},
-    "initial_states": (("n", 30), _F),
-}
-_TIME_SERIES = {
-    **{k: (("n", "s"), _F) for k in ("t", "alpha", "theta", "thetadot", "r", "energy",
-                                      "energy_orbit", "energy_primary", "energy_secondary",
-                                      "work")},
-    **{k: (("n", "s", 3), _F) for k in ("angmom_orbit", "angmom_primary", "angmom_secondary",
-                                         "external_angmom")},
-    **{k: (("n",), _I) for k in ("status", "attitude_class", "stop_status")},
-    **{k: (("n",), _F) for k in ("initial_theta_p", "initial_thetadot_p", "energy_drift",
-                                  "angmom_drift", "max_tilt", "max_npa_angle")},
-    "initial_states": (("n", 30), _F), "states": (("n", "s", 30), _F),
-}
-_GRID = ("theta_p", "thetadot_p")
-_PGRID = ("elongations", "eccentricities")
-_SHAPES = {
-    "section": _SECTION, "time_series": _TIME_SERIES,
-    "chaos_map": {
-        "theta_p": (("theta_p",), _F), "thetadot_p": (("thetadot_p",), _F),
-        **{k: (_GRID, _F) for k in ("megno", "lyapunov", "mean_thetadot", "energy_drift",
-                                    "angmom_drift", "max_tilt")},
-        "status": (_GRID, _I), "attitude_class": (_GRID, _I), "classification": (_GRID, _S),
-        "fraction_lengths": (("k",), _F), "fraction_by_length": (("k",), _F),
-        "tilt": ((2,), _F)},
-    "parameter_map": {
-        "elongations": (("elongations",), _F), "eccentricities": (("eccentricities",), _F),
-        "theta_p": (("start",), _F), "thetadot_p": (("start",), _F),
-        "omega0": (("elongations",), _F), "chaotic_fraction": (_PGRID, _F),
-        **{k: ((*_PGRID, "start"), _F) for k in ("megno", "energy_drift", "angmom_drift")},
-        "classification": ((*_PGRID, "start"), _S), "status": ((*_PGRID, "start"), _I),
-        "inaccurate": (_PGRID, _I), "fraction_monotone": (_PGRID, _B),
-        "fraction_lengths": (("k",), _F), "fraction_by_length": (("k", *_PGRID), _F)},
-    "overlap_scan": {
-        "elongations": (("m",), _F), "overlaps": (("m",), _B), "lengths": (("k",), _F),
-        "overlaps_by_length": (("k", "m"), _B), "megno_overlaps_by_length": (("k", "m"), _I)},
-    "relaxed_libration": {
-        **{k: (("k",), _F) for k in ("lengths", "centres_by_length", "amplitudes_by_length")}},
-}
+# (each result class's SHAPES, ti_spinorbit.results.Result)
+_F, _I, _B, _S = _results.FLOAT, _results.INTEGER, _results.BOOL, _results.TEXT
 
 
 def _code_ranges():
@@ -582,7 +524,7 @@ def _check_loaded(path, result):
         dims["n"] = len(systems)
     unit_of = field_units(result)
     ranges = _code_ranges()
-    for name, (shape, kinds) in _SHAPES.get(kind, {}).items():
+    for name, (shape, kinds) in type(result).SHAPES.items():
         value = getattr(result, name, None)
         if value is None:
             continue

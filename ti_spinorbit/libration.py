@@ -54,6 +54,7 @@ from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, unit
+from .results import FLOAT as _F
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 
 #: Default coarse bracket of θ̇_p(0)/n (wide: coupling shifts the synchronous island).
@@ -160,7 +161,7 @@ def _psi_A_deg(omega0, e):
 
 
 @dataclass(repr=False)
-class RelaxedLibration(Result, _display.Readable):
+class RelaxedLibration(Result, _display.Readable, kind="relaxed_libration"):
     """Centre of the synchronous island and the relaxed-mode libration amplitude.
 
     ``centre_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
@@ -175,6 +176,9 @@ class RelaxedLibration(Result, _display.Readable):
     ``angmom_drift`` its relative drifts and ``max_drift`` their limit
     (``ti_spinorbit.accuracy``); ``seconds`` wall time; ``coordinates`` the spin coordinate of
     ``centre_thetadot_p`` and ``candidates`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
+
+    # what a loaded file's arrays must look like (Result.SHAPES; k lengths)
+    SHAPES = {k: (("k",), _F) for k in ("lengths", "centres_by_length", "amplitudes_by_length")}
 
     centre_thetadot_p: float = unit(SPIN)
     amplitude: float = unit('deg')

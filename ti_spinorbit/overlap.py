@@ -55,13 +55,15 @@ from .convergence import run_lengths
 from .distributed import sections
 from .systems import BinarySystem
 from . import display as _display
-from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, unit
+from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, record, unit
+from .results import FLOAT as _F, INTEGER as _I, BOOL as _B
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
 
 
+@record
 @dataclass
 class OverlapDecision:
     """Evidence for one elongation: island centres (units of n), and the trajectory that
@@ -94,7 +96,7 @@ class OverlapDecision:
 
 
 @dataclass(repr=False)
-class OverlapScan(Result, _display.Readable):
+class OverlapScan(Result, _display.Readable, kind="overlap_scan"):
     """Result of :func:`overlap_threshold`.
 
     ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
@@ -104,6 +106,11 @@ class OverlapScan(Result, _display.Readable):
     the trajectories above it (``ti_spinorbit.accuracy``), left out of the decisions unless
     ``include_inaccurate``; ``coordinates`` the spin coordinate of the starts, centres and
     ranges ("inertial" or "apsidal", docs/physics.md §6.7)."""
+
+    # what a loaded file's arrays must look like (Result.SHAPES; m elongations, k lengths)
+    SHAPES = {
+        "elongations": (("m",), _F), "overlaps": (("m",), _B), "lengths": (("k",), _F),
+        "overlaps_by_length": (("k", "m"), _B), "megno_overlaps_by_length": (("k", "m"), _I)}
 
     name: str
     eccentricity: float = unit('1')

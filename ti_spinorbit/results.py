@@ -99,6 +99,21 @@ def units(cls_or_result):
 
 #: {"save": io.save, "to_xarray": xarray_io.to_xarray}, registered by those modules.
 BACKENDS = {}
+#: Result kinds, archive name -> class: each class declares its kind once, in its class
+#: statement (``class ChaosMap(Result, kind="chaos_map")``); archives (io), xarray and reprs
+#: read it from here or from the class's ``kind``.
+KINDS = {}
+#: Small dataclasses stored as JSON records inside a result (``OverlapScan.decisions``),
+#: name -> class, each registered by :func:`record`.
+RECORDS = {}
+#: dtype kinds of ``Result.SHAPES`` (``numpy.dtype.kind`` letters).
+FLOAT, INTEGER, BOOL, TEXT = "f", "iu", "b", "UO"
+
+
+def record(cls):
+    """Class decorator: ``cls`` (a dataclass) may be stored as records inside a result."""
+    RECORDS[cls.__name__] = cls
+    return cls
 
 
 def _backend(name, module):
@@ -112,7 +127,27 @@ def _backend(name, module):
 class Result:
     """The protocol every result shares (see the module docstring). Subclasses are
     dataclasses with ``status``, ``seconds``, ``rtol``, ``orbits`` fields (or properties)
-    and a ``plot`` that delegates to :mod:`ti_spinorbit.plotting`."""
+    and a ``plot`` that delegates to :mod:`ti_spinorbit.plotting`.
+
+    A subclass declares its archive kind in its class statement, ``class X(Result,
+    kind="x")`` (registered in :data:`KINDS`), and ``SHAPES``, what its loaded arrays must
+    look like: field -> (dimensions, dtype kinds). Dimensions are names bound by the first
+    array that has them (``n`` members, ``w`` crossings, ``s`` samples, ``k`` lengths, ...) or
+    fixed sizes; dtype kinds are :data:`FLOAT`, :data:`INTEGER`, :data:`BOOL`, :data:`TEXT`.
+    A field not listed is not checked; a listed one that does not fit makes
+    :func:`ti_spinorbit.io.load` refuse the file, naming the field."""
+
+    #: the archive kind (:data:`KINDS`); "" for the protocol itself
+    kind = ""
+    SHAPES = {}
+
+    def __init_subclass__(cls, kind=None, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if kind is not None:
+            if KINDS.get(kind, cls) is not cls:
+                raise TypeError(f"result kind {kind!r} is already {KINDS[kind].__name__}'s")
+            cls.kind = kind
+            KINDS[kind] = cls
 
     def _status_array(self):
         status = getattr(self, "status", None)
@@ -159,4 +194,4 @@ class Result:
         raise NotImplementedError(f"{type(self).__name__}.plot")
 
 
-__all__ = ["Status", "STATUS_NAMES", "Result", "unit", "units"]
+__all__ = ["Status", "STATUS_NAMES", "Result", "KINDS", "RECORDS", "record", "unit", "units"]

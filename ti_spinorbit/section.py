@@ -29,6 +29,7 @@ from .initial import ROW_UNIT as STATE_ROW
 from .attitude import CLASS_UNIT as ATTITUDE_CLASS
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations, perturbation_rows
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, unit
+from .results import FLOAT as _F, INTEGER as _I
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -256,7 +257,7 @@ def _state_rows_and_tilt(members, records_list, y0, y_end):
 
 
 @dataclass(repr=False)
-class SectionResult(Result, _display.Readable):
+class SectionResult(Result, _display.Readable, kind="section"):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
     Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
@@ -275,6 +276,18 @@ class SectionResult(Result, _display.Readable):
     status codes before the accuracy verdict: why each member stopped ("done" when it ran to
     the end), kept for an "inaccurate" member that collided or escaped (None in files written
     before it existed)."""
+
+    # what a loaded file's arrays must look like (Result.SHAPES; n members, w crossings)
+    SHAPES = {
+        **{k: (("n", "w"), _F) for k in ("theta_p", "thetadot_p", "t", "r", "a", "e",
+                                          "apsidal_rate")},
+        **{k: (("n",), _I) for k in ("count", "status", "accepted", "rejected", "rhs_calls",
+                                      "stop_status")},
+        **{k: (("n",), _F) for k in ("energy_drift", "angmom_drift", "initial_theta_p",
+                                      "initial_thetadot_p", "megno", "lyapunov", "max_tilt",
+                                      "max_npa_angle")},
+        "initial_states": (("n", 30), _F),
+    }
 
     theta_p: np.ndarray = unit('deg')
     thetadot_p: np.ndarray = unit(SPIN)
@@ -510,7 +523,7 @@ def _state_property(name, shape, doc):
 
 
 @dataclass(repr=False)
-class TimeSeriesResult(Result, _display.Readable):
+class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
 
     ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
@@ -526,6 +539,19 @@ class TimeSeriesResult(Result, _display.Readable):
     line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
     e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7; ``stop_status`` the
     integrator's status codes before the accuracy verdict (why each member stopped)."""
+
+    # what a loaded file's arrays must look like (Result.SHAPES; n members, s samples)
+    SHAPES = {
+        **{k: (("n", "s"), _F) for k in ("t", "alpha", "theta", "thetadot", "r", "energy",
+                                          "energy_orbit", "energy_primary", "energy_secondary",
+                                          "work")},
+        **{k: (("n", "s", 3), _F) for k in ("angmom_orbit", "angmom_primary",
+                                             "angmom_secondary", "external_angmom")},
+        **{k: (("n",), _I) for k in ("status", "attitude_class", "stop_status")},
+        **{k: (("n",), _F) for k in ("initial_theta_p", "initial_thetadot_p", "energy_drift",
+                                      "angmom_drift", "max_tilt", "max_npa_angle")},
+        "initial_states": (("n", 30), _F), "states": (("n", "s", 30), _F),
+    }
 
     t: np.ndarray = unit('s')
     alpha: np.ndarray = unit('deg')

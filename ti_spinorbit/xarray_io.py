@@ -275,6 +275,7 @@ def _relaxed_libration(r, units):
     return data, coords
 
 
+#: Dataset layouts by result kind (``Result.kind``).
 _BUILDERS = {"section": _section, "time_series": _time_series, "chaos_map": _chaos_map,
              "parameter_map": _parameter_map, "overlap_scan": _overlap_scan,
              "relaxed_libration": _relaxed_libration}
@@ -314,8 +315,10 @@ def to_xarray(result_or_path):
         result = io.load(result_or_path)
     else:
         result = result_or_path
-    kind = io.kind_of(result)
+    kind = io.kind_of(result)                       # the kind the result class declares
     units = {**io.ARCHIVE_UNITS, **field_units(result)}     # units live on the fields
+    if kind not in _BUILDERS:
+        raise TypeError(f"to_xarray has no layout for {type(result).__name__} (kind {kind!r})")
     data, coords = _BUILDERS[kind](result, units)
     ds = xr.Dataset(data, coords=coords, attrs=_attrs(result, kind, metadata))
     for name, var in ds.variables.items():
