@@ -22,7 +22,6 @@ dS/dt = hat(Ω2 − Ω1) S equals S hat(Ω2') − hat(Ω1) S because S hat(x) S�
 
 import taichi as ti
 
-from ti_spinorbit.bodies import ROW_LENGTH
 from ti_spinorbit.layout import spatial as _L
 
 from . import perturb

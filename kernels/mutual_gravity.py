@@ -29,7 +29,7 @@ import math
 
 import taichi as ti
 
-from ti_spinorbit.bodies import EXPONENTS_3, EXPONENTS_4
+from ti_spinorbit.layout import EXPONENTS_3, EXPONENTS_4
 
 vec3 = ti.types.vector(3, ti.f64)
 mat3 = ti.types.matrix(3, 3, ti.f64)

@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from ti_spinorbit.bodies import (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH, Body,
-                                 Ellipsoid, Sphere)
+from ti_spinorbit.bodies import Body, Ellipsoid, Sphere
+from ti_spinorbit.layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
 from ti_spinorbit.systems import BinarySystem
 
 AXES = (3.1, 1.7, 0.9)          # a > b > c, m: nothing degenerate

@@ -24,13 +24,8 @@ from ._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LENG
                         MIN_MOMENT_RATIO, require_finite,
                         require_positive_scalar, require_real, show, _as_floats)
 from . import display as _display
-
-# Fixed orders of the monomials, shared with the kernels (kernels/mutual_gravity.py unrolls them).
-EXPONENTS_2 = ((2, 0, 0), (0, 2, 0), (0, 0, 2))
-EXPONENTS_3 = tuple((l, m, 3 - l - m) for l in range(3, -1, -1) for m in range(3 - l, -1, -1))
-EXPONENTS_4 = tuple((l, m, 4 - l - m) for l in range(4, -1, -1) for m in range(4 - l, -1, -1))
-#: Length of :meth:`Body.as_row`: mass, 3 second-order, 10 third-order, 15 fourth-order.
-ROW_LENGTH = 1 + len(EXPONENTS_2) + len(EXPONENTS_3) + len(EXPONENTS_4)
+# the monomial orders of a body's row (Body.as_row), shared with the kernels
+from .layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
 
 
 def row_columns(select):

@@ -56,7 +56,7 @@ def check_coordinates(coordinates, flag="coordinates"):
 
 def _odd(par):
     """Whether any member row has an integral with an odd exponent (as ``Ensemble``)."""
-    from .bodies import ROW_LENGTH
+    from .layout import ROW_LENGTH
     from .ensemble import _odd_columns
 
     return bool(np.any(par[:, _odd_columns(ROW_LENGTH)] != 0.0))

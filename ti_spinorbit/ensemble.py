@@ -166,7 +166,7 @@ class Ensemble:
 
     def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,
                  min_step=MIN_STEP, model="auto", method="cash-karp", perturbation_rows=None):
-        from .bodies import ROW_LENGTH
+        from .layout import ROW_LENGTH
         from .kernels import eom
         from .kernels.tableau import METHODS, check_method
 

@@ -11,7 +11,9 @@ layout is written once and nothing has to be kept in step by hand.
     y = [R(3), V(3), w1(3), w2(3), S(9, row-major), S1(9, row-major)]
 
 (length a, time 1/n, mass m1 + m2; w = Γ/C), and a parameter row of the two bodies' rows
-(``bodies.ROW_LENGTH`` each) followed by the derived constants P_MRED ... P_ESCAPE.
+(ROW_LENGTH each: the mass, then the inertia integrals T^{lmn} in the orders EXPONENTS_2,
+EXPONENTS_3, EXPONENTS_4, :meth:`ti_spinorbit.bodies.Body.as_row`) followed by the derived
+constants P_MRED ... P_ESCAPE.
 
 **Planar model** (``kernels/planar_eom.py``; docs/physics.md §5): the 10-number state
 [r, v_r, ℓ, λ, cos ψ_A, sin ψ_A, w1, cos ψ_B, sin ψ_B, w2] and a 37-column row of Fourier
@@ -28,7 +30,13 @@ planar records are converted to it on the host.
 them.
 """
 
-from .bodies import ROW_LENGTH
+# A body's row: mass, then T^{lmn} in these fixed orders (kernels/mutual_gravity.py unrolls
+# them).
+EXPONENTS_2 = ((2, 0, 0), (0, 2, 0), (0, 0, 2))
+EXPONENTS_3 = tuple((l, m, 3 - l - m) for l in range(3, -1, -1) for m in range(3 - l, -1, -1))
+EXPONENTS_4 = tuple((l, m, 4 - l - m) for l in range(4, -1, -1) for m in range(4 - l, -1, -1))
+#: Length of a body's row: mass, 3 second-order, 10 third-order, 15 fourth-order integrals.
+ROW_LENGTH = 1 + len(EXPONENTS_2) + len(EXPONENTS_3) + len(EXPONENTS_4)
 
 
 class spatial:

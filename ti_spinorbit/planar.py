@@ -16,8 +16,8 @@ stays planar for all time: the 3-D model keeps such a start planar to round-off,
 
 import numpy as np
 
-from .bodies import (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH, row_columns,
-                     tensor_from_integrals)
+from .bodies import row_columns, tensor_from_integrals
+from .layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
 
 _SAMPLES = 16   # angles per Fourier fit: exact for trigonometric polynomials of degree < 8
 

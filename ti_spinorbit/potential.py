@@ -35,7 +35,7 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     from .kernels import eom
     from .kernels import advance as K
     from .ensemble import _odd_columns
-    from .bodies import ROW_LENGTH
+    from .layout import ROW_LENGTH
     from .systems import G
 
     for label, body in (("primary", primary), ("secondary", secondary)):
