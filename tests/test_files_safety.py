@@ -34,6 +34,7 @@ import pytest
 import ti_spinorbit as tso
 from ti_spinorbit import checkpoint as C
 from ti_spinorbit import cli, files, io, plotting
+from ti_spinorbit.cli import common
 from ti_spinorbit.io import ArchiveError
 from ti_spinorbit.libration import RelaxedLibration
 
@@ -292,8 +293,8 @@ def test_system_names_are_made_safe_in_default_file_names(vh, tmp_path, monkeypa
     (tmp_path / "sub").mkdir()
     args = cli._parser().parse_args(["section", "--system", _system_file(tmp_path, vh, name)])
     assert cli.default_stem(args, "sos", name) == stem
-    out, data = cli._paths(args, "sos", name)
-    cli._release_outputs()
+    out, data = common.output_paths(args, "sos", name)
+    common.release_outputs()
     assert (out, data) == (stem + ".png", stem + ".npz")
     assert os.listdir(tmp_path / "sub") == [] and "\n" not in out
 

@@ -11,6 +11,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import catalog, cli
+from ti_spinorbit.cli import common
 from ti_spinorbit.systems import G, ImplausibleInputWarning, NearCircularWarning
 
 HOUR = 3600.0
@@ -58,7 +59,7 @@ def test_eccentricity_flag_applies_to_a_json_system(vh_json):
     d = json.loads(vh_json.read_text())
     vh_json.write_text(json.dumps([d]))      # the one-item list 'systems --out' writes
     args = cli._parser().parse_args(["section", "--system", str(vh_json), "--eccentricity", "0.2"])
-    system = cli._system(args)
+    system = common.build_system(args)
     assert system.e == 0.2 and system.density_scale == 1.0
     np.testing.assert_array_equal(system.parameter_row(),
                                   catalog.system("1991 VH", eccentricity=0.2).parameter_row())

@@ -20,7 +20,8 @@ def test_wheel_contains_kernels_as_subpackage_and_catalogue(tmp_path):
     wheel, = tmp_path.glob("ti_spinorbit-*.whl")
     names = set(zipfile.ZipFile(wheel).namelist())
     for f in ("ti_spinorbit/kernels/advance.py", "ti_spinorbit/kernels/mutual_gravity.py",
-              "ti_spinorbit/data/systems.json", "ti_spinorbit/cli.py"):
+              "ti_spinorbit/data/systems.json", "ti_spinorbit/cli/__init__.py",
+              "ti_spinorbit/cli/section.py", "ti_spinorbit/cli/options.py"):
         assert f in names
     assert not any(n.startswith("kernels/") for n in names)   # no top-level "kernels" package
     entry = [n for n in names if n.endswith("entry_points.txt")]

@@ -14,6 +14,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import accuracy, cli
+from ti_spinorbit.cli import common
 from ti_spinorbit.kernels.advance import (COLLISION, DONE, ESCAPE, INACCURATE, NONFINITE,
                                            STATUS_NAMES, STEP_UNDERFLOW)
 
@@ -377,7 +378,7 @@ def test_exit_status_counts_untrustworthy_members(status, allow, expected, messa
 
     args = argparse.Namespace(command="map", allow_inaccurate=allow)
     drift = np.where(np.array(status) == INACCURATE, 0.5, 1e-9)
-    assert cli._accuracy_status(args, np.array(status), drift, 1e-4) == expected
+    assert common.accuracy_status(args, np.array(status), drift, 1e-4) == expected
     err = capsys.readouterr().err
     assert (message in err) if message else err == ""
 

@@ -348,10 +348,12 @@ def test_spin_rates_are_bounded_within_a_second(vh, name, call, parameter, got):
 
 def test_the_spin_bound_is_the_command_lines():
     from ti_spinorbit import cli
+    from ti_spinorbit.cli import options
 
     assert cli.MAX_SPIN is _validate.MAX_SPIN
-    assert cli.FLAG_RANGES["thetadot"][1:3] == (-_validate.MAX_SPIN, _validate.MAX_SPIN)
-    assert cli.FLAG_RANGES["density"][1:3] == (_validate.MIN_DENSITY, _validate.MAX_DENSITY)
+    assert (options.SPIN.low, options.SPIN.high) == (-_validate.MAX_SPIN, _validate.MAX_SPIN)
+    assert (options.DENSITY.low, options.DENSITY.high) == (_validate.MIN_DENSITY,
+                                                           _validate.MAX_DENSITY)
 
 
 def test_primary_spin_at_the_bound_is_accepted():

@@ -20,6 +20,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import analytic, cli
+from ti_spinorbit.cli import options
 from ti_spinorbit import perturbations as tsp
 from ti_spinorbit.bodies import Sphere
 
@@ -76,7 +77,7 @@ def test_the_default_is_the_papers_torque_half_the_one_turn_one():
     assert one_turn.torque(system) / default.torque(system) == pytest.approx(2.0, rel=1e-14)
     # the CLI's default is the same
     args = cli._parser().parse_args(["section", "--yorp", "5e-4"])
-    assert cli._perturbations(args)[0].convention == "paper"
+    assert options.perturbations(args)[0].convention == "paper"
 
 
 @pytest.mark.parametrize("convention, turns", [("paper", 2), ("one-turn", 1)])
@@ -143,7 +144,7 @@ def test_an_unknown_convention_is_refused_in_one_line(bad):
 
 def test_cli_yorp_convention_flag(tmp_path, capsys):
     args = cli._parser().parse_args(["section", "--yorp", "5e-4", "--yorp-convention", "one-turn"])
-    (yorp,) = cli._perturbations(args)
+    (yorp,) = options.perturbations(args)
     assert yorp.convention == "one-turn"
     assert cli.default_stem(args, "sos", args.system) == "sos_1991VH_yorp0.0005_yorp-one-turn"
     assert "one-turn torque" in cli.perturbation_summary([yorp])
