@@ -36,11 +36,12 @@ def members(n):
     import ti_spinorbit as tso
     from bench_throughput import starts
     from ti_spinorbit.perturbations import perturbation_rows
-    from ti_spinorbit.section import build_members
+    from ti_spinorbit.members import Members
 
     system = tso.catalog.system("1991 VH", elongation=1.5)
     tp, td = starts(n)
-    systems, par, y0, _, _ = build_members(system, tp, td)
+    start = Members.from_starts(system, tp, td)
+    systems, par, y0 = start.systems, start.par, start.y0
     return par, y0, perturbation_rows(systems, perturbations())
 
 

@@ -268,10 +268,11 @@ def benchmark_system():
 
 def member_table(n):
     """Member parameter rows and initial 3-D states (scaled) of the first n members."""
-    from ti_spinorbit.section import build_members
+    from ti_spinorbit.members import Members
 
     theta_p, thetadot_p = starts(n)
-    _, par, y0, _, _ = build_members(benchmark_system(), theta_p, thetadot_p, ESCAPE_DISTANCE)
+    start = Members.from_starts(benchmark_system(), theta_p, thetadot_p, ESCAPE_DISTANCE)
+    par, y0 = start.par, start.y0
     return par, y0
 
 

@@ -24,7 +24,8 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import cost, section
+    from ti_spinorbit import cost
+    from ti_spinorbit.members import Members
 
     names = ["1991 VH", "2004 DC", "test"] if args.quick else tso.catalog.names()
     tolerances = (1e-8, 1e-12) if args.quick else (1e-8, 1e-12, 1e-15)
@@ -34,8 +35,8 @@ def main():
     methods = list(cost.METHOD_COST)
     for name in names:
         system = tso.catalog.system(name)
-        _, par, y0, _, _ = section._members("step_cost", system, *starts, orbits, 50.0,
-                                            "inertial", 4, None)
+        table = Members.from_starts(system, *starts, 50.0)
+        par, y0 = table.par, table.y0
         for k, method in enumerate(methods):
             for rtol in tolerances:
                 r = tso.surface_of_section(system, *starts, orbits=orbits, rtol=rtol,

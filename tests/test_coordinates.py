@@ -15,7 +15,7 @@ import ti_spinorbit as tso
 from ti_spinorbit import coordinates as C
 from ti_spinorbit import reference
 from ti_spinorbit.classify import classify_section
-from ti_spinorbit.section import build_members
+from ti_spinorbit.members import Members
 
 from conftest import run_cli
 
@@ -56,7 +56,8 @@ def test_recorded_pericentre_passages_are_osculating_f_zero(model):
     from ti_spinorbit.kernels import eom
 
     vh = tso.catalog.system("1991 VH")
-    _, par, y0, _, _ = build_members(vh, [0.0, 60.0], [0.45, 1.7])
+    table = Members.from_starts(vh, [0.0, 60.0], [0.45, 1.7])
+    par, y0 = table.par, table.y0
     out = Ensemble(par, y0, rtol=1e-12, model=model).run(2 * np.pi * 5)
     for events in out.events:
         states = events[:, 1:]
@@ -111,7 +112,8 @@ def test_initial_apsidal_rate_against_reference_potential(name, elongation, thet
     """ϖ̇(0) from the kernels' right-hand side equals Gauss at pericentre, −sqrt(p/μ) a_r/e,
     with a_r from the NumPy reference potential (SI), to 1e-9."""
     system = tso.catalog.system(name, elongation=elongation)
-    _, par, y0, _, _ = build_members(system, theta_p, 1.3)
+    table = Members.from_starts(system, theta_p, 1.3)
+    par, y0 = table.par, table.y0
     rate = C.states_rate(par, y0)[0] * system.mean_motion           # rad/s
     R, P, _, _, S, _ = reference.unpack_state(system.to_physical(y0[0]))
     _, force, _, _ = reference.mutual_potential(
@@ -133,12 +135,15 @@ def test_initial_rate_does_not_depend_on_spin_and_converts_the_start():
     from ti_spinorbit.observables import derive
 
     vh = tso.catalog.system("1991 VH", elongation=1.01)
-    _, par, y_slow, _, _ = build_members(vh, 0.0, 0.5)
-    _, _, y_fast, _, _ = build_members(vh, 0.0, 2.5)
+    table = Members.from_starts(vh, 0.0, 0.5)
+    par, y_slow = table.par, table.y0
+    table = Members.from_starts(vh, 0.0, 2.5)
+    y_fast = table.y0
     assert C.states_rate(par, y_slow)[0] == C.states_rate(par, y_fast)[0]
     rate = C.states_rate(par, y_slow)[0]
     assert rate == pytest.approx(0.0157, abs=5e-4)
-    _, par, y_aps, _, td = build_members(vh, 0.0, 1.08, coordinates="apsidal")
+    table = Members.from_starts(vh, 0.0, 1.08, coordinates="apsidal")
+    par, y_aps, td = table.par, table.y0, table.thetadot_p
     assert td[0] == 1.08                                     # the user's (apsidal) value
     spin = derive(par, y_aps)["thetadot"][0]
     assert spin == pytest.approx(1.08 + rate, abs=1e-14)
@@ -149,7 +154,8 @@ def test_section_in_both_coordinates_records_the_same_events():
     """One physical trajectory recorded in both systems: the same crossings and θ_p, and
     θ̇_inertial − θ̇_apsidal = ϖ̇ at every crossing."""
     vh = tso.catalog.system("1991 VH", elongation=1.06)
-    _, par, y0, _, _ = build_members(vh, 0.0, 1.0)
+    table = Members.from_starts(vh, 0.0, 1.0)
+    par, y0 = table.par, table.y0
     rate0 = C.states_rate(par, y0)[0]
     starts = np.array([1.13, 1.70])
     aps = tso.surface_of_section(vh, 0.0, starts, orbits=20, rtol=1e-12, coordinates="apsidal")
@@ -198,7 +204,8 @@ def test_apsidal_start_below_the_eccentricity_floor_is_refused():
                                          r">= 0.001 \(system '1999 KW4' has e = 0.0004\)"):
         tso.surface_of_section(kw4, 0.0, 1.0, orbits=1, coordinates="apsidal")
     # its ϖ̇ would be several n: the apsidal θ̇ would describe the orbit, not the spin
-    _, par, y0, _, _ = build_members(kw4, 0.0, 1.0)
+    table = Members.from_starts(kw4, 0.0, 1.0)
+    par, y0 = table.par, table.y0
     assert abs(C.states_rate(par, y0)[0]) > 1.0
 
 
@@ -279,7 +286,8 @@ def test_relaxed_libration_centre_shifts_by_the_initial_apsidal_rate():
         warnings.simplefilter("ignore", RuntimeWarning)
         ine = tso.relaxed_libration(vh, **kw)
         aps = tso.relaxed_libration(vh, coordinates="apsidal", **kw)
-    _, par, y0, _, _ = build_members(vh, 0.0, 1.0)
+    table = Members.from_starts(vh, 0.0, 1.0)
+    par, y0 = table.par, table.y0
     rate0 = C.states_rate(par, y0)[0]
     assert aps.coordinates == "apsidal"
     assert aps.centre_thetadot_p == pytest.approx(ine.centre_thetadot_p - rate0, abs=2e-4)

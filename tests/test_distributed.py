@@ -140,18 +140,18 @@ BAD_MEMBER = (45.0, 0.9)   # member 5 of the 3 x 4 grid: chunk 1 of 3 with chunk
 
 
 def _install_fault(mode, marker=None):
-    """Replace the worker's surface_of_section. ``mode`` "once": chunks holding BAD_MEMBER
+    """Replace the worker's runner, section_of. ``mode`` "once": chunks holding BAD_MEMBER
     fail while the file ``marker`` exists (the first attempt removes it); "always": they fail
-    every time; "report": every chunk fails, naming the ``model`` keyword it was given."""
+    every time; "report": every chunk fails, naming the model its member table carries."""
     from ti_spinorbit import section
 
-    original = getattr(section, "_unfaulted", section.surface_of_section)
+    original = getattr(section, "_unfaulted", section.section_of)
 
-    def faulty(systems, theta_p, thetadot_p, *args, **kwargs):
+    def faulty(members, *args, **kwargs):
         if mode == "report":
-            raise ValueError(f"chunk got model={kwargs.get('model')!r}")
-        if np.any((np.asarray(theta_p) == BAD_MEMBER[0]) &
-                  (np.asarray(thetadot_p) == BAD_MEMBER[1])):
+            raise ValueError(f"chunk got model={members.model!r}")
+        if np.any((np.asarray(members.theta_p) == BAD_MEMBER[0]) &
+                  (np.asarray(members.thetadot_p) == BAD_MEMBER[1])):
             if mode == "always":
                 raise ValueError("injected failure, every attempt")
             try:
@@ -160,17 +160,17 @@ def _install_fault(mode, marker=None):
                 pass
             else:
                 raise ValueError("injected failure, first attempt only")
-        return original(systems, theta_p, thetadot_p, *args, **kwargs)
+        return original(members, *args, **kwargs)
 
     section._unfaulted = original
-    section.surface_of_section = faulty
+    section.section_of = faulty
 
 
 def _remove_fault():
     from ti_spinorbit import section
 
     if hasattr(section, "_unfaulted"):
-        section.surface_of_section = section._unfaulted
+        section.section_of = section._unfaulted
         del section._unfaulted
 
 
@@ -241,3 +241,20 @@ def test_full_space_chaos_map_with_client_equals_local(client, vh):
     remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, client=client, chunk_size=2, **kw)
     assert remote.indicator_space == local.indicator_space == "full"
     assert_sections_equal(remote.section, local.section)
+
+
+def test_tilted_and_explicit_starts_go_to_the_cluster(client, vh):
+    """The Dask runner takes the member table, so every kind of start goes to a cluster:
+    a tilted chaos map and explicit 3-D states equal their single-process runs bit for bit
+    (they were refused with a client before)."""
+    kw = dict(rtol=RTOL, tilt=(5.0, 2.0), fraction_orbits=(), progress=False)
+    local = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, **kw)
+    remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, client=client, chunk_size=2, **kw)
+    assert remote.section.max_tilt.max() > 1.0           # really out of the plane
+    assert_sections_equal(remote.section, local.section)
+    starts = [vh.tilted_start(30.0, 1.2, roll=3.0, pitch=0.0),
+              vh.tilted_start(60.0, 0.9, roll=0.0, pitch=4.0)]
+    alone = tso.surface_of_section(vh, initial_states=starts, orbits=2, rtol=RTOL)
+    split = tsd.run_sections(client, vh, None, None, 2, chunk_size=1, rtol=RTOL,
+                             initial_states=starts)
+    assert_sections_equal(split, alone)

@@ -9,7 +9,7 @@ from ti_spinorbit import reference
 from ti_spinorbit.ensemble import Ensemble
 from ti_spinorbit.kernels import eom
 from ti_spinorbit.kernels.advance import COLLISION, DONE, ESCAPE, NONFINITE, RUNNING
-from ti_spinorbit.section import build_members
+from ti_spinorbit.members import Members
 
 DAY = 86400.0
 
@@ -40,7 +40,8 @@ def test_kepler_time_series_matches_analytic_radius():
 
 
 def test_planar_start_stays_planar(vh):
-    members, par, y0, _, _ = build_members(vh, [0.0, 40.0], [0.8, 1.6])
+    table = Members.from_starts(vh, [0.0, 40.0], [0.8, 1.6])
+    members, par, y0 = table.systems, table.par, table.y0
     ens = Ensemble(par, y0, rtol=1e-11)
     out = ens.run(2 * np.pi * 5)
     z = [eom.Y_R + 2, eom.Y_V + 2, eom.Y_W1, eom.Y_W1 + 1, eom.Y_W2, eom.Y_W2 + 1,
@@ -74,7 +75,8 @@ def test_list_of_systems_gives_one_member_each():
 def _energy_test_run(rtol, days=5.0):
     system = tso.catalog.system("test")
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
-    members, par, y0, _, _ = build_members(system, 0.0, spin2)
+    table = Members.from_starts(system, 0.0, spin2)
+    members, par, y0 = table.systems, table.par, table.y0
     ens = Ensemble(par, y0, rtol=rtol)
     out = ens.run(days * DAY * system.mean_motion)
     d0, d1 = out.diag_start, out.diag_end
@@ -107,7 +109,8 @@ def test_kernel_trajectory_matches_scipy_reference():
     NumPy reference RHS driven by scipy DOP853 in SI units."""
     system = tso.catalog.system("test")
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
-    members, par, y0, _, _ = build_members(system, 20.0, spin2)
+    table = Members.from_starts(system, 20.0, spin2)
+    members, par, y0 = table.systems, table.par, table.y0
     t_end = np.pi
     out = Ensemble(par, y0, rtol=1e-13).run(t_end)
     got = system.to_physical(out.y[0])
@@ -121,7 +124,8 @@ def test_kernel_trajectory_matches_scipy_reference():
 def test_failed_members_are_flagged_and_the_rest_go_on(vh):
     """A NaN start, an infalling and an outbound-hyperbolic member stop with their status;
     the good members' results equal a run without the bad ones."""
-    members, par, y0, _, _ = build_members(vh, 0.0, [0.9, 1.1, 1.2, 1.3, 1.7])
+    table = Members.from_starts(vh, 0.0, [0.9, 1.1, 1.2, 1.3, 1.7])
+    members, par, y0 = table.systems, table.par, table.y0
     bad = y0.copy()
     bad[1, eom.Y_R] = np.nan
     bad[2, eom.Y_V:eom.Y_V + 3] = (-3.0, 0.0, 0.0)          # straight in: collision

@@ -131,10 +131,9 @@ def test_yorp_spin_change_per_orbit_is_the_torque_the_run_delivers():
 # ---- the step budget -----------------------------------------------------------------------
 
 def _members(thetadots):
-    from ti_spinorbit import section
-    _, par, y0, _, _ = section._members("test", VH, [30.0] * len(thetadots), thetadots, 1.0,
-                                        50.0, "inertial", 4, None)
-    return par, y0
+    from ti_spinorbit.members import Members
+    table = Members.from_starts(VH, [30.0] * len(thetadots), thetadots, 50.0)
+    return table.par, table.y0
 
 
 def test_step_budget_stops_one_member_and_the_rest_goes_on():
@@ -199,12 +198,12 @@ def test_step_estimate_bounds_the_measured_steps(method):
     """The estimate is an upper bound within a factor of eight of the steps a run takes, for a
     slow and a fast (15 n) primary, e = 0.05 and 0.3, two tolerances: far inside the budget's
     factor of 100, and a wrong exponent or spin term would leave the band."""
-    from ti_spinorbit import section
+    from ti_spinorbit.members import Members
     for name in ("1991 VH", "2004 DC", "test"):
         system = tso.catalog.system(name)
         for rtol in (1e-8, 1e-12):
-            _, par, y0, _, _ = section._members("x", system, [30.0, 60.0], [0.5, 1.2], 2.0,
-                                                50.0, "inertial", 4, None)
+            table = Members.from_starts(system, [30.0, 60.0], [0.5, 1.2], 50.0)
+            par, y0 = table.par, table.y0
             r = tso.surface_of_section(system, [30.0, 60.0], [0.5, 1.2], orbits=2, rtol=rtol,
                                        method=method)
             measured = (r.accepted + r.rejected) / 2.0

@@ -13,7 +13,7 @@ pytest.importorskip("numba")
 from ti_spinorbit import planar as PL  # noqa: E402
 from ti_spinorbit.ensemble import Ensemble  # noqa: E402
 from ti_spinorbit.kernels import advance as K  # noqa: E402
-from ti_spinorbit.section import build_members  # noqa: E402
+from ti_spinorbit.members import Members  # noqa: E402
 
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                            "experiments")
@@ -28,7 +28,8 @@ sys.path.remove(EXPERIMENTS)
 def members(taichi_runtime):
     import ti_spinorbit as tso
     system = tso.catalog.system("1991 VH", elongation=1.5)
-    _, par, y0, _, _ = build_members(system, [0.0, 45.0, 120.0], [0.8, 1.3, 2.1], 1000.0)
+    table = Members.from_starts(system, [0.0, 45.0, 120.0], [0.8, 1.3, 2.1], 1000.0)
+    par, y0 = table.par, table.y0
     return par, y0
 
 

@@ -14,7 +14,7 @@ import ti_spinorbit as tso
 from ti_spinorbit import planar as PL
 from ti_spinorbit.ensemble import Ensemble
 from ti_spinorbit.kernels import advance as K
-from ti_spinorbit.section import build_members
+from ti_spinorbit.members import Members
 
 
 def rz(t):
@@ -54,8 +54,9 @@ def systems():
 
 
 def test_conversions_round_trip(rng):
-    members, par, y0, _, _ = build_members(tso.catalog.system("1991 VH"), [0.0, 40.0, 170.0],
-                                           [0.8, 1.5, 2.2], 1000.0)
+    table = Members.from_starts(tso.catalog.system("1991 VH"), [0.0, 40.0, 170.0],
+                                [0.8, 1.5, 2.2], 1000.0)
+    par, y0 = table.par, table.y0
     y = random_planar_states(rng, par, y0)
     np.testing.assert_allclose(PL.to_spatial(PL.to_planar(y)), y, atol=1e-15)
     q = PL.to_planar(y)
@@ -70,7 +71,8 @@ def test_planar_rhs_equals_the_3d_rhs(rng, which, order, odd):
     system = systems()[which]
     if odd != (which == 2) and order >= 3:
         pytest.skip("odd=True exactly for the body with odd integrals")
-    members, par, y0, _, _ = build_members(system, [0.0] * 4, [1.0] * 4, 1000.0)
+    table = Members.from_starts(system, [0.0] * 4, [1.0] * 4, 1000.0)
+    members, par, y0 = table.systems, table.par, table.y0
     y = random_planar_states(rng, par, y0)
     f3 = np.zeros_like(y)
     K.SPATIAL.evaluate_rhs(par, y, f3, order, odd)
@@ -99,7 +101,8 @@ def test_fourier_coefficients_reproduce_the_legendre_terms(rng):
 
 def test_model_choice_and_clear_errors():
     vh = tso.catalog.system("1991 VH")
-    members, par, y0, _, _ = build_members(vh, [0.0, 30.0], [1.0, 1.5], 1000.0)
+    table = Members.from_starts(vh, [0.0, 30.0], [1.0, 1.5], 1000.0)
+    members, par, y0 = table.systems, table.par, table.y0
     assert np.all(PL.qualifies(par, y0))
     assert Ensemble(par, y0).model == "planar"
     assert Ensemble(par, y0, model="3d").model == "3d"
@@ -116,7 +119,8 @@ def test_model_choice_and_clear_errors():
     T = dict(flat_lumpy_body().integrals)
     T[(2, 0, 1)] = 0.005
     odd_z = tso.BinarySystem(tso.Body(1.0, T, 1.5), tso.Sphere(0.3, mass=0.1), a=4.0, e=0.1)
-    _, par2, y2, _, _ = build_members(odd_z, 0.0, 1.0, 1000.0)
+    table = Members.from_starts(odd_z, 0.0, 1.0, 1000.0)
+    par2, y2 = table.par, table.y0
     assert not PL.qualifies(par2, y2)[0]
 
 
@@ -124,7 +128,8 @@ def test_model_choice_and_clear_errors():
 def vh_pair():
     """1991 VH regular starts (1:1 libration, quasi-periodic) with both models at 3 tolerances."""
     vh = tso.catalog.system("1991 VH")
-    _, par, y0, _, _ = build_members(vh, [0.0, 0.0], [0.83, 2.53], 1000.0)
+    table = Members.from_starts(vh, [0.0, 0.0], [0.83, 2.53], 1000.0)
+    par, y0 = table.par, table.y0
     return {(rtol, m): Ensemble(par, y0, rtol=rtol, model=m).run(2 * np.pi * 30)
             for rtol in (1e-10, 1e-12) for m in ("planar", "3d")}
 
@@ -159,14 +164,16 @@ def test_planar_conserves_energy_like_3d(vh_pair):
 
 
 def test_3d_model_keeps_a_qualifying_start_planar():
-    _, par, y0, _, _ = build_members(systems()[2], [0.0, 50.0], [1.0, 1.7], 1000.0)
+    table = Members.from_starts(systems()[2], [0.0, 50.0], [1.0, 1.7], 1000.0)
+    par, y0 = table.par, table.y0
     out = Ensemble(par, y0, rtol=1e-10, model="3d").run(2 * np.pi * 5)
     assert np.all(PL.qualifies(par, out.y))
 
 
 def test_planar_is_slot_and_window_invariant():
     vh = tso.catalog.system("1991 VH")
-    _, par, y0, _, _ = build_members(vh, [0.0, 20.0, 60.0], [0.83, 1.63, 2.2], 1000.0)
+    table = Members.from_starts(vh, [0.0, 20.0, 60.0], [0.83, 1.63, 2.2], 1000.0)
+    par, y0 = table.par, table.y0
     a = Ensemble(par, y0, rtol=1e-10).run(2 * np.pi * 12, window_orbits=3)
     b = Ensemble(par[::-1], y0[::-1], rtol=1e-10).run(2 * np.pi * 12, window_orbits=16)
     for k in range(3):

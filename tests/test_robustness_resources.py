@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
+from ti_spinorbit.members import Members
 from ti_spinorbit import _validate, cli, ensemble, overlap, resources, runtime, section
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -120,7 +121,7 @@ def _no_members(*args, **kwargs):
         tso.catalog.system("Didymos"), orbits=1e7, samples_per_orbit=100000)),
 ])
 def test_absurd_sizes_are_refused_within_seconds(vh, monkeypatch, what, call):
-    monkeypatch.setattr(section, "build_members", _no_members)
+    monkeypatch.setattr(Members, "from_starts", classmethod(_no_members))
     monkeypatch.setattr(tso.catalog, "system", _no_catalog(tso.catalog.system))
     started = time.perf_counter()
     with pytest.raises(_validate.InsufficientMemoryError) as err:
@@ -170,12 +171,12 @@ def test_overlap_scans_at_several_eccentricities_are_sized_together(monkeypatch)
     one = resources.estimate_bytes(15 * 80, 300)
     assert one < 0.8 * GIB < 3 * one
     monkeypatch.setattr(_validate, "available_memory", lambda: GIB)
-    monkeypatch.setattr(section, "build_members", _no_members)
+    monkeypatch.setattr(Members, "from_starts", classmethod(_no_members))
     with pytest.raises(_validate.InsufficientMemoryError, match=r"^overlap_vs_eccentricity needs "):
         overlap.overlap_vs_eccentricity("1991 VH", [0.05, 0.1, 0.15], orbits=300)
 
 
-def test_inputs_that_do_not_broadcast_are_left_to_build_members(vh):
+def test_inputs_that_do_not_broadcast_are_left_to_the_member_table(vh):
     with pytest.raises(ValueError, match="cannot broadcast"):
         tso.surface_of_section(vh, [0.0, 1.0], [1.0, 1.1, 1.2], orbits=1)
 

@@ -266,9 +266,9 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         runs). Recorded in the map (``indicator_space``).
     tilt : (roll, pitch), optional
         Start every grid point tilted out of the plane by these angles, degrees in
-        [-90, 90] (``BinarySystem.tilted_start``; inertial coordinates, single process):
+        [-90, 90] (``BinarySystem.tilted_start``; inertial coordinates):
         the map's ``max_tilt`` then shows how far each pole strays (``plot(quantity=
-        "max_tilt")``). Without it every start is planar and stays so.
+        "max_tilt")``; with ``client`` too). Without it every start is planar and stays so.
     perturbations : list of Tides, YORP, BYORP, optional
         Tides, YORP and BYORP in the equations of every member, each with its ``strength``
         factor (:mod:`ti_spinorbit.perturbations`, docs/physics.md §13); the shorter lengths
@@ -299,7 +299,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     launches = _launches(checkpoint, resume, overwrite_checkpoint, client)
     from .models import check_indicator_space
     indicator_space = check_indicator_space(indicator_space)
-    tilt = _check_tilt(tilt, client, coordinates)
+    tilt = _check_tilt(tilt, coordinates)
     perturbations = check_perturbations(perturbations)
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
                            advice="use a coarser grid or fewer orbits",
@@ -355,7 +355,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
         perturbations=perturbations, **evidence)
 
 
-def _check_tilt(tilt, client, coordinates):
+def _check_tilt(tilt, coordinates):
     """chaos_map's ``tilt`` as a float (roll, pitch) array in degrees, or None."""
     if tilt is None:
         return None
@@ -363,9 +363,6 @@ def _check_tilt(tilt, client, coordinates):
     if values.shape != (2,) or not np.all(np.isfinite(values)) or np.any(np.abs(values) > 90):
         raise ValueError(f"tilt must be (roll, pitch), two finite angles in [-90, 90] degrees "
                          f"(got {show(tilt)})")
-    if client is not None:
-        raise ValueError("tilt does not combine with client (tilted starts run in this "
-                         "process): leave client=None")
     if coordinates != "inertial":
         raise ValueError("tilt needs coordinates='inertial' (the apsidal coordinates are "
                          "defined for planar starts)")

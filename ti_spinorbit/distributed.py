@@ -1,10 +1,9 @@
-"""Scale-out over a Dask cluster: one ensemble split into chunks, one chunk per task (issue 5,
-item 5).
+"""Scale-out over a Dask cluster: one ensemble split into chunks, one chunk per task.
 
 The integrator is per-member deterministic: a member's result does not depend on how many
 members share its launch or on its slot (tests/test_kernels.py, ensemble invariance). So a
 flat member list can be cut into contiguous chunks, each chunk integrated by
-:func:`~ti_spinorbit.section.surface_of_section` in a Dask worker process with its own Taichi
+:func:`~ti_spinorbit.section.section_of` in a Dask worker process with its own Taichi
 runtime, and the chunks' :class:`~ti_spinorbit.section.SectionResult` s concatenated in
 member order: the result is bit-for-bit the single-process one.
 
@@ -14,9 +13,12 @@ Decisions:
 * A failed chunk is retried ``retries`` times by the scheduler (possibly on another worker);
   when the retries are spent, :class:`ChunkError` names the chunk, its members and the
   original exception, and the other chunks are cancelled. No chunk is ever dropped.
-* What one launch decides for all its members (``model="auto"``: the planar model only when
-  every member qualifies) is decided here over the whole member list and passed to every
-  chunk, so a chunk integrates its members exactly as the full launch would.
+* The member table (:class:`ti_spinorbit.members.Members`) is built once, on the client, by
+  the same checks as a local run (``section.section_inputs``): what one launch decides for
+  all its members (``model="auto"``: the planar model only when every member qualifies) is
+  decided there over the whole table, and each chunk is a slice of it, so a chunk
+  integrates its members exactly as the full launch would. Every kind of start goes to the
+  cluster: the paper's (θ_p, θ̇_p), apsidal ones and explicit 3-D states (tilted starts).
 * ``checkpoint``/``resume`` are refused: every chunk would write the same file.
 * Taichi's runtime is process-global and its LLVM backends compile only in the thread that
   initialised them, so each worker process runs its chunks one at a time in one dedicated
@@ -30,7 +32,6 @@ Decisions:
 """
 
 import dataclasses
-import inspect
 import threading
 import time
 import uuid
@@ -40,7 +41,6 @@ import numpy as np
 
 from . import runtime, section
 from ._validate import require_count
-from .ensemble import check_tolerances
 
 #: Default number of chunks per worker process: enough to balance members of unequal cost
 #: (chaotic members, early escapes) without paying Taichi's per-launch overhead too often.
@@ -81,19 +81,18 @@ def check_client(client):
                     f"{type(client).__name__}{hint}")
 
 
-def sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_size=None,
+def sections(client, system, theta_p, thetadot_p, orbits, chunk_size=None,
              **kwargs) -> section.SectionResult:
     """``surface_of_section`` in this process when ``client`` is None, else
     :func:`run_sections` on the cluster behind ``client`` (same arguments, same result)."""
     check_client(client)
     if client is None:
-        return section.surface_of_section(system_or_systems, theta_p, thetadot_p, orbits,
-                                          **kwargs)
-    return run_sections(client, system_or_systems, theta_p, thetadot_p, orbits,
-                        chunk_size=chunk_size, **kwargs)
+        return section.surface_of_section(system, theta_p, thetadot_p, orbits, **kwargs)
+    return run_sections(client, system, theta_p, thetadot_p, orbits, chunk_size=chunk_size,
+                        **kwargs)
 
 
-def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_size=None,
+def run_sections(client, system, theta_p, thetadot_p, orbits, chunk_size=None,
                  retries=DEFAULT_RETRIES, arch=None, cpu_max_num_threads=None, progress=None,
                  **kwargs) -> section.SectionResult:
     """:func:`~ti_spinorbit.section.surface_of_section` split over the workers of a Dask
@@ -102,8 +101,9 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
     Parameters
     ----------
     client : dask.distributed.Client
-    system_or_systems, theta_p, thetadot_p, orbits
-        As for ``surface_of_section`` (broadcast to a flat list of N members).
+    system, theta_p, thetadot_p, orbits
+        As for ``surface_of_section`` (broadcast to a flat list of N members); explicit
+        starts go as ``initial_states=`` among the keywords.
     chunk_size : int, optional
         Members per task. Default: N split into ``CHUNKS_PER_WORKER`` chunks per worker
         process. On GPU workers prefer large chunks (thousands of members per launch).
@@ -130,78 +130,69 @@ def run_sections(client, system_or_systems, theta_p, thetadot_p, orbits, chunk_s
         the flat member list of this process.
     """
     check_client(client)
-    from distributed import as_completed
-
     started = time.perf_counter()
     retries = require_count("retries", retries, 0, 1000)
-    # argument errors are raised here, not retried on the workers
-    call = inspect.signature(section.surface_of_section).bind(
-        system_or_systems, theta_p, thetadot_p, orbits, **kwargs)
-    call.apply_defaults()
-    section.check_orbits(orbits)
-    from .perturbations import check_perturbations
-    kwargs["perturbations"] = check_perturbations(call.arguments["perturbations"])
-    section.check_size("run_sections", system_or_systems, theta_p, thetadot_p, orbits,
-                       perturbed=bool(kwargs["perturbations"]))
-    check_tolerances(call.arguments["rtol"], call.arguments["atol"])
-    from .kernels.tableau import check_method
-    check_method(call.arguments["method"])
-    if call.arguments.get("checkpoint") is not None or call.arguments.get("resume"):
+    if kwargs.get("checkpoint") is not None or kwargs.get("resume"):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
                          "would share one file); failed chunks are retried instead")
-    members, par, y0, tp, td = section.build_members(system_or_systems, theta_p, thetadot_p,
-                                                     call.arguments["escape_distance"],
-                                                     call.arguments["coordinates"],
-                                                     call.arguments["order"])
-    if call.arguments.get("indicators") and call.arguments.get("indicator_space") == "full" \
-            and call.arguments.get("model") == "auto":
-        kwargs["model"] = "3d"            # full-space indicators need the 3-D model
-    elif call.arguments.get("model") == "auto":
-        # decided over the whole ensemble, as one launch would, not chunk by chunk
-        from .models import choose
-        kwargs["model"] = choose("auto", par, y0).name
+    # argument errors are raised here, by the same checks as a local run, not on the workers;
+    # the member table (and what "auto" decides for it) is built once, here
+    members, options = section.section_inputs(system, theta_p, thetadot_p, orbits, **kwargs)
+    result = run_members(client, members, orbits, options, chunk_size=chunk_size,
+                         retries=retries, arch=arch, cpu_max_num_threads=cpu_max_num_threads,
+                         progress=progress)
+    return dataclasses.replace(result, seconds=time.perf_counter() - started)
+
+
+def run_members(client, members, orbits, options, chunk_size=None, retries=DEFAULT_RETRIES,
+                arch=None, cpu_max_num_threads=None, progress=None) -> section.SectionResult:
+    """The Dask runner: a member table (:class:`ti_spinorbit.members.Members`) cut into
+    chunks, each integrated by :func:`ti_spinorbit.section.section_of` on a worker, the
+    SectionResults joined in member order (``options``: section_of's keywords, checked).
+    Starts of every kind go to the cluster: the paper's (θ_p, θ̇_p), apsidal ones, explicit
+    3-D states (tilted), with perturbations."""
+    from distributed import as_completed
+
     n = len(members)
     if chunk_size is None:
         workers = max(len(client.nthreads()), 1)
         chunk_size = -(-n // (CHUNKS_PER_WORKER * workers))
-    chunk_size = require_count("chunk_size", chunk_size, 1, 10**9)
-    bounds = [(lo, min(lo + chunk_size, n)) for lo in range(0, n, chunk_size)]
+    chunks = members.chunks(chunk_size)
     init = {"arch": arch, "cpu_max_num_threads": cpu_max_num_threads}
+    options = dict(options, progress=False)   # no bar in a worker: the client reports chunks
     run_id = uuid.uuid4().hex[:8]
     futures = {}
-    for k, (lo, hi) in enumerate(bounds):
-        future = client.submit(_run_chunk, members[lo:hi], tp[lo:hi], td[lo:hi], orbits, init,
-                               kwargs, key=f"ti_spinorbit-chunk-{k}-of-{len(bounds)}-{run_id}",
+    for k, (lo, hi, chunk) in enumerate(chunks):
+        future = client.submit(_run_chunk, chunk, orbits, init, options,
+                               key=f"ti_spinorbit-chunk-{k}-of-{len(chunks)}-{run_id}",
                                retries=retries, pure=False)
         futures[future] = k
-    parts = [None] * len(bounds)
+    parts = [None] * len(chunks)
     done = 0
     try:
         for future in as_completed(list(futures)):
             k = futures[future]
+            lo, hi, _ = chunks[k]
             if future.status != "finished":
                 exc = future.exception()
-                lo, hi = bounds[k]
                 raise ChunkError(
-                    f"chunk {k} of {len(bounds)} (members {lo}..{hi - 1}) failed after "
+                    f"chunk {k} of {len(chunks)} (members {lo}..{hi - 1}) failed after "
                     f"{retries + 1} attempt{'s' if retries else ''}: {type(exc).__name__}: "
                     f"{exc}", k, slice(lo, hi)) \
                     from exc
             parts[k] = future.result()
-            done += bounds[k][1] - bounds[k][0]
+            done += hi - lo
             if progress is not None:
                 progress(done / n)
     finally:
         client.cancel([f for f in futures if not f.done()])
-    result = concatenate(parts)
-    return dataclasses.replace(result, systems=members, seconds=time.perf_counter() - started)
+    return dataclasses.replace(concatenate(parts), systems=members.systems)
 
 
-def _run_chunk(systems, theta_p, thetadot_p, orbits, init, kwargs):
-    """Worker side: one chunk through surface_of_section on this process's Taichi thread.
+def _run_chunk(members, orbits, init, options):
+    """Worker side: one chunk through section_of on this process's Taichi thread.
     ``systems`` are left out of the reply (the client has them)."""
-    result = _taichi_thread().submit(_integrate, systems, theta_p, thetadot_p, orbits, init,
-                                     kwargs).result()
+    result = _taichi_thread().submit(_integrate, members, orbits, init, options).result()
     return dataclasses.replace(result, systems=[])
 
 
@@ -217,7 +208,7 @@ def _taichi_thread():
         return _THREAD["executor"]
 
 
-def _integrate(systems, theta_p, thetadot_p, orbits, init, kwargs):
+def _integrate(members, orbits, init, options):
     if runtime.current_arch() is not None and runtime.generation() != _THREAD["generation"]:
         raise RuntimeError(
             "Taichi was initialised in this worker process outside ti_spinorbit.distributed "
@@ -230,9 +221,7 @@ def _integrate(systems, theta_p, thetadot_p, orbits, init, kwargs):
     else:
         runtime.ensure_init()
     _THREAD["generation"] = runtime.generation()
-    # no bar in a worker (the client reports chunks); its stderr may well be a terminal
-    return section.surface_of_section(systems, theta_p, thetadot_p, orbits,
-                                      **dict(kwargs, progress=False))
+    return section.section_of(members, orbits, **options)
 
 
 def concatenate(parts) -> section.SectionResult:
@@ -273,5 +262,5 @@ def _join(arrays):
     return np.concatenate(arrays, axis=0)
 
 
-__all__ = ["run_sections", "sections", "check_client", "concatenate", "ChunkError", "CHUNKS_PER_WORKER",
+__all__ = ["run_sections", "run_members", "sections", "check_client", "concatenate", "ChunkError", "CHUNKS_PER_WORKER",
            "DEFAULT_RETRIES"]

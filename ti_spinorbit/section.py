@@ -20,14 +20,15 @@ import numpy as np
 from . import accuracy
 from . import coordinates as _coords
 from . import progress as _progress
-from ._validate import (_as_floats, require_bool, require_count, require_finite,
-                        require_order, require_real, require_spin, show)
+from ._validate import require_bool, require_count, require_order, require_real
 from .ensemble import DEFAULT_WINDOW_ORBITS, Ensemble, RunOutput
+from .members import Members, member_groups
+from .models import check_indicator_space
 from .systems import ESCAPE_DISTANCE, BinarySystem
 from . import display as _display
 from .initial import ROW_UNIT as STATE_ROW
 from .attitude import CLASS_UNIT as ATTITUDE_CLASS
-from .perturbations import UNIT as PERTURBATIONS, check_perturbations, perturbation_rows
+from .perturbations import UNIT as PERTURBATIONS
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result, unit
 from .results import FLOAT as _F, INTEGER as _I
 
@@ -62,34 +63,6 @@ def _check_run_inputs(rtol, atol, order, progress, window_orbits):
     _progress.check(progress)
 
 
-def check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit=None,
-               model="auto", perturbed=False, states=False):
-    """Refuse a run whose estimated peak memory (``resources.estimate_bytes``) exceeds what
-    is available, from the input sizes alone: before any member is built. Inputs that do
-    not broadcast are left to :func:`build_members`, which names them."""
-    from . import resources
-
-    systems = () if isinstance(system, BinarySystem) else \
-        (len(system),) if hasattr(system, "__len__") else None
-    n = None if systems is None else resources.member_count(systems, theta_p, thetadot_p)
-    if n is not None:
-        resources.check_memory(what, n, orbits, samples_per_orbit,
-                               width=resources.record_width(system, model, perturbed),
-                               states=states)
-
-
-def _system_argument(system):
-    """Catalogue names (a str, or str entries of a list) as BinarySystems; anything else as
-    given (build_members checks it)."""
-    from . import catalog
-
-    if isinstance(system, str):
-        return catalog.system(system)
-    if isinstance(system, (list, tuple)) and any(isinstance(s, str) for s in system):
-        return [catalog.system(s) if isinstance(s, str) else s for s in system]
-    return system
-
-
 def _warn_near_circular(members):
     """NearCircularWarning when a section's system has e < NEAR_CIRCULAR_E (pericentre
     ill-defined); a warning, since such a run is still a valid integration."""
@@ -103,128 +76,6 @@ def _warn_near_circular(members):
                       "where the section samples is ill-defined on a nearly circular orbit; the "
                       "points follow the osculating elements more than the spin",
                       NearCircularWarning, stacklevel=3)
-
-
-def _system_list(system):
-    """The systems of a member table as a non-empty list, or TypeError naming ``system``."""
-    try:
-        systems = [system] if isinstance(system, BinarySystem) else list(system)
-    except TypeError:                       # not iterable (a number, None)
-        systems = []
-    if not systems or not all(isinstance(s, BinarySystem) for s in systems):
-        raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
-                        f"of them (got {show(system)})")
-    return systems
-
-
-def _check_escape_distance(escape_distance):
-    distance = _as_floats("escape_distance", escape_distance)
-    if distance.ndim != 0 or not np.isfinite(distance) or distance <= 1:
-        raise ValueError(f"escape_distance must be a finite number > 1 (units of a) "
-                         f"(got {escape_distance!r})")
-
-
-def _parameter_rows(members, escape_distance):
-    """(N, NPAR) kernel parameter rows, one ``parameter_row`` per distinct system."""
-    rows = {}
-    for m in members:
-        if id(m) not in rows:
-            rows[id(m)] = m.parameter_row(escape_distance)
-    return np.stack([rows[id(m)] for m in members])
-
-
-def build_members(system: SystemLike, theta_p, thetadot_p,
-                  escape_distance=ESCAPE_DISTANCE, coordinates="inertial", order=4):
-    """Broadcast systems and initial conditions into a member table.
-
-    Returns (systems list of length N, par (N, NPAR), y0 (N, 30), theta_p_deg (N,),
-    thetadot_p (N,)). ``escape_distance`` is in units of a and must exceed 1. With
-    ``coordinates="apsidal"`` thetadot_p is the apsidal spin rate θ̇ − ϖ̇ at the start and y0
-    carries the inertial spin θ̇_p + ϖ̇(0) (docs/physics.md §6.7; ϖ̇ of the ``order`` model)."""
-    _coords.check_coordinates(coordinates)
-    _check_escape_distance(escape_distance)
-    systems = _system_list(system)
-    # checked before the conversion, so complex values and text are refused, not cast
-    theta_p = np.asarray(require_finite("theta_p", theta_p), dtype=np.float64)
-    thetadot_p = np.asarray(require_spin("thetadot_p", thetadot_p), dtype=np.float64)
-    if theta_p.size == 0 or thetadot_p.size == 0:
-        raise ValueError(f"theta_p and thetadot_p must hold at least one start each (got "
-                         f"shapes {theta_p.shape} and {thetadot_p.shape})")
-    index = np.arange(len(systems)) if len(systems) > 1 else np.zeros((), dtype=int)
-    try:
-        index, theta_p, thetadot_p = np.broadcast_arrays(index, theta_p, thetadot_p)
-    except ValueError:
-        raise ValueError(f"cannot broadcast {len(systems)} systems, theta_p of shape "
-                         f"{theta_p.shape} and thetadot_p of shape {thetadot_p.shape}") from None
-    index, theta_p, thetadot_p = (np.ravel(x) for x in (index, theta_p, thetadot_p))
-    members = [systems[k] for k in index]
-    # one row and one vectorised start per system, spread over its members
-    par = _parameter_rows(systems, escape_distance)[index]
-    y0 = np.empty((len(index), 30))
-    for k, system in enumerate(systems):
-        sel = np.flatnonzero(index == k)
-        if len(sel):
-            y0[sel] = system.initial_states(np.radians(theta_p[sel]), thetadot_p[sel])
-    if coordinates == "apsidal":
-        y0, _ = _coords.apsidal_initial_states(members, par, y0, theta_p, thetadot_p, order)
-    return members, par, y0, theta_p.copy(), thetadot_p.copy()
-
-
-def state_members(system: SystemLike, initial_states, escape_distance=ESCAPE_DISTANCE):
-    """Member table of explicit 3-D starts (:class:`ti_spinorbit.InitialState`): as
-    :func:`build_members`, with one member per state. ``system`` is one system for all or
-    one per state. The returned θ_p and θ̇_p are each start's α (degrees, docs/physics.md
-    §6.2) and inertial spin rate about the orbit normal (units of n), so sections and time
-    series report them as for the paper's starts."""
-    from .initial import InitialState, as_scaled_states
-    from .observables import derive
-
-    states = [initial_states] if isinstance(initial_states, InitialState) else list(initial_states)
-    systems = _system_list(system)
-    if len(systems) not in (1, len(states)):
-        raise ValueError(f"with initial_states, system must be one system or one per state "
-                         f"(got {len(systems)} systems for {len(states)} states)")
-    members = systems * len(states) if len(systems) == 1 else systems
-    _check_escape_distance(escape_distance)
-    y0 = as_scaled_states(members, states)
-    par = _parameter_rows(members, escape_distance)
-    d = derive(par, y0)
-    return members, par, y0, np.degrees(d["alpha"]), d["thetadot"]
-
-
-def _members(what, system, theta_p, thetadot_p, orbits, escape_distance, coordinates, order,
-             initial_states, samples_per_orbit=None, model="auto", perturbed=False,
-             states=False):
-    """The member table of an entry point, from (θ_p, θ̇_p) or from ``initial_states``,
-    after the memory check (``perturbed``: the records carry the accumulators too;
-    ``states``: a time series keeping the state rows, ``resources.estimate_bytes``)."""
-    if initial_states is None:
-        if theta_p is None and thetadot_p is None:     # one None: build_members names it
-            raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
-                            "initial_states=[InitialState, ...]")
-        check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit, model,
-                   perturbed, states)
-        return build_members(system, theta_p, thetadot_p, escape_distance, coordinates, order)
-    if theta_p is not None or thetadot_p is not None:
-        raise ValueError(f"{what}: give theta_p and thetadot_p or initial_states, not both")
-    if coordinates != "inertial":
-        raise ValueError(f"{what}: initial_states need coordinates='inertial' (the apsidal "
-                         "coordinates are defined for the paper's planar starts)")
-    count = 1 if not isinstance(initial_states, (list, tuple, np.ndarray)) else len(initial_states)
-    if count == 0:
-        raise ValueError("initial_states must hold at least one InitialState")
-    check_size(what, system, np.zeros(count), 0.0, orbits, samples_per_orbit, "3d", perturbed,
-               states)
-    return state_members(system, initial_states, escape_distance)
-
-
-def _member_groups(members):
-    """[(system, member indices)] of the distinct systems of a member list, in first-seen
-    order (one entry for an ensemble of one system)."""
-    ids = np.fromiter(map(id, members), dtype=np.uint64, count=len(members))
-    _, first, inverse = np.unique(ids, return_index=True, return_inverse=True)
-    order = np.argsort(first)                       # groups in first-seen order
-    return [(members[first[g]], np.flatnonzero(inverse.ravel() == g)) for g in order]
 
 
 def _segment_max(values, counts, floor):
@@ -247,7 +98,7 @@ def _state_rows_and_tilt(members, records_list, y0, y_end):
     from .initial import physical_rows
 
     rows = np.empty((len(members), 30))
-    for m, idx in _member_groups(members):
+    for m, idx in member_groups(members):
         rows[idx] = physical_rows(m, y0[idx])
     counts = np.fromiter((len(r) for r in records_list), dtype=np.int64, count=len(records_list))
     flat = np.concatenate([np.zeros((0, 30))] + [r[:, 1:31] for r in records_list if len(r)])
@@ -428,54 +279,86 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     -------
     SectionResult
     """
+    members, options = section_inputs(
+        system, theta_p, thetadot_p, orbits, rtol=rtol, atol=atol, order=order,
+        window_orbits=window_orbits, escape_distance=escape_distance, indicators=indicators,
+        progress=progress, model=model, checkpoint=checkpoint, resume=resume,
+        overwrite_checkpoint=overwrite_checkpoint, max_drift=max_drift,
+        coordinates=coordinates, method=method, initial_states=initial_states,
+        perturbations=perturbations, indicator_space=indicator_space)
+    return section_of(members, orbits, **options)
+
+
+def section_inputs(system, theta_p=None, thetadot_p=None, orbits=None, *, rtol=1e-12,
+                   atol=None, order=4, window_orbits=DEFAULT_WINDOW_ORBITS,
+                   escape_distance=ESCAPE_DISTANCE, indicators=False, progress=None,
+                   model="auto", checkpoint=None, resume=False, overwrite_checkpoint=False,
+                   max_drift=None, coordinates="inertial", method="cash-karp",
+                   initial_states=None, perturbations=None, indicator_space="planar"):
+    """:func:`surface_of_section`'s inputs checked (all of them, before any work) and turned
+    into (member table, the keywords of :func:`section_of`): the one front door of the
+    local and the Dask runner alike."""
+    from .kernels.tableau import check_method
+
     _coords.check_coordinates(coordinates)
-    system = _system_argument(system)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
-    limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
-    from .models import check_indicator_space
+    check_method(method)
+    if max_drift is not None:
+        accuracy.drift_limit(rtol, orbits, max_drift)       # checked before any work
     indicator_space = check_indicator_space(indicator_space)
-    if indicators and indicator_space == "full":
-        if model == "planar":
-            raise ValueError("indicator_space='full' needs the 3-D model (the planar model "
-                             "cannot carry out-of-plane deviations): use model='auto' or '3d'")
-        model = "3d" if model == "auto" else model
-    perturbations = check_perturbations(perturbations)
-    members, par, y0, tp, td = _members("surface_of_section", system, theta_p, thetadot_p,
-                                        orbits, escape_distance, coordinates, order,
-                                        initial_states, model=model,
-                                        perturbed=bool(perturbations))
-    _warn_near_circular(members)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
-                   perturbation_rows=perturbation_rows(members, perturbations))
+    members = Members.build("surface_of_section", system, theta_p, thetadot_p, initial_states,
+                            orbits, escape_distance=escape_distance, coordinates=coordinates,
+                            order=order, model=model, perturbations=perturbations,
+                            full_indicators=bool(indicators) and indicator_space == "full")
+    _warn_near_circular(members.systems)
+    return members, dict(rtol=rtol, atol=atol, window_orbits=window_orbits,
+                         indicators=indicators, progress=progress, checkpoint=checkpoint,
+                         resume=resume, overwrite_checkpoint=overwrite_checkpoint,
+                         max_drift=max_drift, method=method, indicator_space=indicator_space)
+
+
+def section_of(members: Members, orbits, *, rtol=1e-12, atol=None,
+               window_orbits=DEFAULT_WINDOW_ORBITS, indicators=False, progress=None,
+               checkpoint=None, resume=False, overwrite_checkpoint=False, max_drift=None,
+               method="cash-karp", indicator_space="planar") -> SectionResult:
+    """The local runner of :func:`surface_of_section`: integrate a member table
+    (:class:`ti_spinorbit.members.Members`) in this process, in one ensemble launch, and
+    build its SectionResult. The Dask runner (:func:`ti_spinorbit.distributed.run_sections`)
+    calls it on every chunk of the table. Arguments as for :func:`surface_of_section`."""
+    ens = Ensemble(members.par, members.y0, order=members.order, rtol=rtol, atol=atol,
+                   model=members.model, method=method,
+                   perturbation_rows=members.perturbation_rows)
     with _progress.reporting(progress, "surface_of_section") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits, indicators=indicators,
                       progress=report, checkpoint=checkpoint, resume=resume,
                       overwrite_checkpoint=overwrite_checkpoint, indicator_space=indicator_space)
+    par, systems, coordinates = members.par, members.systems, members.coordinates
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"),
-                            apsidal=coordinates == "apsidal", order=order)
+                            apsidal=coordinates == "apsidal", order=members.order)
     thetadot, rate = cols["thetadot"], None
     if coordinates == "apsidal":
         rate, = _coords.mask_small_eccentricity(cols["e"], cols["apsidal_rate"],
                                                 what="pericentre passages")
         thetadot = thetadot - rate
-    n = np.array([s.mean_motion for s in members])
-    a = np.array([s.a for s in members])
+    n = np.array([s.mean_motion for s in systems])
+    a = np.array([s.a for s in systems])
     energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end, out.exchange)
-    limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
+    limit = accuracy.drift_limit(ens.rtol, orbits, max_drift)
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
-    rows, tilt, npa = _state_rows_and_tilt(members, out.events, y0, out.y)
+    rows, tilt, npa = _state_rows_and_tilt(systems, out.events, members.y0, out.y)
     return SectionResult(
         theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=thetadot,
         t=cols["t"] / n[:, None], r=cols["r"] * a[:, None], a=cols["a"] * a[:, None], e=cols["e"],
         count=np.array([len(ev) for ev in out.events]), energy_drift=energy_drift,
         angmom_drift=angmom_drift, status=status, accepted=out.counters[:, 0],
-        rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2], initial_theta_p=tp,
-        initial_thetadot_p=td, systems=members, rtol=ens.rtol, atol=ens.atol, order=order,
+        rejected=out.counters[:, 1], rhs_calls=out.counters[:, 2],
+        initial_theta_p=members.theta_p, initial_thetadot_p=members.thetadot_p,
+        systems=systems, rtol=ens.rtol, atol=ens.atol, order=members.order,
         orbits=orbits, seconds=out.seconds, megno=out.megno, lyapunov=out.lyapunov,
         max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
-        indicator_space=indicator_space, perturbations=perturbations,
+        indicator_space=indicator_space, perturbations=members.perturbations,
         stop_status=np.asarray(out.status, dtype=np.int32).copy())
 
 
@@ -702,19 +585,19 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     and ``external_angmom`` (the angular momentum they brought in, inertial, kg m² s⁻¹) at
     every sample; the drifts are those of E − W and L − L_ext."""
     _coords.check_coordinates(coordinates)
-    system = _system_argument(system)
     samples_per_orbit = require_count("samples_per_orbit", samples_per_orbit, 1, 100000)
     orbits = check_orbits(orbits)
     _check_run_inputs(rtol, atol, order, progress, window_orbits)
     limit = accuracy.drift_limit(rtol, orbits, max_drift) if max_drift is not None else None
     states = require_bool("states", states)
-    perturbations = check_perturbations(perturbations)
-    members, par, y0, tp, td = _members("time_series", system, theta_p, thetadot_p, orbits,
-                                        escape_distance, coordinates, order, initial_states,
-                                        samples_per_orbit, model, bool(perturbations),
-                                        states)
-    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=model, method=method,
-                   perturbation_rows=perturbation_rows(members, perturbations))
+    table = Members.build("time_series", system, theta_p, thetadot_p, initial_states, orbits,
+                          escape_distance=escape_distance, coordinates=coordinates,
+                          order=order, model=model, perturbations=perturbations,
+                          samples_per_orbit=samples_per_orbit, states=states)
+    members, par, y0 = table.systems, table.par, table.y0
+    tp, td, perturbations = table.theta_p, table.thetadot_p, table.perturbations
+    ens = Ensemble(par, y0, order=order, rtol=rtol, atol=atol, model=table.model,
+                   method=method, perturbation_rows=table.perturbation_rows)
     with _progress.reporting(progress, "time_series") as report:
         out = ens.run(2.0 * np.pi * orbits, window_orbits=window_orbits,
                       sample_dt=2.0 * np.pi / samples_per_orbit, progress=report,

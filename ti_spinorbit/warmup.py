@@ -62,7 +62,7 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     from . import catalog, runtime
     from ._validate import require_order
     from .ensemble import Ensemble
-    from .section import build_members
+    from .members import Members
 
     models = _choices("models", models, MODELS)
     indicators = _choices("indicators", indicators, (False, True))
@@ -73,9 +73,10 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
     out = sys.stdout if stream is None else stream
     runtime.ensure_init()
     system = catalog.system("1991 VH")
-    members, par, y0, _, _ = build_members(system, 0.0, 1.0, order=order)
-    from .perturbations import Tides, perturbation_rows
-    rows = perturbation_rows(members, [Tides(k2=1e-5, time_lag=600.0)])   # any block will do
+    from .perturbations import Tides
+    table = Members.from_starts(system, 0.0, 1.0, order=order,
+                                perturbations=[Tides(k2=1e-5, time_lag=600.0)])  # any block
+    par, y0, rows = table.par, table.y0, table.perturbation_rows
     done = []
     for method, model, ind, samp, pert in itertools.product(methods, models, indicators,
                                                             sampling, perturbed):
