@@ -7,13 +7,14 @@ converged."""
 import math
 import os
 import re
+import subprocess
 import sys
 
 import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import attitude, cli, distributed, layout, resources, section
+from ti_spinorbit import attitude, cli, distributed, layout, resources, runners, section
 from ti_spinorbit.ensemble import check_tolerances
 from ti_spinorbit.initial import InitialState, orbit_frame, quaternion_to_matrix, rotation
 
@@ -31,17 +32,18 @@ def no_integration(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError("integrated although client is not a Client")
     monkeypatch.setattr(section, "surface_of_section", forbidden)
+    monkeypatch.setattr(section, "section_of", forbidden)
 
 
 @pytest.mark.parametrize("call", [
-    lambda vh: distributed.sections(object(), vh, 0.0, 1.0, 2),
+    lambda vh: runners.run_section(object(), vh, 0.0, 1.0, 2),
     lambda vh: distributed.run_sections(object(), vh, 0.0, 1.0, 2),
     lambda vh: tso.chaos_map(vh, [0.0, 90.0], [1.0, 1.5], 2, client=object()),
     lambda vh: tso.parameter_map("1991 VH", [1.2], [0.1], 2, theta_p=[0.0],
                                  thetadot_p=[1.0], client=object()),
     lambda vh: tso.overlap_threshold("1991 VH", elongations=[1.05], orbits=2, centre_starts=2,
                                      separatrix_starts=2, client=object()),
-], ids=["sections", "run_sections", "chaos_map", "parameter_map", "overlap_threshold"])
+], ids=["run_section", "run_sections", "chaos_map", "parameter_map", "overlap_threshold"])
 def test_client_that_is_not_a_client_is_a_one_line_type_error(vh, no_integration, call):
     with pytest.raises(TypeError, match=CLIENT_MESSAGE) as info:
         call(vh)
@@ -53,12 +55,12 @@ def test_check_client_names_the_type_given():
         def nthreads(self):
             return {}
 
-    assert distributed.check_client(None) is None
+    assert runners.check_client(None) is None
     with pytest.raises(TypeError, match=r"^client must be a dask\.distributed\.Client or "
                                         r"None, not FakeClient$"):
-        distributed.check_client(FakeClient())
+        runners.check_client(FakeClient())
     with pytest.raises(TypeError, match=r", not str$"):
-        distributed.check_client("tcp://127.0.0.1:8786")
+        runners.check_client("tcp://127.0.0.1:8786")
 
 
 # ---- 2. kicked() when V is parallel to R ----------------------------------------------------
@@ -334,3 +336,18 @@ def test_libration_not_converged_accepted_with_allow_inaccurate(tmp_path, capsys
     assert cli.main([*LIBRATION, "--allow-inaccurate", "--out", out]) == 0
     err = capsys.readouterr().err
     assert "ti-spinorbit libration: not converged (" in err and "exit status 3" not in err
+
+
+def test_a_local_map_never_imports_the_dask_module():
+    """The runner is chosen by client: without one, the maps and scans never import
+    ti_spinorbit.distributed (nor dask)."""
+    code = ("import sys, ti_spinorbit as tso\n"
+            "tso.chaos_map('1991 VH', [0.0], [1.0], 1, fraction_orbits=(), progress=False)\n"
+            "tso.overlap_threshold('1991 VH', elongations=[1.05], orbits=1, max_orbits=1,\n"
+            "                      centre_starts=2, separatrix_starts=2, progress=False)\n"
+            "print(sorted(m for m in sys.modules if m in ('ti_spinorbit.distributed', 'dask',\n"
+            "             'distributed')))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=dict(os.environ, MPLBACKEND="Agg"), timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().splitlines()[-1] == "[]"

@@ -31,7 +31,7 @@ from ._validate import (_as_floats, require_positive, require_real,
 from .classify import MIN_POINTS, classify_section
 from .convergence import run_lengths
 from .coordinates import check_coordinates
-from .distributed import sections
+from .runners import check_client, run_section
 from .section import INDICATOR_SPACE, SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
@@ -320,7 +320,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
     lengths = shorter + [float(orbits)]
 
     def stage(k, length, share):
-        section = sections(client, system, grid_tp, grid_td, length, chunk_size=chunk_size,
+        section = run_section(client, system, grid_tp, grid_td, length, chunk_size=chunk_size,
                            rtol=rtol, indicators=True, model=model, max_drift=max_drift,
                            coordinates=coordinates, progress=share, **section_kwargs,
                            **launches.next())
@@ -375,6 +375,7 @@ def _launches(checkpoint, resume, overwrite, client):
     work; none with a Dask client (refused there by the first launch)."""
     from .checkpoint import Launches, check_path
 
+    check_client(client)
     checkpoint = check_path(checkpoint)
     if client is not None and (checkpoint is not None or resume):
         raise ValueError("checkpoint/resume do not combine with a Dask client (every chunk "
@@ -589,7 +590,7 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     lengths = shorter + [float(orbits)]
 
     def stage(k, length, share):
-        section = sections(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
+        section = run_section(client, members, np.tile(tp, len(grid)), np.tile(td, len(grid)),
                            length, chunk_size=chunk_size, rtol=rtol, indicators=True,
                            model=model, max_drift=max_drift, coordinates=coordinates,
                            progress=share, **section_kwargs, **launches.next())

@@ -40,6 +40,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from . import runtime, section
+from .runners import check_client
 from ._validate import require_count
 
 #: Default number of chunks per worker process: enough to balance members of unequal cost
@@ -61,35 +62,6 @@ class ChunkError(RuntimeError):
         super().__init__(message)
         self.chunk = chunk
         self.members = members
-
-
-def check_client(client):
-    """``client`` if it is a ``dask.distributed.Client`` (or None), else a one-line TypeError
-    naming what was given: raised before any work, not as an AttributeError from inside the
-    run (``client.nthreads``, ``client.submit``)."""
-    if client is None:
-        return None
-    try:
-        from distributed import Client
-    except ImportError:
-        Client = None
-    if Client is not None and isinstance(client, Client):
-        return client
-    hint = "" if Client is not None else \
-        " (dask is not installed: pip install ti-spinorbit[dask])"
-    raise TypeError(f"client must be a dask.distributed.Client or None, not "
-                    f"{type(client).__name__}{hint}")
-
-
-def sections(client, system, theta_p, thetadot_p, orbits, chunk_size=None,
-             **kwargs) -> section.SectionResult:
-    """``surface_of_section`` in this process when ``client`` is None, else
-    :func:`run_sections` on the cluster behind ``client`` (same arguments, same result)."""
-    check_client(client)
-    if client is None:
-        return section.surface_of_section(system, theta_p, thetadot_p, orbits, **kwargs)
-    return run_sections(client, system, theta_p, thetadot_p, orbits, chunk_size=chunk_size,
-                        **kwargs)
 
 
 def run_sections(client, system, theta_p, thetadot_p, orbits, chunk_size=None,
@@ -262,5 +234,5 @@ def _join(arrays):
     return np.concatenate(arrays, axis=0)
 
 
-__all__ = ["run_sections", "run_members", "sections", "check_client", "concatenate", "ChunkError", "CHUNKS_PER_WORKER",
+__all__ = ["run_sections", "run_members", "concatenate", "ChunkError", "CHUNKS_PER_WORKER",
            "DEFAULT_RETRIES"]

@@ -52,7 +52,7 @@ from ._validate import (_as_floats, require_count, require_range,
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
 from .convergence import run_lengths
-from .distributed import sections
+from .runners import run_section
 from .systems import BinarySystem
 from . import display as _display
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, record, unit
@@ -368,7 +368,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                 members += [systems[k]] * per
                 theta0 += [0.0] * len(centre_rates) + [90.0] * len(sep_rates)
                 rates += list(centre_rates) + list(sep_rates)
-            sec = sections(client, members, np.array(theta0), np.array(rates),
+            sec = run_section(client, members, np.array(theta0), np.array(rates),
                            orbits=length, progress=share, **run, **launches.next())
             member_orbits += len(members) * float(length)
             first_sec = sec if first_sec is None else first_sec
