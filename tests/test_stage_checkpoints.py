@@ -1,4 +1,4 @@
-"""Every stage of a multi-stage entry point is checkpointed (issue 22, §3): a chaos or
+"""Every stage of a multi-stage entry point is checkpointed: a chaos or
 parameter map's evidence lengths (orbits/4, orbits/2) and the map itself, overlap_threshold's
 doublings and relaxed_libration's search and convergence runs each checkpoint into
 ``DIR/launch-kkk``. A run interrupted at any window of any stage resumes to a result equal
