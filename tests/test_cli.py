@@ -211,8 +211,9 @@ def read_checkpoint_launches(path):
 
 
 def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
-    """The map is interrupted by SIGKILL after two windows, `--resume` finishes it, and the
-    saved arrays equal those of an uninterrupted run."""
+    """The map is interrupted by SIGKILL after two windows of its first stage (the evidence
+    length orbits/4, checkpointed in launch-000), `--resume` finishes it, and the saved
+    arrays equal those of an uninterrupted run."""
     import signal
     import time
 
@@ -223,13 +224,15 @@ def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "ti_spinorbit", *args, "--out", "m.png",
                              "--checkpoint", str(ckpt)], cwd=tmp_path, env=env)
     deadline = time.time() + 300
-    while time.time() < deadline and not (ckpt / "records-000001.npz").exists():
+    first = ckpt / "launch-000"
+    while time.time() < deadline and not (first / "records-000001.npz").exists():
         time.sleep(0.05)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     assert proc.returncode == -signal.SIGKILL                    # killed, not finished
-    done = read_checkpoint_launches(ckpt)
-    assert 2 <= done < 100                                       # 100 windows of 16 orbits
+    done = read_checkpoint_launches(first)
+    assert 2 <= done < 25                  # 25 windows of 16 orbits in the first 400 orbits
+    assert not (ckpt / "launch-001").exists()
     p = run_cli(*args, "--out", "m.png", "--checkpoint", str(ckpt), "--resume", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     p = run_cli(*args, "--out", "full.png", cwd=tmp_path)
@@ -239,7 +242,7 @@ def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
             np.testing.assert_array_equal(a[key], b[key], err_msg=key)
 
 
-# ---- output hygiene (issue 14 §7) ------------------------------------------------------
+# ---- output hygiene ------------------------------------------------------
 
 @pytest.mark.parametrize("argv, stem", [
     (["section"], "sos_1991VH"),

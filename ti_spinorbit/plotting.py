@@ -4,8 +4,19 @@ Surface of section: θ_p (deg) in [0°, 180°) horizontally, θ̇_p/n vertically
 trajectory unless a classification gives the paper's colours (resonant red, chaotic blue,
 quasi-periodic green)."""
 
+import os
+import re
+
+import numpy as np
+
+from . import analytic
 from .classify import COLORS as CLASS_COLORS  # the paper's red / blue / green
 from .coordinates import THETADOT_LABEL       # "θ̇_p/n (inertial)" or "(apsidal)"
+from .display import elongation, span
+from .files import atomic_write
+
+# matplotlib is imported inside the functions that draw (pyplot through _pyplot), so that
+# importing the package, or this module, does not load it.
 
 #: MEGNO colour scale of maps: 2 (regular) to 8 and beyond (chaotic; the colourbar says ≥ 8).
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -14,8 +25,8 @@ MEGNO_COLOR_RANGE = (0.0, 8.0)
 def _pyplot():
     """matplotlib.pyplot with the backend the session chose: a library never switches it
     (in a notebook that would turn the inline figures off for the whole kernel); the
-    command line picks a file backend for itself (``cli._choose_backend``)."""
-    import matplotlib.pyplot as plt
+    command line picks a file backend for itself (``cli.common.choose_backend``)."""
+    import matplotlib.pyplot as plt      # matplotlib: when a figure is drawn
 
     return plt
 
@@ -39,8 +50,6 @@ def run_title(systems, orbits=None, rtol=None, what=None):
     """A figure title with the run's identity: system, a/b, e, orbits, rtol, e.g.
     "1991 VH, a/b = 1.41, e = 0.05, 300 orbits, rtol 1e-12" (ranges for several systems),
     then ": what" when given."""
-    from .display import elongation, span
-
     unique = list({id(s): s for s in (systems or ())}.values())
     parts = []
     if len(unique) == 1:
@@ -78,7 +87,7 @@ def _legend_outside(ax, where="right", **kwargs):
 
 def class_legend(ax, classes, where="right", **kwargs):
     """A legend of the classes present (the paper's colours), outside the axes."""
-    from matplotlib.lines import Line2D
+    from matplotlib.lines import Line2D      # matplotlib: when a figure is drawn
 
     present = [c for c in CLASS_ORDER if c in set(map(str, classes))]
     handles = [Line2D([], [], ls="", marker="o", ms=4, color=_class_color(c), label=c)
@@ -95,8 +104,6 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
     else one per member with a legend for up to ``MAX_LEGEND`` members and, above that, a
     colourbar of the start θ̇_p(0)/n. Legends sit outside the axes (``legend_loc`` "right"
     or "below"). Returns the Axes."""
-    import numpy as np
-
     plt = _pyplot()
     ax = _axes(ax)
     n = len(result.count)
@@ -109,7 +116,7 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
         classes = list(colors)
         colors = [_class_color(c) for c in classes]
     elif colors is None and n > MAX_LEGEND:
-        from matplotlib.colors import Normalize
+        from matplotlib.colors import Normalize      # matplotlib: when a figure is drawn
 
         lo, hi = float(np.nanmin(start)), float(np.nanmax(start))
         by_start = plt.cm.ScalarMappable(Normalize(lo, hi if hi > lo else lo + 1e-9),
@@ -148,8 +155,6 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
 
 def _edges(centres, low=None, high=None):
     """Cell edges for pcolormesh from cell centres (midpoints; outer cells mirrored)."""
-    import numpy as np
-
     c = np.asarray(centres, dtype=np.float64)
     if c.size == 1:
         half = 0.5 if low is None else 0.5 * (high - low)
@@ -171,8 +176,7 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
     (y).
     ``overlay=True`` adds the section points of up to ``overlay_members`` evenly spaced members
     as small black dots. Returns the Axes."""
-    import numpy as np
-    from matplotlib.colors import ListedColormap
+    from matplotlib.colors import ListedColormap      # matplotlib: when a figure is drawn
 
 
     ax = _axes(ax)
@@ -185,7 +189,7 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
     elif quantity == "lyapunov":
         z, kw, label = cmap.lyapunov, dict(cmap="magma", vmin=0.0), r"$\lambda$ (1/orbit)"
     elif quantity == "max_tilt":
-        from matplotlib.colors import LogNorm
+        from matplotlib.colors import LogNorm      # matplotlib: when a figure is drawn
 
         if getattr(cmap, "max_tilt", None) is None:
             raise ValueError("quantity='max_tilt' needs a map that recorded the tilt")
@@ -240,10 +244,6 @@ def plot_parameter_map(pmap, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=
     """pcolormesh of a ParameterMap's chaotic fraction over (e, a/b), with the analytic
     overlap line a/b(ω0^RO(e)) and contours of the chaotic-layer half-width ΔE/E0(ω0(a/b), e)
     (14π form as quoted). Returns the Axes."""
-    import numpy as np
-
-    from . import analytic
-
     ax = _axes(ax)
     x = np.clip(_edges(pmap.eccentricities), 0.0, 0.999)  # physical ranges only
     y = np.maximum(_edges(pmap.elongations), 1.0)
@@ -268,8 +268,6 @@ def plot_parameter_map(pmap, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=
     ax.set_ylabel(r"$a/b$")
     ax.legend(fontsize=7, loc="lower right", framealpha=0.5)
     if title is None:
-        from .display import span
-
         what = f"chaotic fraction of {pmap.megno.shape[-1]} starts"
         if pmap.n_inaccurate:
             what += (f" ({pmap.n_inaccurate} inaccurate starts "
@@ -284,8 +282,6 @@ def overlap_megno(scan):
     """Largest finite ⟨Y⟩ among each elongation's trajectories in the run its decision comes
     from (``OverlapDecision.max_megno``; for files written before it was kept, from the
     first run's sections), NaN where unknown: no indicators, or nothing saved."""
-    import numpy as np
-
     out = np.full(len(scan.elongations), np.nan)
     for k, d in enumerate(scan.decisions):
         if d.max_megno is not None:
@@ -303,8 +299,6 @@ def plot_overlap(scan, ax=None, title=None):
     analytic thresholds, and on a second axis the largest MEGNO ⟨Y⟩ of each elongation's
     trajectories (chaos shows there before a trajectory connects the islands). Returns the
     Axes of the decisions."""
-    import numpy as np
-
     ax = _axes(ax, (6.4, 3.6))
     ax.scatter(scan.elongations, scan.overlaps.astype(int),
                c=["tab:blue" if o else "tab:green" for o in scan.overlaps], s=25, zorder=3)
@@ -347,8 +341,6 @@ def plot_time_series(ts, ax=None, quantity="thetadot", members=None, title=None)
     θ̇/n (``quantity="thetadot"``), α (``"alpha"``, deg), θ (``"theta"``, deg) or r
     (``"r"``, units of a). Members labelled by their start (legend right of the axes, up to
     ``MAX_LEGEND``; a colourbar of the start beyond). Returns the Axes."""
-    import numpy as np
-
     labels = {"thetadot": r"$\dot\theta/n$" + f" ({ts.coordinates})", "alpha": r"$\alpha$ (deg)",
               "theta": r"$\theta$ (deg)", "r": r"$r/a$"}
     if quantity not in labels:
@@ -360,7 +352,7 @@ def plot_time_series(ts, ax=None, quantity="thetadot", members=None, title=None)
     start = ts.initial_thetadot_p
     mappable = None
     if len(idx) > MAX_LEGEND and start is not None:
-        from matplotlib.colors import Normalize
+        from matplotlib.colors import Normalize      # matplotlib: when a figure is drawn
 
         lo, hi = float(np.nanmin(start)), float(np.nanmax(start))
         mappable = plt.cm.ScalarMappable(Normalize(lo, hi if hi > lo else lo + 1e-9),
@@ -415,8 +407,6 @@ def plot_libration_search(result, axes=None):
     """Two panels of the centre search of a RelaxedLibration: every launch's section extent
     against the start θ̇_p(0)/n (the V whose tip is the centre), and the last window around
     the centre. Returns the left Axes."""
-    import numpy as np
-
     if axes is None:
         _, axes = _pyplot().subplots(1, 2, figsize=(9.6, 4.2), dpi=150)
     left, right = axes
@@ -445,8 +435,6 @@ def plot_libration(result, ax=None, title=None, search=None):
     Without ``ax`` (or with ``search=True``) the figure also gets the search's two panels
     (:func:`plot_libration_search`). The trajectory is the stored ``result.series`` (computed
     again for files written without it). Returns the Axes of α(t)."""
-    import numpy as np
-
     plt = _pyplot()
     search = ax is None if search is None else search
     if ax is None:
@@ -486,7 +474,7 @@ def plot_libration(result, ax=None, title=None, search=None):
 def figure_texts(fig):
     """Every non-empty text of a figure (titles, axis and colourbar labels, legend entries,
     annotations, tick labels)."""
-    from matplotlib.text import Text
+    from matplotlib.text import Text      # matplotlib: when a figure is drawn
 
     return [t.get_text() for t in fig.findobj(Text) if t.get_text()]
 
@@ -494,8 +482,6 @@ def figure_texts(fig):
 def raw_markup(fig):
     """The figure's texts that show a raw ``_`` or ``^`` outside mathtext (``$...$``): labels
     must say θ_p as ``$\\theta_p$``, never the characters."""
-    import re
-
     return [t for t in figure_texts(fig) if re.search(r"[_^]", re.sub(r"\$[^$]*\$", "", t))]
 
 
@@ -504,10 +490,6 @@ def save_figure(ax, path):
     one) and close it. The write is atomic (:func:`ti_spinorbit.files.atomic_write`): the
     image goes to a temporary file in the same folder, fsync-ed, then replaces ``path``, so a
     failed or killed write never leaves a partial figure and never harms an existing one."""
-    import os
-
-    from .files import atomic_write
-
     plt = _pyplot()
     fig = ax.figure
     try:
