@@ -1,5 +1,5 @@
 """Benchmark-only baseline: a compiled single-trajectory DOP853 integrator of the planar model
-(numba), for ``bench_throughput.py`` (issue 13 §1: the ensemble must run at least 2x per core
+(numba), for ``bench_throughput.py`` (the ensemble must run at least 2x per core
 what a plain compiled loop does).
 
 Written independently of the Taichi kernels: the right-hand side below is derived again from

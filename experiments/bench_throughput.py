@@ -1,7 +1,7 @@
 """Benchmark: where the ensemble integrator's time goes on 1991 VH (a/b = 1.5), and how it scales.
 
-Issue 5, item 1 ("measure first"); issue 13 §1 (methods as an axis, a compiled DOP853
-baseline in the same run, accuracy at equal rtol, the issue-13 targets with their ratios).
+Measure first: methods as an axis, a compiled DOP853 baseline in the same run, accuracy at
+equal rtol, and the speed targets with their ratios.
 Every run is deterministic: member k starts at
 θ_p = 180° frac(½ + k/g), θ̇_p/n = 0.5 + 2 frac(½ + k/g²) with g the plastic number (an
 R2 low-discrepancy sequence over θ_p ∈ [0, 180), θ̇_p/n ∈ [0.5, 2.5]), so the first N
@@ -83,7 +83,7 @@ accuracy
     error = max |Δy| over the scaled 3-D state (planar states through ``to_spatial``, so
     both models meet the same reference), median and max over members. One line per model
     and rtol gives every method's median error and its ratio to Cash-Karp's, so that a
-    faster method is not bought with accuracy. Then, informational (not an issue-13
+    faster method is not bought with accuracy. Then, informational (not a
     target), "equal accuracy": each planar method's per-core rate over the numba baseline's
     rate at the SAME median error (log-log interpolation between the baseline's measured
     tolerances): the kernels' max-norm error control is more accurate at a given rtol than
@@ -105,7 +105,7 @@ Methods: ``--methods cash-karp dop853 vern9 ...`` (``Ensemble(method=...)``; the
 a method ``Ensemble`` does not accept yet is skipped with a one-line note). The split, flops,
 threads and window sections use Cash-Karp.
 
-Issue-13 targets (planar unless said, 1991 VH a/b = 1.5, N = the split N, "fastest" = the
+Targets (planar unless said, 1991 VH a/b = 1.5, N = the split N, "fastest" = the
 fastest method measured): >= 60 000 member-orbits/s on 2 cores at rtol 1e-12; >= 2x per core
 the numba DOP853 baseline (ensemble member-orbits per CPU-second over the baseline's orbits
 per CPU-second; on a GPU the wall rate against one CPU core); at 1e-15 >= 4x the Cash-Karp
@@ -113,8 +113,8 @@ rate of the same run; 3-D >= 15 000 at 1e-12; and the accuracy at equal rtol of 
 no worse than Cash-Karp's (median error ratio <= 1). Each prints MET/MISS, its value and
 value/target.
 
-Targets (2-core machine): issue 5, >= 20 000 member-orbits/s for the planar model and
->= 2 000 for the 3-D model at N = 4096, rtol 1e-12 (issue 2 asked >= 1 000); >= 300x the
+Targets (2-core machine): >= 20 000 member-orbits/s for the planar model and
+>= 2 000 for the 3-D model at N = 4096, rtol 1e-12; >= 300x the
 baseline; <= 3 s to the first result from a fresh process with a warm cache. (The 64 x 64 x
 500-orbit MEGNO map target is measured by experiments/chaos_maps.py.)
 
@@ -160,22 +160,22 @@ SECTIONS = ("throughput", "split", "flops", "threads", "window", "baseline", "nu
 DEFAULT_METHOD = "cash-karp"
 METHODS = ("cash-karp", "dop853", "vern9")
 TARGET_RATE = {"planar": 20000.0, "3d": 2000.0}   # member-orbits/s, N = 4096, rtol 1e-12
-# issue 13 §1 (planar, 1991 VH a/b = 1.5, N >= 1024; "fastest" = the fastest method measured)
-TARGET13_PLANAR = 60000.0         # member-orbits/s on 2 cores, rtol 1e-12
-TARGET13_3D = 15000.0             # member-orbits/s, 3-D, rtol 1e-12
-TARGET13_PER_CORE = 2.0           # x the numba DOP853 baseline, per core, same run
-TARGET13_TIGHT = 4.0              # x today's Cash-Karp rate at rtol 1e-15
-NUMBA_RTOLS = (1e-12, 1e-15)      # the baseline's tolerances (issue 13 §1)
+# (planar, 1991 VH a/b = 1.5, N >= 1024; "fastest" = the fastest method measured)
+TARGET_PLANAR = 60000.0         # member-orbits/s on 2 cores, rtol 1e-12
+TARGET_3D = 15000.0             # member-orbits/s, 3-D, rtol 1e-12
+TARGET_PER_CORE = 2.0           # x the numba DOP853 baseline, per core, same run
+TARGET_TIGHT = 4.0              # x today's Cash-Karp rate at rtol 1e-15
+NUMBA_RTOLS = (1e-12, 1e-15)      # the baseline's tolerances
 ACCURACY_REFERENCE_RTOL = 1e-16   # numba DOP853, the tight reference of the accuracy section
 TARGET_SPEEDUP = 300.0            # over the scipy baseline
-# issue 13 §2: cold compile of every variant (model x method x indicators, each in a fresh
+# cold compile of every variant (model x method x indicators, each in a fresh
 # process with an empty kernel cache: the integrator and diagnostics kernels)
 # <= 25 s and <= 2x "the planar one" (the planar default: Cash-Karp without indicators, what
 # the README's first command compiles); warm start (fresh process, warm cache, import to the
 # first result of a one-orbit section) <= 1 s for each model.
-TARGET13_COMPILE_S = 25.0
-TARGET13_COMPILE_RATIO = 2.0
-TARGET13_WARM_S = 1.0
+TARGET_COMPILE_S = 25.0
+TARGET_COMPILE_RATIO = 2.0
+TARGET_WARM_S = 1.0
 TARGET_FIRST_RESULT_S = 3.0       # fresh process, warm offline cache
 SCIPY_MIN_RTOL = 100 * np.finfo(float).eps   # scipy's RK solvers raise smaller rtol to this
 FLOPS_PER_CYCLE = 16              # f64, AVX2 + FMA: 2 FMA units × 4 lanes × 2 flops
@@ -873,67 +873,67 @@ def fastest(points, model, rtol, n, methods, key="member_orbits_per_s"):
 
 
 def targets13(points, numba_rows, accuracy_rows, models, methods, n, cores, cpu):
-    """Issue 13 §1 targets with their values and ratios to the target."""
+    """Targets with their values and ratios to the target."""
     out = []
 
     def add(text, value, goal):
-        out.append({"target": "issue 13: " + text, "value": value, "ratio": value / goal,
+        out.append({"target": text, "value": value, "ratio": value / goal,
                     "met": value >= goal})
 
     if "planar" in models:
         method, row = fastest(points, "planar", 1e-12, n, methods)
         if row:
-            add(f">= {TARGET13_PLANAR:.0f} member-orbits/s on {cores} cores, planar, fastest "
+            add(f">= {TARGET_PLANAR:.0f} member-orbits/s on {cores} cores, planar, fastest "
                 f"method ({method}), N = {n}, rtol 1e-12", row["member_orbits_per_s"],
-                TARGET13_PLANAR)
+                TARGET_PLANAR)
         for b in (b for b in numba_rows if not b.get("curve")):
             key = "member_orbits_per_cpu_s" if cpu else "member_orbits_per_s"
             method, row = fastest(points, "planar", b["rtol"], n, methods, key)
             if row:
-                add(f">= {TARGET13_PER_CORE:g}x the numba DOP853 baseline "
+                add(f">= {TARGET_PER_CORE:g}x the numba DOP853 baseline "
                     f"({b['orbits_per_cpu_s']:.0f} orbits/CPU-s, one core) "
                     + ("per core" if cpu else "(device wall rate against one CPU core)")
                     + f", planar, fastest method ({method}, {row[key]:.0f}), N = {n}, "
                     f"rtol {b['rtol']:.0e}", row[key] / b["orbits_per_cpu_s"],
-                    TARGET13_PER_CORE)
+                    TARGET_PER_CORE)
         today = points.measured("planar", 1e-15, n, DEFAULT_METHOD)
         method, row = fastest(points, "planar", 1e-15, n, methods)
         if today and row:
-            add(f">= {TARGET13_TIGHT:g}x today's Cash-Karp rate ({today['member_orbits_per_s']:.0f}"
+            add(f">= {TARGET_TIGHT:g}x today's Cash-Karp rate ({today['member_orbits_per_s']:.0f}"
                 f"), planar, fastest method ({method}), N = {n}, rtol 1e-15",
-                row["member_orbits_per_s"] / today["member_orbits_per_s"], TARGET13_TIGHT)
+                row["member_orbits_per_s"] / today["member_orbits_per_s"], TARGET_TIGHT)
     if "3d" in models:
         method, row = fastest(points, "3d", 1e-12, n, methods)
         if row:
-            add(f">= {TARGET13_3D:.0f} member-orbits/s, 3-D, fastest method ({method}), N = {n}, "
-                "rtol 1e-12", row["member_orbits_per_s"], TARGET13_3D)
+            add(f">= {TARGET_3D:.0f} member-orbits/s, 3-D, fastest method ({method}), N = {n}, "
+                "rtol 1e-12", row["member_orbits_per_s"], TARGET_3D)
     return out + _accuracy_targets(accuracy_rows, methods)
 
 
 def targets13_compile(compile_rows, first_runs):
-    """Issue 13 §2 targets: cold compile per variant and warm start per model."""
+    """Targets: cold compile per variant and warm start per model."""
     out = []
     ref = [r for r in compile_rows if (r["model"], r["method"], r["indicators"])
            == ("planar", DEFAULT_METHOD, "off")]
     for r in compile_rows:
         what = f"{r['model']}, {r['method']}, indicators {r['indicators']}"
-        out.append({"target": f"issue 13: cold compile <= {TARGET13_COMPILE_S:.0f} s, {what}",
-                    "value": r["compile_s"], "ratio": r["compile_s"] / TARGET13_COMPILE_S,
-                    "met": r["compile_s"] <= TARGET13_COMPILE_S})
+        out.append({"target": f"cold compile <= {TARGET_COMPILE_S:.0f} s, {what}",
+                    "value": r["compile_s"], "ratio": r["compile_s"] / TARGET_COMPILE_S,
+                    "met": r["compile_s"] <= TARGET_COMPILE_S})
         if ref:
             ratio = r["compile_s"] / ref[0]["compile_s"]
-            out.append({"target": f"issue 13: cold compile <= {TARGET13_COMPILE_RATIO:g}x the "
+            out.append({"target": f"cold compile <= {TARGET_COMPILE_RATIO:g}x the "
                                   f"planar default's ({ref[0]['compile_s']:.2f} s), {what}",
-                        "value": ratio, "ratio": ratio / TARGET13_COMPILE_RATIO,
-                        "met": ratio <= TARGET13_COMPILE_RATIO})
+                        "value": ratio, "ratio": ratio / TARGET_COMPILE_RATIO,
+                        "met": ratio <= TARGET_COMPILE_RATIO})
     for model in dict.fromkeys(f["model"] for f in first_runs):
         warm = [f["wall_s"] for f in first_runs if f["model"] == model and f["run"] == "warm cache"]
         if warm:
             best = min(warm)
-            out.append({"target": f"issue 13: warm start <= {TARGET13_WARM_S:g} s, fresh process "
+            out.append({"target": f"warm start <= {TARGET_WARM_S:g} s, fresh process "
                                   f"to the first result of a one-orbit {model} section (best "
                                   f"of {len(warm)})", "value": best,
-                        "ratio": best / TARGET13_WARM_S, "met": best <= TARGET13_WARM_S})
+                        "ratio": best / TARGET_WARM_S, "met": best <= TARGET_WARM_S})
     return out
 
 
@@ -947,7 +947,7 @@ def _accuracy_targets(accuracy_rows, methods):
               == (a["model"], a["rtol"], DEFAULT_METHOD)]
         if ck:
             ratio = a["median_error"] / max(ck[0]["median_error"], 1e-300)
-            out.append({"target": f"issue 13: accuracy at equal rtol, {a['method']} error <= "
+            out.append({"target": f"accuracy at equal rtol, {a['method']} error <= "
                                   f"Cash-Karp's, {a['model']}, rtol {a['rtol']:.0e} (median "
                                   f"{a['median_error']:.2e} vs {ck[0]['median_error']:.2e})",
                         "value": ratio, "met": ratio <= 1.0})
@@ -955,7 +955,7 @@ def _accuracy_targets(accuracy_rows, methods):
 
 
 def equal_accuracy(points, numba_rows, accuracy_rows, methods, n, cpu):
-    """Informational (not an issue-13 target): each planar method at each baseline rtol
+    """Informational (not a target): each planar method at each baseline rtol
     against the numba baseline at the SAME median final-state error, its rate read off the
     baseline's rate-against-error curve (log-log interpolation between the measured
     tolerances; None outside the curve)."""

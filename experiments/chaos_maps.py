@@ -4,7 +4,7 @@ Each map is one ensemble launch with shadow trajectories (ti_spinorbit.chaosmap.
 section points of a subsample of members are overlaid. A fourth panel histograms ⟨Y⟩ over
 all maps: regular orbits pile up at ⟨Y⟩ ≈ 2 and chaotic ones spread far above it, which is
 why the chaotic threshold sits at 4. Full run: 64 × 64 starts × 500 orbits for 1991 VH (the
-issue's benchmark) and 48 × 48 × 300 for the other two; ``--quick``: 8 × 8 × 50.
+package's benchmark size) and 48 × 48 × 300 for the other two; ``--quick``: 8 × 8 × 50.
 
 Prints: chaotic fraction per system, seconds and member-orbits/s per map, and the share of
 members in the histogram's gap 2.5 < ⟨Y⟩ < 4.

@@ -1,4 +1,4 @@
-"""Dask scaling (issue 13 §5): a MEGNO chaos map of 1991 VH through the package's Dask path on a
+"""Dask scaling: a MEGNO chaos map of 1991 VH through the package's Dask path on a
 ``dask.distributed.LocalCluster`` of 1, 2, ... worker processes, and the cost of one chunk.
 
 Each worker is a process with one Dask thread and one Taichi CPU thread

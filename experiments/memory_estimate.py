@@ -6,7 +6,7 @@ entry point (kernels compiled, allocator warm), resets the peak RSS to the curre
 reads the RSS, runs the case and reads the peak RSS (``VmHWM``; ``ru_maxrss`` where there is
 no /proc: on Linux ru_maxrss inherits the parent's peak, see :func:`peak_rss`). The growth is compared with the estimate the entry point itself computed
 before any work (``ti_spinorbit.resources.check_memory``, captured here). The estimate must be
-within a factor 1.5 of the growth (issue 10); the ratio column shows it.
+within a factor 1.5 of the growth; the ratio column shows it.
 
     python experiments/memory_estimate.py            # full sizes (a few GiB at most, ~2 min)
     python experiments/memory_estimate.py --quick    # small sizes (CI)
@@ -43,7 +43,7 @@ FULL = [
     ("section 3d 16384x2", "surface_of_section", dict(members=16384, orbits=2, model="3d")),
     ("section 65536x1", "surface_of_section", dict(members=65536, orbits=1)),
     ("time_series 4x500x64", "time_series", dict(members=4, orbits=500, samples_per_orbit=64)),
-    ("time_series 16x4000x40 (issue 10)", "time_series",
+    ("time_series 16x4000x40", "time_series",
      dict(members=16, orbits=4000, samples_per_orbit=40)),
     ("time_series 3d 4x500x64", "time_series", dict(members=4, orbits=500, samples_per_orbit=64,
                                                    model="3d")),

@@ -1,4 +1,4 @@
-"""Resonance-overlap threshold vs eccentricity (issue 4: the numerical counterpart of the
+"""Resonance-overlap threshold vs eccentricity (the numerical counterpart of the
 Chirikov estimate ω0^RO = 1/(2 + sqrt(14 e)) for the 1:1 and 3:2 resonances).
 
 1991 VH with its eccentricity replaced by each value of a grid; at each e the elongation a/b

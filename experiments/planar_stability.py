@@ -1,4 +1,4 @@
-"""Stability of the paper's planar states out of the plane (beyond the paper: issue 12 §4).
+"""Stability of the paper's planar states out of the plane (beyond the paper).
 
 Naidu & Margot (2015) integrate planar starts only, and their chaos indicators (like this
 package's default) perturb planar directions only: an island that is regular in the plane

@@ -1,4 +1,4 @@
-"""SIMD lanes (issue 13 §4): several ensemble members per CPU thread as vector lanes, against
+"""SIMD lanes: several ensemble members per CPU thread as vector lanes, against
 today's one member per thread, on the planar right-hand side of 1991 VH (a/b = 1.5).
 
 Benchmark-only prototype: the package kernels are not changed. Three layouts of the same work

@@ -15,7 +15,7 @@ inertial longitude of R; (cA, sA) = (cos ψ_A, sin ψ_A) and (cB, sB) = (cos ψ_
 of body k's long axis); w_k = Γ_k/C_k as in the 3-D model (Γ_k the spin angular momentum
 about z, C_k the body's largest principal moment; dθ_k/dt = ω_k = w_k C_k/I_zz).
 
-Why this form (the "cheapest formulation" of issue 5, measured in experiments/README.md):
+Why this form (the cheapest formulation measured in experiments/README.md):
 
 * the potential needs exactly r and the angles ψ_A, ψ_B: no square root, no rotation;
 * the angles are stored as cosine and sine, so no transcendental call is made, every

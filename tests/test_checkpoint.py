@@ -1,4 +1,4 @@
-"""Checkpoint and resume (issue 6): a run killed between windows resumes to exactly the
+"""Checkpoint and resume: a run killed between windows resumes to exactly the
 results of an uninterrupted run; damaged or mismatched checkpoints raise clear errors."""
 
 import dataclasses

@@ -106,7 +106,7 @@ def test_libration_command(tmp_path):
     assert 0.0 < result.amplitude < 90.0 and result.converged
     # the printed numbers are the saved ones
     assert f"amplitude {result.amplitude:.4f} deg" in p.stdout
-    # ψ_A as an amplitude with its phase in words, never a negative angle (issue 14 §7)
+    # ψ_A as an amplitude with its phase in words, never a negative angle
     assert f"|ψ_A| = {abs(result.psi_A):.4f} deg" in p.stdout
     assert result.psi_A < 0 and f"{result.psi_A:.4f}" not in p.stdout
     assert "(phase: ψ = −|ψ_A| sin M, in antiphase with M" in p.stdout
@@ -373,7 +373,7 @@ def test_warmup_refuses_an_unknown_method(capsys):
                                        "cash-karp, dop853, vern9 (got 'rk4')\n")
 
 
-# ---- tides, YORP and BYORP (issue 15) ---------------------------------------------------
+# ---- tides, YORP and BYORP ------------------------------------------------------------------
 
 @pytest.mark.parametrize("argv, stem", [
     (["section", "--tide", "secondary", "--k2", "1e-5", "--time-lag", "600", "--strength",

@@ -1,4 +1,4 @@
-"""The documentation site builds with warnings as errors (issue 14 §8), quickly: the gallery's
+"""The documentation site builds with warnings as errors, quickly: the gallery's
 pages are generated but its examples are not executed (``-D plot_gallery=0``; CI's full build
 in .ci/run executes them). The build runs on a copy of docs/ and examples/ in a temporary
 folder, so the checkout gains no generated files."""

@@ -1,4 +1,4 @@
-"""Full-space chaos indicators (issue 12 §2, docs/physics.md §10.4): a shadow direction that
+"""Full-space chaos indicators (docs/physics.md §10.4): a shadow direction that
 spans the whole state sees out-of-plane instability that the planar-restricted one cannot;
 the attitude parts of the direction are first-order rotations; choices are checked, recorded,
 saved and part of a checkpoint's settings."""

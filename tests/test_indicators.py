@@ -1,4 +1,4 @@
-"""Chaos indicators from the shadow trajectory (issue 4 foundation): MEGNO ⟨Y⟩ → 2 and a
+"""Chaos indicators from the shadow trajectory: MEGNO ⟨Y⟩ → 2 and a
 Lyapunov exponent falling like ln t / t on regular orbits, ⟨Y⟩ ≫ 2 and a positive exponent on
 chaotic ones; independent of tolerance, slot, and leaving the main trajectory untouched."""
 
@@ -26,7 +26,7 @@ def test_megno_regular_and_chaotic(vh_runs):
 
 
 def test_chaotic_2004_dc():
-    """The issue's example: 2004 DC a/b = 1.3, θ̇_p/n = 1.39."""
+    """The example: 2004 DC a/b = 1.3, θ̇_p/n = 1.39."""
     r = tso.surface_of_section(tso.catalog.system("2004 DC"), 0.0, 1.39, orbits=150,
                                rtol=1e-10, indicators=True)
     assert r.megno[0] > 20 and r.lyapunov[0] > 0.5

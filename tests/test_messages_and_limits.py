@@ -1,4 +1,4 @@
-"""One-line messages and sensible limits (open issue, items 1-8): a Dask ``client`` that is
+"""One-line messages and sensible limits: a Dask ``client`` that is
 not one, a kick of a state whose V is parallel to R, the memory estimate of a time series with
 ``states=True``, the pole tilt near 0, ``InitialState ==``, the range of ``atol``, a
 ``parameter_map`` factory returning something else, and ``libration --quiet`` when not

@@ -1,4 +1,4 @@
-"""Tides, YORP and BYORP on every entry point (issue 15, item 1: "works everywhere"): recorded
+"""Tides, YORP and BYORP on every entry point: recorded
 in every result and its saved file, in xarray, with indicators, checkpoints and the Dask
 path. Tiny runs: a few members, a few orbits, tolerances where the drift limits hold."""
 

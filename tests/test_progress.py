@@ -1,4 +1,4 @@
-"""No silent waits (issue 14 §1, issue 13 §2): ``progress=None | True | False | callable`` on
+"""No silent waits: ``progress=None | True | False | callable`` on
 every entry point, a tqdm bar in a terminal, plain lines in a log, nothing by default where no
 bar can be drawn; compile time announced once and kept out of elapsed time, ETA and rates.
 

@@ -100,7 +100,7 @@ def test_overlap_decision_units_come_from_its_fields():
 
 def test_io_does_not_import_xarray_io():
     """The data flow one way: xarray_io reads io; io imports neither xarray_io nor results'
-    users at import time (the import loop issue 14 §5 names)."""
+    users at import time (an import loop)."""
     def imported(path):
         tree = ast.parse(path.read_text())
         names = set()
@@ -222,7 +222,7 @@ def test_conservation_is_the_clis_energy_check(time_series):
         time_series.conservation(2)
 
 
-# ---- figures (issue 14 §6) --------------------------------------------------------------------
+# ---- figures -----------------------------------------------------------------------------------
 def _all_texts(fig):
     return plotting.figure_texts(fig)
 

@@ -1,4 +1,4 @@
-"""Accuracy is checked, not assumed (issue: trustworthy results), and the command line's
+"""Accuracy is checked, not assumed, and the command line's
 outputs: paths checked before any work, data written before the figure, exit statuses.
 
 A healthy Cash-Karp run drifts linearly in rtol and in the run length (≈ 13 rtol per orbit in

@@ -1,4 +1,4 @@
-"""Files and checkpoints lose nothing (issue 10, part 2): a checkpoint directory has one
+"""Files and checkpoints lose nothing: a checkpoint directory has one
 writer (a second is refused at once, naming the holder; a killed holder never blocks), a
 checkpoint is never overwritten by accident, any damage to a checkpoint is one
 "checkpoint damaged: ..." line (exit status 2 on the CLI), ``tso.load`` raises one

@@ -1,4 +1,4 @@
-"""Degenerate and mistyped input is refused before any integration (issue 10, part 4), and the
+"""Degenerate and mistyped input is refused before any integration, and the
 library bounds spin rates and the primary's spin as the command line does (part 3).
 
 Every case asserts the exception type and that the one-line message names the parameter (and

@@ -1,4 +1,4 @@
-"""Issue 10, resources and environment: the memory estimate is right (within a factor 1.5 of
+"""Resources and environment: the memory estimate is right (within a factor 1.5 of
 the measured peak RSS growth), absurd sizes are refused from the sizes alone before any member
 is built, progress comes every few seconds even inside a long window without changing a bit
 of the results, and a read-only HOME (unwritable kernel cache) no longer crashes at exit."""
@@ -42,9 +42,9 @@ def test_estimate_within_factor_1_5_of_measured_peak_rss(entry, kw):
     assert 1 / 1.5 <= r["estimate"] / r["growth"] <= 1.5, r
 
 
-def test_estimate_of_the_issue_case_matches_its_measured_peak():
+def test_estimate_of_the_reported_case_matches_its_measured_peak():
     """16 members x 4000 orbits x 40 samples per orbit: measured peak RSS growth 2.92 GiB
-    (issue 10); the old estimate said 0.42 GiB."""
+    (an earlier estimate said 0.42 GiB)."""
     estimate = resources.estimate_bytes(16, 4000, 40) / GIB
     assert 2.92 / 1.5 <= estimate <= 2.92 * 1.5, estimate
 
