@@ -24,6 +24,9 @@ from conftest import lumpy_body
 
 pytest.importorskip("distributed")
 
+# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+pytestmark = pytest.mark.slow
+
 THETA_P = np.array([0.0, 45.0, 90.0])
 THETADOT_P = np.array([0.5, 0.9, 1.3, 2.5])
 ORBITS = 4

@@ -19,9 +19,11 @@ TOOLS = ["sphinx", "numpydoc", "pydata_sphinx_theme", "sphinx_gallery", "myst_pa
 MISSING = [name for name in TOOLS if importlib.util.find_spec(name) is None]
 GENERATED = ("_build", "auto_examples", "generated", "sg_execution_times.rst")
 
-pytestmark = pytest.mark.skipif(
+# the slow part of the suite (deselect with -m "not slow", README "Tests"); skipped without
+# the documentation tools
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(
     bool(MISSING), reason=f"documentation tools not installed ({', '.join(MISSING)}): "
-                          'pip install -e ".[docs]"')
+                          'pip install -e ".[docs]"')]
 
 
 @pytest.fixture(scope="module")

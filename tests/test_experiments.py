@@ -13,6 +13,9 @@ import sys
 import numpy as np
 import pytest
 
+# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+pytestmark = pytest.mark.slow
+
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "experiments")
 STUDIES = sorted(os.path.basename(p)[:-3] for p in glob.glob(os.path.join(EXPERIMENTS, "study[0-9][0-9]_*.py")))
 # every other experiment script too, except private helpers and the benchmark (timed, not tested)

@@ -23,6 +23,9 @@ import bench_throughput as bt  # noqa: E402
 
 sys.path.remove(EXPERIMENTS)
 
+# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def members(taichi_runtime):

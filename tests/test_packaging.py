@@ -7,7 +7,12 @@ import sys
 import zipfile
 from pathlib import Path
 
+import pytest
+
 import ti_spinorbit as tso
+
+# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]
 

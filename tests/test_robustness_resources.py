@@ -14,7 +14,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit.members import Members
-from ti_spinorbit import _validate, cli, ensemble, overlap, resources, runtime, section
+from ti_spinorbit import _validate, cli, ensemble, overlap, resources, runtime
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXPERIMENT = os.path.join(ROOT, "experiments", "memory_estimate.py")
