@@ -94,7 +94,7 @@ class Controller:
     def funcs(self):
         """Taichi funcs ``factor``, ``rejected``, ``accepted``, ``event_converged`` with this
         controller's constants compiled in (the exponent is a template argument)."""
-        import taichi as ti
+        import taichi as ti      # Taichi: the controller's data is read without it (tableau)
 
         safety, lo, hi = self.safety, self.min_factor, self.max_factor
         nonfinite, ev_rtol, ev_iter = self.nonfinite_factor, self.event_rtol, self.event_max_iter

@@ -36,8 +36,7 @@ from .results import Result, Status
 from .initial import InitialState
 from .perturbations import BYORP, YORP, Tides
 from .warmup import warmup
-
-__version__ = "0.1.0"
+from ._version import __version__
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
            "ImplausibleInputWarning", "NearCircularWarning", "InitialState",

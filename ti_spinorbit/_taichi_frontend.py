@@ -57,11 +57,11 @@ def memoise(original, key):
 def install():
     """Memoise Taichi's ``get_pos_info`` and the front end's ``getsourcelines``
     (idempotent). Returns True when both are in place."""
-    import taichi as ti
+    import taichi as ti      # Taichi: installed by runtime.init, which has imported it
 
     if tuple(ti.__version__[:2]) not in CHECKED_VERSIONS:
         return False
-    try:
+    try:                     # Taichi internals, where this version has them
         from taichi.lang import kernel_impl
         from taichi.lang.ast.ast_transformer_utils import ASTTransformerContext
     except ImportError:

@@ -42,6 +42,7 @@ the default with a number in (0, 1].
 
 import numpy as np
 
+from ._validate import _as_floats, require_range
 from .results import STATUS_NAMES, Result, Status
 
 #: Drift limit per orbit per unit of rtol (50x what healthy runs show, see module docstring).
@@ -55,8 +56,6 @@ def drift_limit(rtol, orbits, max_drift=None):
     ``min(DRIFT_CAP, DRIFT_PER_ORBIT · rtol · max(orbits, 1))``. ``orbits`` in orbital
     periods; returns a float (relative drift)."""
     if max_drift is not None:
-        from ._validate import _as_floats, require_range
-
         if isinstance(max_drift, bool) or _as_floats("max_drift", max_drift).ndim != 0:
             raise TypeError(f"max_drift must be one number in (0, 1] (got {max_drift!r})")
         require_range("max_drift", max_drift, 0.0, 1.0, low_open=True, high_open=False)

@@ -26,6 +26,9 @@ Classification (decision; thresholds are parameters with these defaults):
 
 import numpy as np
 
+from ._validate import require_scalar
+from .initial import ROW_SLICES, orbit_frame as _orbit_frame
+
 #: Class labels, in the order of the integer codes :func:`classify` returns.
 CLASSES = ("planar libration", "3-D libration", "circulation", "tumbling")
 PLANAR_LIBRATION, LIBRATION_3D, CIRCULATION, TUMBLING = range(4)
@@ -54,10 +57,8 @@ def _split(y):
 def orbit_frame(y):
     """Orbit frame of each state in the primary's frame: matrix (..., 3, 3) whose columns
     are the radial, along-track and normal unit vectors (:func:`ti_spinorbit.initial.orbit_frame`)."""
-    from .initial import orbit_frame as frame
-
     R, V, _, _ = _split(y)
-    return frame(R, V)
+    return _orbit_frame(R, V)
 
 
 def relative_attitude(y):
@@ -78,11 +79,9 @@ def euler_angles(y):
 def euler_angles_of_rows(rows):
     """:func:`euler_angles` of SI state rows (``initial.ROW_SLICES``: inertial R, V and the
     secondary's body -> inertial attitude), e.g. a time series' ``states``."""
-    from .initial import ROW_SLICES, orbit_frame as frame
-
     rows = np.asarray(rows, dtype=np.float64)
     A2 = rows[..., ROW_SLICES["secondary_attitude"]].reshape(rows.shape[:-1] + (3, 3))
-    O = frame(rows[..., ROW_SLICES["R"]], rows[..., ROW_SLICES["V"]])
+    O = _orbit_frame(rows[..., ROW_SLICES["R"]], rows[..., ROW_SLICES["V"]])
     return _euler(np.swapaxes(O, -1, -2) @ A2)
 
 
@@ -149,8 +148,6 @@ def classify(samples, system, *, tilt_angle=TILT_ANGLE, npa_angle=NPA_ANGLE):
     stopped, are ignored), or a list of (times_k, 30) arrays. Thresholds in degrees (module
     docstring). Samples must resolve the yaw angle's changes (well under 180° apart: the
     spin is at most a few n, so 16 samples per orbit are plenty)."""
-    from ._validate import require_scalar
-
     tilt_angle = require_scalar("tilt_angle", tilt_angle, 0.0, 90.0, low_open=True, unit="degrees")
     npa_angle = require_scalar("npa_angle", npa_angle, 0.0, 90.0, low_open=True, unit="degrees")
     members = [np.asarray(s, dtype=np.float64) for s in samples]

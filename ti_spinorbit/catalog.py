@@ -12,7 +12,7 @@ from functools import lru_cache
 from importlib import resources
 
 from ._validate import (MAX_DENSITY, MIN_DENSITY, require_positive_scalar, require_range,
-                        require_real)
+                        require_real, show)
 from .bodies import Ellipsoid, Sphere
 from .systems import BinarySystem
 
@@ -136,6 +136,4 @@ def as_system(system, allow_list=False):
         return [as_system(s) for s in system]
     accepted = "a BinarySystem or a catalogue name" + (" or a non-empty list of them"
                                                          if allow_list else "")
-    from ._validate import show
-
     raise TypeError(f"system must be {accepted} (got {show(system)})")

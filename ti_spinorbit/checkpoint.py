@@ -65,9 +65,15 @@ import os
 import re
 import socket
 import sys
+import tempfile
 import zipfile
 
+import filelock
 import numpy as np
+
+from ._version import __version__
+from .npzfile import _DAMAGE, _Entries
+from .results import Status
 
 FORMAT = "ti_spinorbit checkpoint"
 #: 3: the state holds the records files' SHA-256 digests and is checked on resume;
@@ -172,8 +178,6 @@ def save(path, settings, fingerprint, state, new_records):
     previous save; ``state["launches"]`` counts the windows done including this one;
     ``state["records_sha256"]`` is the list of the digests of the records files written so
     far (hex str), shared with the caller: this window's digest is appended to it."""
-    from . import __version__
-
     path = _fspath(path)
     os.makedirs(path, exist_ok=True)
     width = state["y"].shape[1] + 1
@@ -209,8 +213,6 @@ def _owner_text(path):
 
 def _lock_class():
     """The lock type (a function so that tests can substitute filelock.SoftFileLock)."""
-    import filelock
-
     return filelock.FileLock
 
 
@@ -288,8 +290,6 @@ def check_target(path, resume=False, overwrite=False, cli=False):
 def _writable(path):
     """Whether files can be created in the directory ``path`` (a real probe: permission bits
     say nothing for root or on a read-only mount)."""
-    import tempfile
-
     try:
         with tempfile.TemporaryFile(dir=path):
             return True
@@ -306,7 +306,6 @@ def _check_finished(path):
     status = arrays.get("status")
     if status is None or status.ndim != 1 or status.dtype.kind not in "iu":
         raise _damaged(path, f"{STATE} has no status array")
-    from .results import Status
 
     running = int(np.count_nonzero(status == Status.RUNNING))
     if running:
@@ -330,8 +329,6 @@ def claim(path, resume=False, overwrite=False):
     mount) takes no lock and writes nothing: it is allowed when the checkpointed run is
     finished (the resumed run then only reads it), and refused with a CheckpointError
     before any work otherwise."""
-    import filelock
-
     path = _fspath(path)
     check_target(path, resume, overwrite)
     if resume and holds_checkpoint(path) and not _writable(path):
@@ -351,8 +348,6 @@ def claim(path, resume=False, overwrite=False):
             f"checkpoint {path!r} is locked by another run: {_owner_text(path)}; wait for it to "
             "end or use another checkpoint directory") from None
     try:
-        from . import __version__
-
         owner = {"pid": os.getpid(), "host": socket.gethostname(),
                  "started_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(
                      timespec="seconds"),
@@ -385,8 +380,6 @@ def _read(path, what, names, digest=None):
     """The arrays ``names`` of one checkpoint file (those present; no other entry is ever
     decompressed), sizes checked before reading (io.ArchiveError rules), its SHA-256
     compared with ``digest`` first when given."""
-    from .npzfile import _DAMAGE, _Entries
-
     folder = os.path.dirname(path)
     try:
         if digest is not None:
@@ -411,8 +404,6 @@ def load(path, settings, fingerprint):
     when ``path`` holds no checkpoint (does not exist, or only files of a run killed before
     its first state). Raises CheckpointDamaged for a damaged checkpoint, CheckpointError
     (both ValueError) for a mismatched one or a directory that is not a checkpoint."""
-    from . import __version__
-
     path = _fspath(path)
     if not os.path.exists(path):
         return None

@@ -40,6 +40,9 @@ import time
 
 import numpy as np
 
+from . import progress, runtime
+from .layout import DONE
+
 _LOG = logging.getLogger("ti_spinorbit")
 
 #: Seconds a cold compile of a variant takes when nothing was measured on this machine yet
@@ -105,8 +108,6 @@ def default_seconds(variant):
 
 def record_path():
     """The measurements file in the kernel cache folder."""
-    from . import runtime
-
     return os.path.join(runtime.cache_folder(), RECORD_FILE)
 
 
@@ -139,7 +140,7 @@ def _write_records(records):
 def fingerprint(variant):
     """Digest of what Taichi's cache key depends on for us: the kernel sources, the Taichi
     version, the arch and the variant."""
-    from . import kernels, runtime
+    from . import kernels    # kernels/: on first use (the quiet import loads no kernel module)
 
     h = hashlib.sha256(variant.encode())
     folder = list(kernels.__path__)[0]
@@ -148,7 +149,7 @@ def fingerprint(variant):
             with open(os.path.join(folder, name), "rb") as f:
                 h.update(name.encode() + f.read())
     try:
-        import taichi
+        import taichi         # Taichi: imported on first use, the package import stays quiet
 
         h.update(str(taichi.__version__).encode())
     except ImportError:  # pragma: no cover - taichi is a dependency
@@ -186,8 +187,6 @@ def _launch(kernel, args):
 def _one_member(args, n, status):
     """Arguments of a compile-only launch: one-member copies of every per-member array (first
     dimension ``n``), the status "done" (the kernel skips the member); the rest as given."""
-    from .layout import DONE
-
     out = []
     for a in args:
         if a is status:
@@ -209,8 +208,6 @@ class FirstUse:
     kernel's compile time, which the caller keeps out of its own clock."""
 
     def __init__(self, kernel, variant, status):
-        from . import runtime
-
         self.kernel = kernel
         self.variant = variant
         self.status = status
@@ -225,8 +222,6 @@ class FirstUse:
 
     def _begin(self):
         """Announce the compile (once) unless the disk cache holds the variant."""
-        from . import progress, runtime
-
         if self._begun:
             return
         self._begun = True
@@ -279,8 +274,6 @@ class FirstUse:
 
     def _record(self, total):
         """Store the measurement (the whole first use: what a user waits for)."""
-        from . import runtime
-
         records = read_records()
         rec = dict(records.get(self.variant) or {})
         rec["loaded_seconds" if self._cached else "seconds"] = round(total, 3)

@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from .accuracy import usable
+
 #: Longest user-supplied name shown (longer ones are cut with "…").
 MAX_NAME = 40
 #: Most distinct systems named in a result's summary.
@@ -185,8 +187,6 @@ def _time_series(r):
 
 
 def _fraction(r):
-    from .accuracy import usable          # status codes live with the kernels: import late
-
     counted = int(usable(r.status, getattr(r, "include_inaccurate", False)).sum())
     row = [("chaotic fraction", f"{number(r.chaotic_fraction, '.3g')} of {counted} counted")]
     if getattr(r, "megno_chaotic", None) is not None:

@@ -44,6 +44,13 @@ import stat
 import sys
 import unicodedata
 
+try:
+    import fcntl
+except ImportError:      # pragma: no cover - Windows: claims take a filelock instead
+    fcntl = None
+
+import filelock
+
 #: Longest file name (bytes) where the folder does not say (POSIX's common NAME_MAX).
 NAME_MAX = 255
 #: Longest path (bytes) where the system does not say (Linux's PATH_MAX).
@@ -252,9 +259,7 @@ class Claim:
 
     def _take(self, label, path, command):
         lock = lock_path(path)
-        try:
-            import fcntl
-        except ImportError:      # pragma: no cover - Windows: filelock, without holder text
+        if fcntl is None:        # pragma: no cover - Windows: filelock, without holder text
             return self._take_filelock(label, path, lock)
         for _ in range(100):
             fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
@@ -284,8 +289,6 @@ class Claim:
         raise OutputBusy(f"{label}: cannot lock {lock!r} (it keeps being replaced)")  # pragma: no cover
 
     def _take_filelock(self, label, path, lock):     # pragma: no cover - no fcntl
-        import filelock
-
         fl = filelock.FileLock(lock, timeout=0)
         try:
             fl.acquire()

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validate import show
+from ._validate import MAX_PRIMARY_SPIN, MAX_SPIN, require_scalar, show
 
 #: |R × V| / (|R| |V|) at or below which V counts as parallel to R (the orbit normal is then
 #: rounding noise): :meth:`InitialState.kicked` applies only radial kicks there.
@@ -191,8 +191,6 @@ class InitialState:
         Bound: the two-point-mass orbital energy V²/2 − G(m1 + m2)/|R| must be negative; the
         mutual potential's higher orders change it by (size/|R|)² only, so this is the
         orbit's eccentricity < 1 test of the paper's set-up."""
-        from ._validate import MAX_PRIMARY_SPIN, MAX_SPIN
-
         n = system.mean_motion
         for body, omega, limit in (("primary", self.primary_omega, MAX_PRIMARY_SPIN),
                                    ("secondary", self.secondary_omega, MAX_SPIN)):
@@ -351,8 +349,6 @@ def tilted_start(system, theta_p, thetadot_p, *, roll=0.0, pitch=0.0, yaw=0.0,
     With every angle and off-axis spin zero this is exactly
     ``system.initial_state(radians(theta_p), thetadot_p)`` (the paper's start, §6.4).
     """
-    from ._validate import MAX_SPIN, require_scalar
-
     theta_p = require_scalar("theta_p", theta_p)
     thetadot_p = require_scalar("thetadot_p", thetadot_p, -MAX_SPIN, MAX_SPIN, unit="(units of n)")
     ang = {k: np.radians(require_scalar(k, v, -360.0, 360.0)) for k, v in

@@ -45,6 +45,8 @@ import math
 import sys
 import time
 
+from ._validate import show
+
 #: Seconds a run must last before the default (``progress=None``) bar appears.
 DELAY_S = 2.0
 #: Fraction between plain lines when the stream is not a terminal.
@@ -157,6 +159,8 @@ class Progress:
         return sys.stderr if self._stream is None else self._stream
 
     def _make_bar(self):
+        # tqdm: imported when a bar is first drawn (tens of ms, and which front end it
+        # takes is decided here, at run time)
         if self._stream is None and in_jupyter():
             from tqdm.auto import tqdm
         else:
@@ -313,8 +317,6 @@ def check(progress, name="progress"):
     (before any work: a bad value would otherwise fail only after the first window)."""
     if progress is None or isinstance(progress, bool) or callable(progress):
         return progress
-    from ._validate import show
-
     raise TypeError(f"{name} must be True, False, None or a callable progress(fraction) "
                     f"(got {show(progress)})")
 

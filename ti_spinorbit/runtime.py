@@ -28,8 +28,15 @@ Decisions (docs/design.md, "Kernel design"):
   anything in the package imports taichi (``ti_spinorbit/__init__.py``).
 """
 
+import atexit
 import os
+import shutil
 import sys
+import tempfile
+
+import platformdirs
+
+from . import _taichi_frontend
 
 
 def _is_command_line():
@@ -90,11 +97,10 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         raise ValueError(f"{label} must be one of {', '.join(_KNOWN_ARCHS)} (got {name!r})")
     name = name.lower()
 
-    import taichi as ti
+    import taichi as ti      # Taichi: imported on first use, the package import stays quiet
 
     if _STATE["arch"] == name:
         return name
-    from . import _taichi_frontend
     _taichi_frontend.install()   # warm start: Taichi re-traces every kernel, even cached ones
     ti_arch = {"cpu": ti.cpu, "x64": ti.x64, "arm64": ti.arm64, "cuda": ti.cuda,
                "vulkan": ti.vulkan, "metal": ti.metal, "opengl": ti.opengl, "gpu": ti.gpu}[name]
@@ -155,8 +161,6 @@ def cache_folder():
     path = os.environ.get(CACHE_ENV)
     if path:
         return path
-    import platformdirs
-
     return os.path.join(platformdirs.user_cache_dir("taichi", appauthor=False), CACHE_SUBDIR)
 
 
@@ -164,8 +168,6 @@ def _unwritable(folder):
     """None when ``folder`` exists or can be created and a file can be written in it, else
     the reason (a real write probe: permission bits say nothing to root or on read-only
     mounts)."""
-    import tempfile
-
     try:
         os.makedirs(folder, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder) as f:
@@ -180,10 +182,6 @@ def _temporary_cache():
     removed at exit after Taichi has shut down (``ti.reset`` first: Taichi's own exit hook
     would otherwise recreate it)."""
     if _STATE.get("temporary_cache") is None:
-        import atexit
-        import shutil
-        import tempfile
-
         try:
             folder = tempfile.mkdtemp(prefix="ti_spinorbit-cache-")
         except OSError:
@@ -191,7 +189,7 @@ def _temporary_cache():
 
         def cleanup():
             if _STATE["arch"] is not None:
-                import taichi as ti
+                import taichi as ti      # Taichi: already imported (an arch is set)
                 ti.reset()
                 _STATE["arch"] = None
             shutil.rmtree(folder, ignore_errors=True)
