@@ -35,9 +35,12 @@ import math
 
 import numpy as np
 
-from ._validate import require_count, require_finite, require_positive, require_range
+from ._validate import (require_count, require_finite, require_positive, require_range,
+                        require_scalar)
 from .constants import (AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q,  # noqa: F401  (public here)
                         K2_MODELS, L_SUN)
+from .perturbations import (BYORP, Q_RATE_FLOOR, YORP_CONVENTION, Tides, body_radius,
+                            yorp_torque, yorp_turns_per_orbit)
 from .systems import G
 
 
@@ -388,7 +391,6 @@ def yorp_energy_per_orbit(system, heliocentric_a_au, heliocentric_e, f_yorp=DEFA
     require_positive("heliocentric_a_au", heliocentric_a_au)
     require_range("heliocentric_e", heliocentric_e, 0.0, 1.0)
     require_positive("f_yorp", f_yorp)
-    from .perturbations import YORP_CONVENTION, yorp_torque, yorp_turns_per_orbit
     return (2.0 * math.pi * yorp_turns_per_orbit(YORP_CONVENTION)
             * yorp_torque(f_yorp, R, heliocentric_a_au * AU, heliocentric_e, YORP_CONVENTION))
 
@@ -612,7 +614,6 @@ def hut_f5(e2):
 
 
 def _check_tides(tides):
-    from .perturbations import Tides
     if not isinstance(tides, Tides):
         raise TypeError(f"tides must be a ti_spinorbit.Tides object (got {type(tides).__name__})")
     return tides
@@ -620,7 +621,6 @@ def _check_tides(tides):
 
 def _tide_inputs(system, tides, omega, e, a):
     """(κ N m⁷, m_red kg, C kg m², a m, n rad/s, e, ω rad/s) of a tide on its body, checked."""
-    from ._validate import require_scalar
     _check_tides(tides)
     omega = require_scalar("omega", omega, unit="rad/s")
     e = require_scalar("e", e, 0.0, 1.0, high_open=True)
@@ -637,7 +637,6 @@ def _effective_lag(system, tides, omega, n):
     (1/2Q)/sqrt((ω − n)² + (ε n0)²), ε = kernels.perturb.Q_RATE_FLOOR and n0 the system's
     (initial) mean motion, the circular orbit's bulge rate ω − n regularised as in the
     kernels."""
-    from .perturbations import Q_RATE_FLOOR
     if tides.time_lag is not None:
         return tides.time_lag
     Q = tides.Q if tides.Q is not None else DEFAULT_Q
@@ -721,8 +720,6 @@ def byorp_da_dt(system, byorp, a=None):
     F_B = :meth:`BYORP.force` (N, strength included), m_s the secondary's mass and
     n = sqrt(G (m1 + m2)/a³); a is the system's unless given (m). F_B does not depend on a,
     so da/dt grows as a^{3/2}."""
-    from ._validate import require_scalar
-    from .perturbations import BYORP
     if not isinstance(byorp, BYORP):
         raise TypeError(f"byorp must be a ti_spinorbit.BYORP object (got {type(byorp).__name__})")
     a = system.a if a is None else require_scalar("a", a, 0.0, math.inf, low_open=True, unit="m")
@@ -751,7 +748,6 @@ def tide_byorp_equilibrium(system, tides, byorp):
     byorp : BYORP
         With a negative coefficient (a contracting BYORP), else there is no equilibrium.
     """
-    from .perturbations import BYORP
     _check_tides(tides)
     if not isinstance(byorp, BYORP):
         raise TypeError(f"byorp must be a ti_spinorbit.BYORP object (got {type(byorp).__name__})")
@@ -767,7 +763,6 @@ def tide_byorp_equilibrium(system, tides, byorp):
                          f"equilibrium (got {byorp.coefficient:g})")
     Q = tides.Q if tides.Q is not None else DEFAULT_Q
     mp, ms = system.primary.mass, system.secondary.mass
-    from .perturbations import body_radius
     Rp = body_radius(system, "primary", tides.radius)
     k2 = tides.love_number(system)
     a7 = 3.0 * (k2 / Q) * tides.strength * G * (mp + ms) * ms ** 2 * Rp ** 5 / (2.0 * mp * abs(F))

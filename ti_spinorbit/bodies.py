@@ -25,7 +25,7 @@ from ._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LENG
                         require_positive_scalar, require_real, show, _as_floats)
 from . import display as _display
 # the monomial orders of a body's row (Body.as_row), shared with the kernels
-from .layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
+from .layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
 
 
 def row_columns(select):
@@ -36,6 +36,14 @@ def row_columns(select):
         cols += [off + k for k, e in enumerate(group) if select(e)]
         off += len(group)
     return cols
+
+
+def odd_columns(row_length=ROW_LENGTH):
+    """Parameter-row columns of the integrals with an odd exponent, for both body rows (the
+    primary's from 0, the secondary's from ``row_length``): any non-zero one makes a member
+    need the kernels' odd terms."""
+    cols = row_columns(lambda e: any(x % 2 for x in e))
+    return cols + [row_length + c for c in cols]
 
 
 def tensor_from_integrals(order, integral):

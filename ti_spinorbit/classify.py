@@ -89,7 +89,8 @@ from typing import ClassVar, Dict
 import numpy as np
 
 from ._validate import require_count, require_positive, require_range
-from .analytic import _decoupled_half_orbit
+from .accuracy import usable
+from .analytic import _decoupled_half_orbit, omega0_effective
 
 #: Paper colour convention (Naidu & Margot 2015, Figs. 4–5 and 7–9).
 COLORS = {"resonant": "red", "chaotic": "blue", "quasi-periodic": "green"}
@@ -352,8 +353,6 @@ def island_centres(system, p_max=6.0):
     with ω0,eff² = ω0² m1/(m1 + m2) and the system's e (see the module notes).
 
     Returns a dict {p: θ̇_p/n}; NaN where no symmetric periodic orbit was found."""
-    from .analytic import omega0_effective
-
     two_p_max = int(math.ceil(2.0 * p_max))
     centers = _decoupled_centers(round(float(omega0_effective(system)), 12),
                                  round(float(system.e), 12), two_p_max)
@@ -530,8 +529,6 @@ def classify_section(result, megno=None, island_shift=True, include_inaccurate=F
     -------
     SectionClassification
     """
-    from .accuracy import usable
-
     failed = ~usable(result.status, include_inaccurate)
     systems = result.systems if island_shift else None
     if megno is None:

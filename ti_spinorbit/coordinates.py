@@ -32,6 +32,10 @@ import warnings
 
 import numpy as np
 
+from . import runtime
+from ._validate import MAX_SPIN
+from .bodies import odd_columns
+
 #: The section coordinate systems, and the package default (docs/design.md, "Section
 #: coordinates": inertial is well defined at every e and is what the equations integrate).
 COORDINATES = ("inertial", "apsidal")
@@ -56,10 +60,7 @@ def check_coordinates(coordinates, flag="coordinates"):
 
 def _odd(par):
     """Whether any member row has an integral with an odd exponent (as ``Ensemble``)."""
-    from .layout import ROW_LENGTH
-    from .ensemble import _odd_columns
-
-    return bool(np.any(par[:, _odd_columns(ROW_LENGTH)] != 0.0))
+    return bool(np.any(par[:, odd_columns()] != 0.0))
 
 
 def true_acceleration(par, states, order=4):
@@ -67,8 +68,7 @@ def true_acceleration(par, states, order=4):
     components, scaled units (G = 1, a = 1, n = 1), for 3-D states (M, 30) with parameter
     rows par (M, NPAR). It is −(∂U/∂R)/m: the kernels' dV/dt = V × Ω1 − (∂U/∂R)/m with the
     frame term V × Ω1 removed (docs/physics.md §4.3)."""
-    from . import runtime
-    from .kernels import eom
+    from .kernels import eom  # Taichi: imported on first use
     from .kernels import advance as K
 
     runtime.ensure_init()
@@ -122,7 +122,7 @@ def true_anomaly(R, V, mu=1.0):
 
 def states_rate(par, states, order=4):
     """ϖ̇ (units of n) of scaled 3-D states (M, 30) with parameter rows par (M, NPAR)."""
-    from .kernels import eom
+    from .kernels import eom  # Taichi: imported on first use
 
     states = np.atleast_2d(states)
     acc = true_acceleration(par, states, order)
@@ -150,8 +150,6 @@ def apsidal_initial_states(members, par, y0, theta_p_deg, thetadot_p, order=4):
     """Initial states whose apsidal spin rate is ``thetadot_p``: θ̇_inertial(0) = θ̇_aps(0) +
     ϖ̇(0), rebuilt with ``BinarySystem.initial_state``. Refuses (ValueError) a member whose
     system's e is below APSIDAL_MIN_ECCENTRICITY. Returns (y0, ϖ̇(0) per member)."""
-    from ._validate import MAX_SPIN
-
     ecc = np.array([s.e for s in members])
     if np.any(ecc < APSIDAL_MIN_ECCENTRICITY):
         k = int(np.argmin(ecc))

@@ -64,7 +64,7 @@ class Model:
 
     def kernels(self, method="cash-karp", perturbed=False):
         """The Taichi kernel set (``kernels.advance.kernels_for``); imports Taichi."""
-        from .kernels import advance as K
+        from .kernels import advance as K      # Taichi: imported on first use
         return K.kernels_for(self.name, method, perturbed)
 
     def qualifies(self, par, y0):
@@ -162,12 +162,14 @@ class Planar(Model):
 SPATIAL = Spatial()
 PLANAR = Planar()
 MODELS = {"planar": PLANAR, "3d": SPATIAL}
+#: What an entry point's ``model=`` may ask for: "auto" (decided by :func:`choose`) or a model.
+REQUESTS = ("auto", *MODELS)
 
 
 def choose(model, par, y0):
     """The model object for ``model`` in {"auto", "planar", "3d"}: "auto" takes the planar
     model when every member qualifies (decided over the whole ensemble, never per chunk)."""
-    if model not in ("auto", "planar", "3d"):
+    if model not in REQUESTS:
         raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
     if model == "3d":
         return SPATIAL

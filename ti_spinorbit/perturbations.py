@@ -45,6 +45,7 @@ from ._validate import HELIOCENTRIC_A_RANGE as _HELIOCENTRIC_A_RANGE
 from ._validate import (check_heliocentric, require_positive_scalar, require_range,
                         require_real, show)
 from .layout import perturbation as _layout
+from .systems import BinarySystem, G
 
 #: The kernels' perturbation block, its accumulators (work, L_ext x, y, z) and the
 #: constant-Q rate floor (units of the system's n; the analytic rates use it too), from
@@ -167,7 +168,6 @@ def _constructor_radius(name, body, radius_m, system):
     if system is None:
         raise ValueError(f"Tides.{name} needs radius_m (m) or system= (a BinarySystem) for the "
                          f"{body}'s radius")
-    from .systems import BinarySystem
     if not isinstance(system, BinarySystem):
         raise TypeError(f"system must be a ti_spinorbit.BinarySystem (got {show(system)})")
     return body_radius(system, body)
@@ -241,7 +241,6 @@ class Tides:
     def coefficient(self, system):
         """κ = 3 k2 G M² R⁵ × strength, N m⁷ (force κ / r⁷ at zero lag), M the other body's
         mass."""
-        from .systems import G
         other = system.secondary if self.body == "primary" else system.primary
         R = body_radius(system, self.body, self.radius)
         return 3.0 * self.love_number(system) * G * other.mass ** 2 * R ** 5 * self.strength
@@ -436,8 +435,6 @@ def change_per_orbit(p, system):
     largest, 1/(2Q) or Δt·n), the semimajor axis as a fraction per orbit (BYORP, 4π a_B /
     (n² a)), and the tide's conservative force κ / r_p⁷ over the mutual gravity G m₁ m₂ / r_p²
     at pericentre r_p = a (1 − e)."""
-    from .systems import G
-
     n, rp = system.mean_motion, system.a * (1.0 - system.e)
     if isinstance(p, Tides):
         kappa = p.coefficient(system)

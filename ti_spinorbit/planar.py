@@ -24,7 +24,7 @@ _SAMPLES = 16   # angles per Fourier fit: exact for trigonometric polynomials of
 
 def qualifies(par, y0):
     """Boolean per member: planar start and bodies symmetric about their equators."""
-    from .kernels import eom
+    from .kernels import eom      # Taichi: on first use
 
     par = np.atleast_2d(par)
     y0 = np.atleast_2d(y0)
@@ -95,7 +95,7 @@ def _cross_coefficients(jA, jB):
 
 def parameter_rows(par):
     """Planar kernel rows (kernels/planar_eom.py layout) from 3-D member rows (eom layout)."""
-    from .kernels import eom, planar_eom as P
+    from .kernels import eom, planar_eom as P      # Taichi: on first use
 
     par = np.atleast_2d(np.asarray(par, dtype=np.float64))
     out = np.zeros((len(par), P.NPAR))
@@ -124,7 +124,7 @@ def parameter_rows(par):
 
 def to_planar(y):
     """3-D scaled states (..., 30) -> planar states (..., 10), layout of kernels/planar_eom.py."""
-    from .kernels import eom, planar_eom as P
+    from .kernels import eom, planar_eom as P      # Taichi: on first use
 
     y = np.asarray(y, dtype=np.float64)
     R = y[..., eom.Y_R:eom.Y_R + 3]                      # primary frame
@@ -149,7 +149,7 @@ def to_planar(y):
 
 def to_spatial(q):
     """Planar states (..., 10) -> 3-D scaled states (..., 30) in the primary's frame."""
-    from .kernels import eom, planar_eom as P
+    from .kernels import eom, planar_eom as P      # Taichi: on first use
 
     q = np.asarray(q, dtype=np.float64)
     r, vr, ell, lam = q[..., P.Y_R], q[..., P.Y_VR], q[..., P.Y_L], q[..., P.Y_LAM]
@@ -173,7 +173,7 @@ def to_spatial(q):
 def shadow_direction():
     """Unit direction of the chaos-indicator shadow's initial offset: r, v_r, ℓ and the
     secondary's spin (the planar counterpart of the 3-D model's direction)."""
-    from .kernels import planar_eom as P
+    from .kernels import planar_eom as P      # Taichi: on first use
 
     u = np.zeros(P.NSTATE)
     u[[P.Y_R, P.Y_VR, P.Y_L, P.Y_W2]] = 1.0

@@ -9,7 +9,9 @@ import numpy as np
 
 from . import runtime
 from ._validate import require_finite, require_order
-from .bodies import Body
+from .bodies import Body, odd_columns
+from .layout import ROW_LENGTH
+from .systems import G
 
 
 def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
@@ -32,11 +34,8 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
         V in J; F = −∂V/∂R the force on the secondary, N; torques about each body's centre of
         mass, N m (δV = −torque·δθ for an infinitesimal rotation of that body alone).
     """
-    from .kernels import eom
+    from .kernels import eom          # Taichi: imported on first use
     from .kernels import advance as K
-    from .ensemble import _odd_columns
-    from .layout import ROW_LENGTH
-    from .systems import G
 
     for label, body in (("primary", primary), ("secondary", secondary)):
         if not isinstance(body, Body):
@@ -67,7 +66,7 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     par = np.zeros((len(Rf), eom.NPAR))
     par[:, eom.BODY_A:eom.BODY_A + ROW_LENGTH] = primary.as_row()
     par[:, eom.BODY_B:eom.BODY_B + ROW_LENGTH] = secondary.as_row()
-    odd = bool(np.any(par[:, _odd_columns(ROW_LENGTH)] != 0.0))
+    odd = bool(np.any(par[:, odd_columns(ROW_LENGTH)] != 0.0))
     runtime.ensure_init()
     out = np.zeros((len(Rf), 10))
     K.evaluate_mutual(par, Rf, Sf, out, G, int(order), odd)

@@ -302,7 +302,7 @@ def integrate(G, body_a, body_b, y0, t_span, rtol, atol, order=4, t_eval=None):
     """Integrate :func:`rhs` with scipy's DOP853; returns scipy's ``OdeResult``.
 
     scipy is imported here only: it is a test-time dependency of the package."""
-    from scipy.integrate import solve_ivp
+    from scipy.integrate import solve_ivp      # scipy: optional (tests only), imported here
 
     pair = _Pair(body_a, body_b)
     return solve_ivp(lambda t, y: pair.rhs(G, y, order), t_span, np.asarray(y0, dtype=np.float64),

@@ -39,7 +39,10 @@ import math
 
 import numpy as np
 
+from . import planar
 from ._validate import GIB, require_memory
+from .perturbations import NACC
+from .systems import BinarySystem
 
 #: Peak bytes per recorded row (crossing or sample), measured: see the module docstring.
 ROW_BYTES = 1300.0
@@ -123,10 +126,7 @@ def record_width(system, model="auto", perturbed=False):
     bodies equatorially symmetric) or "planar" is asked, else the 3-D one (31; also when
     ``system`` is a list, not yet known); with ``perturbed`` (tides, YORP or BYORP) the
     records also carry the NACC work and external-angular-momentum accumulators (15, 35)."""
-    from . import planar
-    from .kernels import advance as K
-    from .perturbations import NACC
-    from .systems import BinarySystem
+    from .kernels import advance as K      # Taichi: imported on first use
 
     width = K.SPATIAL.RECORD_WIDTH
     if model == "planar":

@@ -13,7 +13,9 @@ secondary spinning at θ̇_p·n about the orbit normal and the primary at 2π/P 
 The state is fully 3-D even though these starts are planar.
 """
 
+import json
 import math
+import os
 import warnings
 from dataclasses import dataclass, field
 from typing import Optional, Tuple
@@ -25,8 +27,10 @@ from ._validate import (MAX_BULK_DENSITY, MAX_MASS, MAX_MASS_RATIO, MAX_PRIMARY_
                         MIN_MOMENT_RATIO, check_heliocentric, refuse_unknown_keys,
                         require_finite, require_positive_scalar, require_range, require_real,
                         show)
-from .bodies import Body
+from .bodies import Body, Ellipsoid
 from . import display as _display
+from .initial import tilted_start as _tilted_start
+from .layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
 
 #: Newtonian constant of gravitation, m^3 kg^-1 s^-2 (CODATA 2018).
 G = 6.67430e-11
@@ -221,8 +225,6 @@ class BinarySystem(_display.Readable):
     # ---- scaled member rows -------------------------------------------------------------
     def scaled_body_row(self, body: Body) -> np.ndarray:
         """Body.as_row in scaled units: T^{lmn} / ((m1+m2) a^{l+m+n})."""
-        from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
-
         row = body.as_row()
         M = self.total_mass
         scale = [M] + [M * self.a**2] * len(EXPONENTS_2) + [M * self.a**3] * len(EXPONENTS_3) \
@@ -231,7 +233,7 @@ class BinarySystem(_display.Readable):
 
     def parameter_row(self, escape_distance: float = ESCAPE_DISTANCE) -> np.ndarray:
         """The kernels' parameter row (kernels/eom.py layout), scaled units."""
-        from .kernels import eom
+        from .kernels import eom      # Taichi: imported on first use
 
         p = np.zeros(eom.NPAR)
         p[eom.BODY_A:eom.BODY_A + len(self.primary.as_row())] = self.scaled_body_row(self.primary)
@@ -258,7 +260,7 @@ class BinarySystem(_display.Readable):
         """:meth:`initial_state` of many starts at once: theta_p (radians) and thetadot_p
         (units of n) 1-D arrays of one length; returns (N, 30). The numbers are those of
         the one-start form, bit for bit (the same operations, elementwise)."""
-        from .kernels import eom
+        from .kernels import eom      # Taichi: imported on first use
 
         theta_p = np.asarray(theta_p, dtype=np.float64).ravel()
         thetadot_p = np.asarray(thetadot_p, dtype=np.float64).ravel()
@@ -288,12 +290,11 @@ class BinarySystem(_display.Readable):
         an :class:`ti_spinorbit.InitialState` (keywords roll, pitch, yaw, spin_x, spin_y,
         inclination, primary_tilt: :func:`ti_spinorbit.initial.tilted_start`,
         docs/physics.md §6.8)."""
-        from .initial import tilted_start
-        return tilted_start(self, theta_p, thetadot_p, **tilts)
+        return _tilted_start(self, theta_p, thetadot_p, **tilts)
 
     def to_physical(self, y: np.ndarray) -> np.ndarray:
         """Scaled internal state -> SI physical state [R, P, Γ1, Γ2, S, S1] (reference layout)."""
-        from .kernels import eom
+        from .kernels import eom      # Taichi: imported on first use
 
         y = np.asarray(y, dtype=np.float64)
         out = y.copy()
@@ -427,8 +428,6 @@ DERIVED_RTOL = 1e-9
 def _body_from(b, label, mismatches):
     """A body of a system description (see BinarySystem.from_description); a derived
     bounding_radius_m that disagrees is added to ``mismatches``."""
-    from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, Ellipsoid
-
     if not isinstance(b, dict):
         raise TypeError(f"{label} must be an object with the keys {', '.join(BODY_KEYS)} "
                         f"(got {show(b)})")
@@ -542,9 +541,6 @@ def read_system_file(path, what="path"):
     """The BinarySystem of a system file (BinarySystem.from_file), every error one line
     starting with ``what`` (the parameter, or the command line's flag: "--system") and
     naming the file."""
-    import json
-    import os
-
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError(f"{what} must be a file path (str or os.PathLike), got {show(path)}")
     p = os.fsdecode(os.fspath(path))
@@ -587,8 +583,6 @@ def _scaled_body(body: Body, factor: float) -> Body:
     integral) multiplied by ``factor``. A uniform ellipsoid is rebuilt from its semi-axes
     and new mass, so that its description (semi-axes, mass) rebuilds it bit for bit."""
     if hasattr(body, "semi_axes"):
-        from .bodies import Ellipsoid
-
         return Ellipsoid(*body.semi_axes, mass=body.mass * factor, name=body.name)
     scaled = Body(body.mass * factor, {k: v * factor for k, v in body.integrals.items()},
                   body.bounding_radius, body.name)
@@ -602,8 +596,6 @@ def _volume(body: Body) -> float:
     """A body's volume, m³, for its bulk density: (4/3)π abc of an ellipsoid; of a general
     Body, that of the uniform ellipsoid with its second moments (semi-axes sqrt(5 T^200 / m),
     sqrt(5 T^020 / m), sqrt(5 T^002 / m))."""
-    from .bodies import EXPONENTS_2
-
     axes = getattr(body, "semi_axes", None) or \
         [math.sqrt(5.0 * body.integral(*k) / body.mass) for k in EXPONENTS_2]
     return 4.0 / 3.0 * math.pi * axes[0] * axes[1] * axes[2]
