@@ -1,5 +1,8 @@
 """``import ti_spinorbit`` is quiet and cheap: it prints nothing (no "[Taichi] version" banner)
-and imports neither Taichi nor the kernels until the first computation.
+and imports neither Taichi nor the kernels until the first computation. The kernels package's
+pure-Python data modules are the exception: the Butcher tableaux and the controller
+(``kernels/tableau.py``, ``kernels/controller.py``, no Taichi) are the one registry of methods
+the host reads its method names from.
 
 Each check runs in a fresh interpreter (``sys.executable``, this environment passed through so
 PYTHONPATH keeps working): the test session itself has long since imported Taichi. The
@@ -12,9 +15,11 @@ import sys
 
 import pytest
 
+#: The kernels package's modules that hold data only (no Taichi), which the host imports.
+PURE = ("ti_spinorbit.kernels", "ti_spinorbit.kernels.tableau", "ti_spinorbit.kernels.controller")
 #: Print the Taichi and kernel modules loaded (one line, a Python list).
 LOADED = ("import sys; print(sorted(m for m in sys.modules if m.split('.')[0] == 'taichi' "
-          "or m.startswith('ti_spinorbit.kernels')))")
+          f"or m.startswith('ti_spinorbit.kernels') and m not in {PURE!r}))")
 
 
 def run_python(code):

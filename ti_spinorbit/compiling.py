@@ -37,10 +37,13 @@ import json
 import logging
 import os
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
+from . import models as _models
 from . import progress, runtime
+from .kernels import tableau as _tableau
 from .layout import DONE
 
 _LOG = logging.getLogger("ti_spinorbit")
@@ -57,53 +60,65 @@ SAMPLING_FACTOR = 1.0
 ANNOUNCE_MIN_S = 1.0
 #: The measurements, in the kernel cache folder (runtime.cache_folder()).
 RECORD_FILE = "compile_seconds.json"
-#: Methods warmup() accepts (the one place to extend when the kernels get more).
-METHODS = ("cash-karp", "dop853", "vern9")   # kernels.tableau.METHODS (not imported: quiet import)
-MODELS = ("planar", "3d")
+#: The methods and models, from their one registry each (kernels.tableau.METHODS, pure
+#: Python: importing it loads no Taichi; models.MODELS).
+METHODS = tuple(_tableau.METHODS)
+MODELS = tuple(_models.MODELS)
 
 _SEEN = set()              # (runtime generation, arch, variant) compiled in this process
 _TOTAL = [0.0]             # compile seconds spent in this process
 _HOW = {}                  # variant -> how its last first use went ("compiled", "loaded")
 
 
-def variant_name(model, indicators, sampling, order=4, odd=False, method="cash-karp",
-                 perturbed=False):
-    """A variant as text (the key of the measurements): ``planar/indicators/order4/cash-karp``
-    (``.../perturbed/cash-karp`` with tides, YORP or BYORP)."""
-    parts = [model, "indicators" if indicators else "plain", "sampling" if sampling else
-             "sections", f"order{int(order)}"]
-    if odd:
-        parts.append("odd")
-    if perturbed:
-        parts.append("perturbed")
-    return "/".join(parts + [method])
+@dataclass(frozen=True)
+class KernelVariant:
+    """One compiled variant of the window kernel: its Taichi template arguments. ``name``
+    is its text (the key of the measurements file), ``describe()`` its words in the
+    compile announcement, ``default_seconds`` the cold-compile estimate before anything was
+    measured on this machine."""
 
+    model: str                       # "planar" or "3d" (MODELS)
+    indicators: bool = False         # the shadow trajectory (MEGNO, Lyapunov)
+    sampling: bool = False           # dense samples (time series) besides the crossings
+    order: int = 4                   # truncation order of the mutual potential
+    odd: bool = False                # odd-degree inertia integrals present
+    method: str = "cash-karp"        # Runge-Kutta pair (METHODS)
+    perturbed: bool = False          # tides, YORP or BYORP in the equations
 
-def describe(variant):
-    """``planar/indicators/sections/order4/cash-karp`` -> "the planar model with indicators"."""
-    model, ind, samp = variant.split("/")[:3]
-    what = [f"the {'3-D' if model == '3d' else model} model"]
-    if ind == "indicators":
-        what.append("with chaos indicators")
-    if samp == "sampling":
-        what.append("with dense sampling")
-    if "perturbed" in variant.split("/"):
-        what.append("with perturbations")
-    method = variant.split("/")[-1]
-    if method != "cash-karp":
-        what.append(f"({method})")
-    return " ".join(what)
+    @property
+    def name(self) -> str:
+        """``planar/indicators/sections/order4/cash-karp`` (``.../perturbed/cash-karp`` with
+        tides, YORP or BYORP)."""
+        parts = [self.model, "indicators" if self.indicators else "plain",
+                 "sampling" if self.sampling else "sections", f"order{int(self.order)}"]
+        if self.odd:
+            parts.append("odd")
+        if self.perturbed:
+            parts.append("perturbed")
+        return "/".join(parts + [self.method])
 
+    def describe(self) -> str:
+        """"the planar model with chaos indicators (dop853)", ..."""
+        what = [f"the {'3-D' if self.model == '3d' else self.model} model"]
+        if self.indicators:
+            what.append("with chaos indicators")
+        if self.sampling:
+            what.append("with dense sampling")
+        if self.perturbed:
+            what.append("with perturbations")
+        if self.method != "cash-karp":
+            what.append(f"({self.method})")
+        return " ".join(what)
 
-def default_seconds(variant):
-    """``DEFAULT_COMPILE_SECONDS`` of the variant's model, scaled for indicators/sampling."""
-    model, ind, samp = variant.split("/")[:3]
-    seconds = DEFAULT_COMPILE_SECONDS.get(model, max(DEFAULT_COMPILE_SECONDS.values()))
-    if ind == "indicators":
-        seconds *= INDICATORS_FACTOR
-    if samp == "sampling":
-        seconds *= SAMPLING_FACTOR
-    return seconds
+    @property
+    def default_seconds(self) -> float:
+        """``DEFAULT_COMPILE_SECONDS`` of the model, scaled for indicators and sampling."""
+        seconds = DEFAULT_COMPILE_SECONDS.get(self.model, max(DEFAULT_COMPILE_SECONDS.values()))
+        if self.indicators:
+            seconds *= INDICATORS_FACTOR
+        if self.sampling:
+            seconds *= SAMPLING_FACTOR
+        return seconds
 
 
 def record_path():
@@ -137,12 +152,12 @@ def _write_records(records):
             pass
 
 
-def fingerprint(variant):
+def fingerprint(variant: KernelVariant):
     """Digest of what Taichi's cache key depends on for us: the kernel sources, the Taichi
     version, the arch and the variant."""
     from . import kernels    # kernels/: on first use (the quiet import loads no kernel module)
 
-    h = hashlib.sha256(variant.encode())
+    h = hashlib.sha256(variant.name.encode())
     folder = list(kernels.__path__)[0]
     for name in sorted(os.listdir(folder)):
         if name.endswith(".py"):
@@ -211,7 +226,7 @@ class FirstUse:
         self.kernel = kernel
         self.variant = variant
         self.status = status
-        self.key = (runtime.generation(), runtime.current_arch(), variant)
+        self.key = (runtime.generation(), runtime.current_arch(), variant.name)
         self.first = self.key not in _SEEN
         self.seconds = 0.0          # integrator kernel compile, not yet taken
         self.how = "ready"          # "compiled", "loaded" (disk cache) or "ready" (in process)
@@ -225,15 +240,15 @@ class FirstUse:
         if self._begun:
             return
         self._begun = True
-        rec = read_records().get(self.variant) or {}
+        rec = read_records().get(self.variant.name) or {}
         self._fp = fingerprint(self.variant)
         self._cached = runtime.disk_cache() and rec.get("fingerprint") == self._fp
         self._report = progress.active()
         if self._cached:
             return
-        estimate = rec.get("seconds") or default_seconds(self.variant)
+        estimate = rec.get("seconds") or self.variant.default_seconds
         if estimate >= ANNOUNCE_MIN_S:
-            text = (f"compiling kernels for {describe(self.variant)} (first use only, about "
+            text = (f"compiling kernels for {self.variant.describe()} (first use only, about "
                     f"{estimate:.0f} s)")
             _LOG.info(text)
             if self._report is not None:
@@ -264,10 +279,10 @@ class FirstUse:
             _TOTAL[0] += seconds
             self.seconds += seconds
             self.how = "loaded" if self._cached else "compiled"
-            _HOW[self.variant] = self.how
+            _HOW[self.variant.name] = self.how
             total = seconds + self._other
             self._record(total)
-            _LOG.info("kernels for %s %s in %.2f s", describe(self.variant), self.how, total)
+            _LOG.info("kernels for %s %s in %.2f s", self.variant.describe(), self.how, total)
             if self._report is not None:
                 self._report.compiled(total)
         return self.kernel(*args)
@@ -275,14 +290,14 @@ class FirstUse:
     def _record(self, total):
         """Store the measurement (the whole first use: what a user waits for)."""
         records = read_records()
-        rec = dict(records.get(self.variant) or {})
+        rec = dict(records.get(self.variant.name) or {})
         rec["loaded_seconds" if self._cached else "seconds"] = round(total, 3)
         if runtime.disk_cache():
             rec["fingerprint"] = self._fp
         else:
             rec.pop("fingerprint", None)
-        if rec != records.get(self.variant):
-            records[self.variant] = rec
+        if rec != records.get(self.variant.name):
+            records[self.variant.name] = rec
             _write_records(records)
 
     def take_seconds(self):

@@ -351,9 +351,9 @@ class Ensemble:
             st = ckpt.load(checkpoint, settings, fingerprint)
         # the first use of a variant in this process compiles its kernels, announced; that
         # time stays out of seconds, rates and window lengths (ti_spinorbit.compiling)
-        advance = compiling.FirstUse(kern.advance, compiling.variant_name(
-            self.model, indicators, sampling, self.order, self.odd,
-            getattr(self, "method", "cash-karp"), self.perturbed), lambda: self.status)
+        advance = compiling.FirstUse(kern.advance, compiling.KernelVariant(
+            self.model, bool(indicators), sampling, self.order, self.odd, self.method,
+            self.perturbed), lambda: self.status)
         if st is None:
             with advance.other_kernels():
                 st = self._fresh_run_state(sampling, sample_dt, indicators, separation,

@@ -32,8 +32,6 @@ from . import layout as _layout
 from .perturbations import NACC, check_perturbations, perturbation_rows
 from .systems import ESCAPE_DISTANCE, BinarySystem
 
-#: The model requests an entry point takes (``Members.model`` holds the decision).
-MODEL_REQUESTS = ("auto", "planar", "3d")
 
 
 @dataclass(frozen=True, eq=False)
@@ -278,4 +276,4 @@ def member_groups(members):
 
 
 __all__ = ["Members", "as_systems", "system_list", "parameter_rows", "check_size",
-           "member_groups", "MODEL_REQUESTS"]
+           "member_groups"]

@@ -27,6 +27,7 @@ import enum
 import numpy as np
 
 from . import layout
+from .kernels import tableau as _tableau
 
 
 class Status(enum.IntEnum):
@@ -66,7 +67,9 @@ STATUS_NAMES = layout.STATUS_NAMES
 
 # units shared by many fields
 SPIN = "mean motion n"                 # spin rates and frequencies in units of n
-METHOD = "name: Runge-Kutta pair ('cash-karp', 'dop853' or 'vern9')"
+_METHODS = tuple(_tableau.METHODS)     # the one registry of methods (pure Python)
+METHOD = ("name: Runge-Kutta pair (" + ", ".join(map(repr, _METHODS[:-1])) + " or "
+          + repr(_METHODS[-1]) + ")")
 STATUS = "status code (metadata status_codes)"
 CLASS = "label"
 RELATIVE = "1 (relative)"

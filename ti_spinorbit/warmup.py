@@ -9,7 +9,7 @@ import time
 import numpy as np
 
 from . import compiling
-from .compiling import METHODS, MODELS, variant_name
+from .compiling import METHODS, MODELS, KernelVariant
 
 
 def _choices(name, values, allowed):
@@ -88,7 +88,7 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
         before = len(compiling._SEEN), compiling._TOTAL[0]
         ens.run(2.0 * np.pi * 0.01, sample_dt=2.0 * np.pi / 64 if samp else None,
                 indicators=ind)
-        variant = variant_name(model, ind, samp, order, ens.odd, method, pert)
+        variant = KernelVariant(model, ind, samp, order, ens.odd, method, pert).name
         seconds = time.perf_counter() - started
         kernel = compiling._TOTAL[0] - before[1]
         how = "ready" if len(compiling._SEEN) == before[0] else compiling._HOW.get(variant, "compiled")

@@ -13,6 +13,7 @@ import re
 from .._validate import MAX_DENSITY, MAX_SPIN, MIN_DENSITY  # bounds shared with the library
 from ..section import MAX_ORBITS  # orbits limit shared with the library
 from .. import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
+from .. import models as _models  # the model requests (one registry)
 from .common import EXIT_INACCURATE, build_system, fmt, one_line, say
 
 #: Accepted --rtol range (the integrator's own limits, ensemble.check_tolerances).
@@ -163,7 +164,7 @@ def run_options(s, out_help, data=True, orbits=300.0, rtol=1e-10, model=True, re
                    help="replace output files that already exist (refused by default, "
                         "before any work)")
     if model:
-        s.add_argument("--model", choices=("auto", "planar", "3d"), default="auto",
+        s.add_argument("--model", choices=_models.REQUESTS, default="auto",
                        help="equations of motion: the reduced planar model for planar "
                             "starts (auto, default) or the general 3-D one (3d)")
     if resume:
