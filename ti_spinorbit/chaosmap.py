@@ -28,17 +28,21 @@ from . import accuracy, analytic, catalog, compiling, resources
 from . import progress as _progress
 from ._validate import (_as_floats, require_positive, require_real,
                         require_spin, show)
+from .checkpoint import Launches, check_path
 from .classify import MIN_POINTS, classify_section
 from .convergence import run_lengths
 from .coordinates import check_coordinates
+from .ensemble import check_tolerances
+from .models import check_indicator_space
+from .plotting import plot_chaos_map, plot_parameter_map
 from .runners import check_client, run_section
 from .section import INDICATOR_SPACE, SectionResult, check_orbits
 from .systems import BinarySystem
 from . import display as _display
-from .attitude import CLASS_UNIT as ATTITUDE_CLASS
+from .attitude import CLASS_UNIT as ATTITUDE_CLASS, CLASSES, classify_crossings
 from .perturbations import UNIT as PERTURBATIONS, check_perturbations
 from .results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, STATUS, Result,
-                      unit)
+                      Status, unit)
 from .results import FLOAT as _F, INTEGER as _I, BOOL as _B, TEXT as _S
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
@@ -62,8 +66,6 @@ def _axis(name, values):
 
 def _check_map_inputs(rtol, megno_chaotic, progress):
     """Scalars of chaos_map and parameter_map, checked before any member is built."""
-    from .ensemble import check_tolerances
-
     check_tolerances(rtol, None)
     require_real("megno_chaotic", megno_chaotic)
     require_positive("megno_chaotic", megno_chaotic)
@@ -96,8 +98,6 @@ def _labels(section, megno_chaotic, orbits):
 def _attitude_classes(section, classes):
     """Attitude class codes of a map's members (``attitude.classify_crossings``): libration
     where the section is resonant in the synchronous resonance, tumbling, circulation."""
-    from .attitude import classify_crossings
-
     if section.max_tilt is None or section.max_npa_angle is None:
         return None
     with np.errstate(invalid="ignore"):
@@ -179,7 +179,6 @@ class ChaosMap(Result, _display.Readable, kind="chaos_map"):
     @property
     def attitude_class_names(self):
         """``attitude_class`` as text, the map's shape (an object array; "" where none)."""
-        from .attitude import CLASSES
         if self.attitude_class is None:
             return None
         codes = np.asarray(self.attitude_class)
@@ -201,8 +200,6 @@ class ChaosMap(Result, _display.Readable, kind="chaos_map"):
         exponent (``quantity="lyapunov"``), the classes (``"classification"``) or the largest
         pole tilt (``"max_tilt"``, deg, log colours) over θ_p and θ̇_p/n:
         :func:`ti_spinorbit.plotting.plot_chaos_map`. Returns the Axes."""
-        from .plotting import plot_chaos_map
-
         return plot_chaos_map(self, ax=ax, quantity=quantity, overlay=overlay,
                               overlay_members=overlay_members, colorbar=colorbar, title=title)
 
@@ -297,7 +294,6 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, rtol=1e-10, meg
                         "tilt=(roll, pitch)), not initial_states: for explicit states call "
                         "surface_of_section(initial_states=..., indicators=True)")
     launches = _launches(checkpoint, resume, overwrite_checkpoint, client)
-    from .models import check_indicator_space
     indicator_space = check_indicator_space(indicator_space)
     tilt = _check_tilt(tilt, coordinates)
     perturbations = check_perturbations(perturbations)
@@ -373,8 +369,6 @@ def _launches(checkpoint, resume, overwrite, client):
     """The checkpoints of a map's launches (every length: the evidence, then the map), in
     ``checkpoint/launch-kkk`` (:class:`ti_spinorbit.checkpoint.Launches`), checked before any
     work; none with a Dask client (refused there by the first launch)."""
-    from .checkpoint import Launches, check_path
-
     check_client(client)
     checkpoint = check_path(checkpoint)
     if client is not None and (checkpoint is not None or resume):
@@ -420,7 +414,6 @@ def fraction_evidence(lengths, fractions):
 
 def _inaccurate_code():
     """The "inaccurate" status code (:class:`ti_spinorbit.results.Status`)."""
-    from .results import Status
     return int(Status.INACCURATE)
 
 
@@ -492,8 +485,6 @@ class ParameterMap(Result, _display.Readable, kind="parameter_map"):
     def plot(self, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=True, title=None):
         """pcolormesh of the chaotic fraction over (e, a/b) with the analytic overlap line and
         chaotic-layer contours: :func:`ti_spinorbit.plotting.plot_parameter_map`."""
-        from .plotting import plot_parameter_map
-
         return plot_parameter_map(self, ax=ax, contours=contours, colorbar=colorbar, title=title)
 
 

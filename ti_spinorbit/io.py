@@ -43,8 +43,13 @@ import numpy as np
 
 from . import perturbations, runtime
 from . import results as _results
+from ._version import __version__
+from .attitude import CLASS_UNIT, CLASSES
 from .files import atomic_write
+from .layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
 from .npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
+from .results import STATUS, STATUS_NAMES, units as field_units
+from .systems import BinarySystem
 
 #: Layout version written into every archive's metadata; bump it when the layout changes.
 FORMAT_VERSION = 2
@@ -90,8 +95,6 @@ def units(kind):
     """Units of the arrays and scalars of a result kind (a new dict), e.g.
     ``units("section")``: the units declared on the result class's fields
     (:func:`ti_spinorbit.results.units`) plus the archive's own entries."""
-    from .results import units as field_units
-
     if kind not in _kinds():
         raise ValueError(f"unknown kind {kind!r}; known kinds: {', '.join(_kinds())}")
     return {**ARCHIVE_UNITS, **field_units(_kinds()[kind])}
@@ -100,8 +103,6 @@ def units(kind):
 def status_codes():
     """Integrator status code -> name, e.g. {0: "running", 1: "done", ...}
     (:class:`ti_spinorbit.results.Status`)."""
-    from .results import STATUS_NAMES
-
     return dict(enumerate(STATUS_NAMES))
 
 
@@ -115,8 +116,6 @@ def status_names(status):
 
 def provenance():
     """Package, version, Taichi arch and UTC timestamp: the common head of every metadata."""
-    from . import __version__
-
     return {"package": "ti_spinorbit", "version": __version__, "arch": runtime.current_arch(),
             "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat()}
 
@@ -175,8 +174,6 @@ def describe_system(system):
     """``system.describe()`` plus each body's inertia integrals (``"integrals"``,
     ``{"l,m,n": T^{lmn}}`` in kg m^(l+m+n), non-zero entries), so that
     :meth:`BinarySystem.from_description` rebuilds any body exactly, not only ellipsoids."""
-    from .bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
-
     d = system.describe()
     for label, body in (("primary", system.primary), ("secondary", system.secondary)):
         row = body.as_row()[1:]
@@ -187,8 +184,6 @@ def describe_system(system):
 
 
 def _is_system(x):
-    from .systems import BinarySystem
-
     return isinstance(x, BinarySystem)
 
 
@@ -414,8 +409,6 @@ def load(path):
         whose shapes, dtypes or status / attitude codes are not what the package writes);
         one line naming the file and the fault.
     """
-    from . import __version__
-
     p = os.fspath(path)
     zf, entries, meta = _open(p)
     with zf:
@@ -453,8 +446,6 @@ def load(path):
 
 
 def _decode_file(meta, entries):
-    from .systems import BinarySystem
-
     descriptions = meta.get("systems", [])
     if not isinstance(descriptions, list):
         raise TypeError(f"metadata 'systems' is a {type(descriptions).__name__}, not a list")
@@ -505,17 +496,12 @@ _F, _I, _B, _S = _results.FLOAT, _results.INTEGER, _results.BOOL, _results.TEXT
 
 def _code_ranges():
     """Unit text of a code field -> the codes allowed (status codes, attitude classes)."""
-    from .attitude import CLASS_UNIT, CLASSES
-    from .results import STATUS, STATUS_NAMES
-
     return {STATUS: (0, len(STATUS_NAMES) - 1), CLASS_UNIT: (-1, len(CLASSES) - 1)}
 
 
 def _check_loaded(path, result):
     """Refuse a loaded result whose arrays do not have the shapes, dtypes and code ranges the
     package writes (an edited or damaged file): ArchiveError naming the file and field."""
-    from .results import STATUS_NAMES, units as field_units
-
     kind = kind_of(result)
     where = f"{path!r} is damaged or edited: {kind} field"
     dims = {}
@@ -579,8 +565,6 @@ def _check_loaded(path, result):
 def _upgrade_v0(path, meta, arrays):
     """Metadata of a pre-format_version file (save_result of ti_spinorbit 0.1: a section or
     time series with one system description per member) in the version-1 layout."""
-    from .systems import BinarySystem
-
     kind = "time_series" if "alpha" in arrays else "section"
     if meta["kind"] not in ("section", "time_series"):
         raise ValueError(f"{path!r} (format_version 0) holds kind {meta['kind']!r}; format 0 "
@@ -611,9 +595,7 @@ __all__ = ["save", "load", "save_result", "read_metadata", "write_archive",
 
 def _register():
     """Give every result its ``save`` (:data:`ti_spinorbit.results.BACKENDS`)."""
-    from . import results
-
-    results.BACKENDS["save"] = save
+    _results.BACKENDS["save"] = save
 
 
 _register()

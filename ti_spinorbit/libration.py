@@ -43,13 +43,16 @@ from typing import List
 
 import numpy as np
 
-from . import accuracy, analytic, compiling, resources
+from . import accuracy, analytic, catalog, compiling, resources
 from . import progress as _progress
+from .checkpoint import Launches
 from .classify import horizontal_extent
 from ._validate import (require_bool, require_count, require_positive,
                         require_real, require_scalar, require_spin)
 from .convergence import run_lengths
+from .coordinates import check_coordinates
 from .ensemble import check_tolerances
+from .plotting import plot_libration
 from .section import SystemLike, check_orbits, surface_of_section, time_series
 from .systems import BinarySystem
 from . import display as _display
@@ -240,8 +243,6 @@ class RelaxedLibration(Result, _display.Readable, kind="relaxed_libration"):
         """α(t) at the centre with the amplitude max |α| and the decoupled |ψ_A| band (and,
         on a new figure, the search's panels): :func:`ti_spinorbit.plotting.plot_libration`.
         Returns the Axes of α(t)."""
-        from .plotting import plot_libration
-
         return plot_libration(self, ax=ax, title=title, search=search)
 
     def evidence(self):
@@ -383,9 +384,6 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     RuntimeError
         No coarse candidate librates, or the trajectory at the centre found does not.
     """
-    from . import catalog
-    from .coordinates import check_coordinates
-
     system = catalog.as_system(system)
     check_coordinates(coordinates)
     if not system.omega0 > 0:
@@ -429,7 +427,6 @@ def relaxed_libration(system: BinarySystem, orbits=100, rtol=1e-12, candidates=N
     if not float(orbits) <= cap <= 1e7:
         raise ValueError(f"max_orbits must lie in [orbits, 1e7] = [{float(orbits):g}, 1e7] "
                          f"(got {cap:g})")
-    from .checkpoint import Launches
 
     perturbations = check_perturbations(perturbations)
     section_kwargs = dict(section_kwargs, coordinates=coordinates, model=model,  # every launch alike

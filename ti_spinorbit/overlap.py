@@ -40,6 +40,7 @@ records them for the connecting trajectory, which should be clearly chaotic (⟨
 All elongations of a scan run in one ensemble launch (each member carries its own system).
 """
 
+import inspect
 from dataclasses import dataclass, field
 from typing import Callable, List, Optional, Union
 
@@ -49,10 +50,15 @@ from . import accuracy, analytic, catalog, compiling, resources
 from . import progress as _progress
 from ._validate import (_as_floats, require_count, require_range,
                         require_scalar, show)
+from .checkpoint import Launches
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
 from .convergence import run_lengths
+from .coordinates import check_coordinates
+from .ensemble import check_tolerances
+from .plotting import plot_overlap
 from .runners import run_section
+from .section import check_orbits
 from .systems import BinarySystem
 from . import display as _display
 from .results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, record, unit
@@ -187,8 +193,6 @@ class OverlapScan(Result, _display.Readable, kind="overlap_scan"):
     def plot(self, ax=None, title=None):
         """Decision per elongation with the numerical and analytic thresholds and the largest
         ⟨Y⟩ per elongation: :func:`ti_spinorbit.plotting.plot_overlap`. Returns the Axes."""
-        from .plotting import plot_overlap
-
         return plot_overlap(self, ax=ax, title=title)
 
     @property
@@ -285,11 +289,6 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     ``OverlapDecision.megno_overlap``; ``megno_first_overlap`` its threshold): a chaotic
     layer spanning both islands shows in ⟨Y⟩ before a single trajectory has crossed it.
     """
-    from .coordinates import check_coordinates
-
-    from .ensemble import check_tolerances
-    from .section import check_orbits
-
     # every scalar before any system is built or integrated
     check_coordinates(coordinates)
     check_orbits(orbits)
@@ -314,7 +313,6 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                         f"(elongation) -> BinarySystem (got {type(system).__name__})")
     make, name = _factory(system, eccentricity)
     perturbations = check_perturbations(perturbations)
-    from .checkpoint import Launches
     launches = Launches(checkpoint, resume, overwrite_checkpoint)
     if elongations is not None and (np.ndim(elongations) != 1 or np.size(elongations) == 0):
         raise ValueError(f"elongations must be a non-empty 1-D array of a/b values in (1, 10] "
@@ -524,7 +522,6 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
     ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
     # every scan keeps its sections: size all of them together, before the first
-    import inspect
     default = {k: v.default for k, v in inspect.signature(overlap_threshold).parameters.items()}
     args = dict(default, **kwargs)
     try:

@@ -178,7 +178,6 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
     as small black dots. Returns the Axes."""
     from matplotlib.colors import ListedColormap      # matplotlib: when a figure is drawn
 
-
     ax = _axes(ax)
     x, y = _edges(cmap.theta_p, 0.0, 180.0), _edges(cmap.thetadot_p)
     extend = "neither"

@@ -47,6 +47,9 @@ import numpy as np
 
 from . import io
 from . import results as _results
+from .attitude import CLASSES
+from .initial import _UNITS, ROW_SLICES
+from .perturbations import describe as _describe_perturbations
 from .results import units as field_units
 
 INSTALL_HINT = 'to_xarray needs xarray: pip install "ti-spinorbit[xarray]"'
@@ -54,7 +57,7 @@ INSTALL_HINT = 'to_xarray needs xarray: pip install "ti-spinorbit[xarray]"'
 
 def _xarray():
     try:
-        import xarray
+        import xarray           # optional dependency: imported on first use only
     except ImportError as exc:
         raise ImportError(INSTALL_HINT) from exc
     return xarray
@@ -76,8 +79,7 @@ def _attrs(result, kind, metadata):
         elif isinstance(value, (int, float, str)):
             attrs[name] = value
     if isinstance(getattr(result, "perturbations", None), tuple):
-        from .perturbations import describe
-        attrs["perturbations"] = json.dumps(describe(result.perturbations))
+        attrs["perturbations"] = json.dumps(_describe_perturbations(result.perturbations))
     systems = getattr(result, "systems", None)
     if systems is None and getattr(result, "system", None) is not None:
         systems = [result.system]
@@ -103,8 +105,6 @@ def _element_labels():
     """The 30 columns of a state row (``ti_spinorbit.initial.ROW_SLICES``) as labels: ``R_x``,
     ``V_z``, ``primary_attitude_01`` (row 0, column 1), ``secondary_omega_y``, ...; and the
     unit of each column."""
-    from .initial import _UNITS, ROW_SLICES
-
     labels, col_units = [], []
     for name, sl in ROW_SLICES.items():
         size = sl.stop - sl.start
@@ -129,8 +129,6 @@ def _states(data, coords, r, dims):
 
 def _attitude(data, r, dims):
     """Pole tilt, non-principal-axis angle and attitude class (code and name) where present."""
-    from .attitude import CLASSES
-
     for k in ("max_tilt", "max_npa_angle", "stop_status"):
         if getattr(r, k, None) is not None:
             data[k] = (dims, getattr(r, k))
