@@ -8,7 +8,7 @@ metadata and puts it in the figure's title (experiments/README.md has the table)
 
 Every study script calls :func:`parse` (``--quick`` for CI, ``--out`` folder, ``--arch``),
 computes, then :func:`save` writes ``<out>/<name>.npz`` (arrays + JSON parameters via
-ti_spinorbit.io conventions) and ``<out>/<name>.png``, and prints the numbers it stands for.
+ti_spinorbit.output.io conventions) and ``<out>/<name>.png``, and prints the numbers it stands for.
 """
 
 import argparse
@@ -63,8 +63,8 @@ def save(args, name, fig, arrays, parameters, numbers, started):
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit.io import write_archive
-    from ti_spinorbit.plotting import raw_markup
+    from ti_spinorbit.output.io import write_archive
+    from ti_spinorbit.output.plotting import raw_markup
 
     png = os.path.join(args.out, f"{name}.png")
     npz = os.path.join(args.out, f"{name}.npz")

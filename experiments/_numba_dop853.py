@@ -6,7 +6,7 @@ Written independently of the Taichi kernels: the right-hand side below is derive
 the planar equations of docs/physics.md §3.2–3.5 and the docstring of ``kernels/planar_eom.py``
 (state y = [r, v_r, ℓ, λ, cos ψ_A, sin ψ_A, w1, cos ψ_B, sin ψ_B, w2], scaled units, G = 1),
 and only the member's parameter row (the Fourier coefficients of each body's Legendre terms,
-``ti_spinorbit.planar.parameter_rows``) is shared. ``tests/test_experiments.py`` checks this RHS
+``ti_spinorbit.model.planar.parameter_rows``) is shared. ``tests/test_experiments.py`` checks this RHS
 against the package's to round-off, and the benchmark checks whole trajectories against the
 kernels at tight tolerance.
 

@@ -10,8 +10,8 @@ def section_panel(ax, system, starts, orbits, rtol=1e-12, what=None, coordinates
     rtol, then ``what``); returns (result, classification). ``coordinates`` defaults to the
     paper's apsidal ones (docs/physics.md §6.7): the starts θ̇_p/n are the paper's numbers."""
     import ti_spinorbit as tso
-    from ti_spinorbit.classify import classify_section
-    from ti_spinorbit.plotting import run_title
+    from ti_spinorbit.studies.classify import classify_section
+    from ti_spinorbit.output.plotting import run_title
 
     result = tso.surface_of_section(system, 0.0, np.array(starts, dtype=float), orbits=orbits,
                                     rtol=rtol, coordinates=coordinates)

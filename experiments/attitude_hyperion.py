@@ -37,6 +37,7 @@ centre it stays below 1.1e-4° over 1500 orbits. ``--control X`` runs the check 
 figure) with a Hyperion control spin of X n.
 """
 
+import ti_spinorbit
 import numpy as np
 
 import _common
@@ -81,14 +82,14 @@ def check_controls(controls, tilt0):
     CHECK_ORBITS["3d"] orbits of the 3-D model. Returns the printed numbers; SystemExit
     naming the control and the failure otherwise."""
     import ti_spinorbit as tso
-    from ti_spinorbit.classify import classify_section
+    from ti_spinorbit.studies.classify import classify_section
 
     numbers, failures = {}, []
     for label, system, spin in controls:
         key = label.lower().replace(", ", "_").replace(" ", "_").replace(".", "")
         orbits = CHECK_ORBITS["planar"]
         sec = tso.surface_of_section(system, 0.0, [spin], orbits=orbits, rtol=1e-12,
-                                     indicators=True, progress=False)
+                                     indicators=True, run=ti_spinorbit.Run(progress=False))
         cls = classify_section(sec, min_points=64)
         planar, megno = str(cls.classification[0]), float(sec.megno[0])
         numbers[f"control {key} planar class ({orbits} orbits)"] = planar
@@ -100,7 +101,9 @@ def check_controls(controls, tilt0):
         states = [system.tilted_start(0.0, spin, roll=tilt0),
                   system.tilted_start(0.0, spin, pitch=tilt0)]
         ts = tso.time_series(system, orbits=orbits, samples_per_orbit=16, rtol=1e-12,
-                             model="3d", initial_states=states, states=True, progress=False)
+                             initial_states=states, states=True,
+                             integrator=ti_spinorbit.Integrator(model="3d"),
+                             run=ti_spinorbit.Run(progress=False))
         tilt = float(np.nanmax(ts.pole_tilt))
         numbers[f"control {key} max tilt over {orbits} orbits (deg)"] = tilt
         if not np.all(ts.status == tso.Status.DONE):
@@ -149,7 +152,9 @@ def main():
     for (label, system, spin), colour in zip(cases, ("C3", "C1", "C0", "C2")):
         states = [system.tilted_start(0.0, spin, roll=tilt0), system.tilted_start(0.0, spin, pitch=tilt0)]
         ts = tso.time_series(system, orbits=orbits, samples_per_orbit=16, rtol=1e-12,
-                             model="3d", initial_states=states, states=True, progress=False)
+                             initial_states=states, states=True,
+                             integrator=ti_spinorbit.Integrator(model="3d"),
+                             run=ti_spinorbit.Run(progress=False))
         if not np.all(ts.status == tso.Status.DONE):
             raise SystemExit(f"{label}: a run stopped early or failed its accuracy check "
                              f"({ts.status_names})")

@@ -35,8 +35,8 @@ def perturbations():
 def members(n):
     import ti_spinorbit as tso
     from bench_throughput import starts
-    from ti_spinorbit.perturbations import perturbation_rows
-    from ti_spinorbit.members import Members
+    from ti_spinorbit.model.perturbations import perturbation_rows
+    from ti_spinorbit.engine.members import Members
 
     system = tso.catalog.system("1991 VH", elongation=1.5)
     tp, td = starts(n)
@@ -47,7 +47,7 @@ def members(n):
 
 def timed_run(par, y0, rows, model, method, orbits):
     """(member-orbits per second, accepted steps per orbit, wall s incl. compile)."""
-    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.engine.ensemble import Ensemble
 
     wall = time.perf_counter()
     ens = Ensemble(par, y0, rtol=RTOL, model=model, method=method, perturbation_rows=rows)

@@ -268,7 +268,7 @@ def benchmark_system():
 
 def member_table(n):
     """Member parameter rows and initial 3-D states (scaled) of the first n members."""
-    from ti_spinorbit.members import Members
+    from ti_spinorbit.engine.members import Members
 
     theta_p, thetadot_p = starts(n)
     start = Members.from_starts(benchmark_system(), theta_p, thetadot_p, ESCAPE_DISTANCE)
@@ -327,7 +327,7 @@ class AdvanceTimer:
 def make_ensemble(par, y0, model, rtol, method=DEFAULT_METHOD):
     """``Ensemble`` of the members with ``model`` and ``method``; ``method=`` is passed only
     when it is not the default, so the script runs on a package without the keyword."""
-    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.engine.ensemble import Ensemble
 
     extra = {} if method == DEFAULT_METHOD else {"method": method}
     return Ensemble(par, y0, rtol=rtol, model=model, **extra)
@@ -336,7 +336,7 @@ def make_ensemble(par, y0, model, rtol, method=DEFAULT_METHOD):
 def method_unavailable(method):
     """None if ``Ensemble`` runs ``method``, else a one-line reason (the keyword or the
     value not accepted yet): such a method is skipped, not an error."""
-    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.engine.ensemble import Ensemble
 
     if method == DEFAULT_METHOD:
         return None
@@ -490,7 +490,7 @@ def bench_rhs(points, model_name, n, seconds, repeat):
     """ns per RHS evaluation of one model on the first n benchmark states."""
     import taichi as ti
 
-    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.engine.ensemble import Ensemble
 
     ens = Ensemble(*points.table(n), model=model_name)    # kernel-layout parameters, states
     kernel = rhs_loop_kernel(ens.kernels.model)
@@ -652,8 +652,8 @@ def bench_window(points, n):
 def bench_baseline(members, orbits, rtols):
     """scipy DOP853 on the NumPy reference, and the same members through the kernels."""
     import ti_spinorbit as tso
-    from ti_spinorbit import reference
-    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.model import reference
+    from ti_spinorbit.engine.ensemble import Ensemble
 
     system = benchmark_system()
     unit = system.to_physical(np.ones(30))  # SI size of one scaled unit, per component
@@ -739,7 +739,7 @@ def bench_numba(points, rtols, members, seconds, repeat, check_orbits, curve=())
     """numba DOP853, planar, one member at a time on one core; orbits per CPU-second at
     ``rtols`` and, marked ``curve``, at the extra tolerances ``curve`` (the rate-against-
     error curve of the equal-accuracy comparison)."""
-    from ti_spinorbit import planar
+    from ti_spinorbit.model import planar
 
     nb = numba_baseline()
     if nb is None:
@@ -788,7 +788,7 @@ def bench_accuracy(models, methods, rtols, members, orbits, numba_rtols=()):
     tight reference: numba DOP853 at ACCURACY_REFERENCE_RTOL (else the kernels' Cash-Karp at
     that rtol). Error of a member: max over the 30 scaled 3-D state components (the planar
     states are compared after ``to_spatial``, so both models meet the same reference)."""
-    from ti_spinorbit import planar
+    from ti_spinorbit.model import planar
 
     par, y0 = member_table(members)
     t_end = 2.0 * np.pi * orbits

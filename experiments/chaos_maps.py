@@ -1,6 +1,6 @@
 """Chaos maps: MEGNO over (θ_p, θ̇_p/n) for 1991 VH (a/b = 1.5), 2003 YT1 and 2004 DC.
 
-Each map is one ensemble launch with shadow trajectories (ti_spinorbit.chaosmap.chaos_map);
+Each map is one ensemble launch with shadow trajectories (ti_spinorbit.studies.chaosmap.chaos_map);
 section points of a subsample of members are overlaid. A fourth panel histograms ⟨Y⟩ over
 all maps: regular orbits pile up at ⟨Y⟩ ≈ 2 and chaotic ones spread far above it, which is
 why the chaotic threshold sits at 4. Full run: 64 × 64 starts × 500 orbits for 1991 VH (the
@@ -32,8 +32,8 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit.chaosmap import chaos_map
-    from ti_spinorbit.plotting import MEGNO_COLOR_RANGE
+    from ti_spinorbit.studies.chaosmap import chaos_map
+    from ti_spinorbit.output.plotting import MEGNO_COLOR_RANGE
 
     maps = [m for m in MAPS if args.systems is None or m[0] in args.systems]
     if not maps:

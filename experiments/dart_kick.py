@@ -48,6 +48,7 @@ the secondary in the orbit frame (its libration amplitude; docs/physics.md §6.9
 attitude class (planar/3-D libration, circulation, tumbling).
 """
 
+import ti_spinorbit
 import numpy as np
 
 import _common
@@ -136,7 +137,7 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import attitude
+    from ti_spinorbit.model import attitude
 
     orbits = args.orbits or (8.0 if args.quick else 100.0)
     shapes = [(q, r) for q in ELONGATIONS for r in FLATTENINGS]
@@ -160,8 +161,10 @@ def main():
                 systems.append(system)
                 states.append(state.kicked(kick))
     # every member its own shape: one launch of the 3-D model
-    ts = tso.time_series(systems, orbits=orbits, samples_per_orbit=32, rtol=1e-11, model="3d",
-                         initial_states=states, states=True, progress=False)
+    ts = tso.time_series(systems, orbits=orbits, samples_per_orbit=32, rtol=1e-11,
+                         initial_states=states, states=True,
+                         integrator=ti_spinorbit.Integrator(model="3d"),
+                         run=ti_spinorbit.Run(progress=False))
     ok = ts.status == tso.Status.DONE
     if not np.all(ok):
         print(f"[dart_kick] {np.count_nonzero(~ok)} members stopped early or failed the "

@@ -2,10 +2,10 @@
 ``dask.distributed.LocalCluster`` of 1, 2, ... worker processes, and the cost of one chunk.
 
 Each worker is a process with one Dask thread and one Taichi CPU thread
-(``cpu_max_num_threads=1``, passed through ``chaos_map`` to ``run_sections``), so k workers use
+(``tso.Run(worker_threads=1)``, passed through ``chaos_map`` to every chunk), so k workers use
 k cores; the worker counts are 1, 2, 4, ... up to the usable cores. The cluster starts with
 the largest count, every worker loads its kernels (a warm-up map in one-member chunks), and
-the cluster is then scaled down count by count. Timed: ``tso.chaos_map(..., client=client)``
+the cluster is then scaled down count by count. Timed: ``tso.chaos_map(..., run=tso.Run(client=client))``
 (grid, orbits, ``fraction_orbits=()``: one pass), rtol 1e-10, the default chunking (3 chunks
 per worker); the maps must be identical at every worker count;
 member-orbits per second (wall), per worker CPU-second (summed process CPU time of the
@@ -15,7 +15,7 @@ same map in this process without Dask (Taichi on every core).
 
 Per-chunk overhead, on one worker: (a) the same smaller map at several ``chunk_size``
 (time per chunk against members per chunk; the intercept of time = a + b·members over the
-chunks is the fixed cost of a chunk), and (b) ``run_sections`` with one-member, 0.01-orbit
+chunks is the fixed cost of a chunk), and (b) ``surface_of_section`` with one-member, 0.01-orbit
 chunks, one after the other (scheduling, pickling, result concatenation, launch set-up).
 
     python experiments/dask_scaling.py             # 48 x 48 x 50 orbits; ~2 min on 2 cores
@@ -62,31 +62,39 @@ def chaos(system, grid, orbits, client=None, chunk_size=None):
 
     theta_p = np.linspace(0.0, 180.0, grid, endpoint=False)
     thetadot_p = np.linspace(0.5, 2.5, grid)
-    extra = {} if client is None else dict(client=client, chunk_size=chunk_size, arch="cpu",
-                                           cpu_max_num_threads=1)
+    run = None if client is None else tso.Run(client=client, chunk_size=chunk_size,
+                                              worker_arch="cpu", worker_threads=1)
     cpu = cpu_seconds(client)
     t0 = time.perf_counter()
     cmap = tso.chaos_map(system, theta_p, thetadot_p, orbits, rtol=RTOL, fraction_orbits=(),
-                         **extra)
+                         run=run)
     wall = time.perf_counter() - t0
     return wall, cmap, cpu_seconds(client) - cpu
 
 
+def _one_member_chunks(client):
+    """Run options of the overhead measurements: one member per chunk, one CPU thread each."""
+    import ti_spinorbit as tso
+
+    return tso.Run(client=client, chunk_size=1, worker_arch="cpu", worker_threads=1,
+                   progress=False)
+
+
 def warm_up(client, system, workers):
     """Every worker loads its kernels: one-member chunks, several per worker, map and section."""
-    from ti_spinorbit.distributed import run_sections
+    import ti_spinorbit as tso
 
-    run_sections(client, system, 0.0, np.linspace(0.5, 2.5, 4 * workers), 0.05, chunk_size=1,
-                 indicators=True, rtol=RTOL, arch="cpu", cpu_max_num_threads=1)
+    tso.surface_of_section(system, 0.0, np.linspace(0.5, 2.5, 4 * workers), 0.05,
+                           indicators=True, rtol=RTOL, run=_one_member_chunks(client))
 
 
 def tiny_chunks(client, system, count):
     """Seconds per one-member, 0.01-orbit chunk, ``count`` chunks on the cluster."""
-    from ti_spinorbit.distributed import run_sections
+    import ti_spinorbit as tso
 
     t0 = time.perf_counter()
-    run_sections(client, system, 0.0, np.full(count, 1.3), 0.01, chunk_size=1, indicators=True,
-                 rtol=RTOL, arch="cpu", cpu_max_num_threads=1)
+    tso.surface_of_section(system, 0.0, np.full(count, 1.3), 0.01, indicators=True, rtol=RTOL,
+                           run=_one_member_chunks(client))
     return (time.perf_counter() - t0) / count
 
 

@@ -1,4 +1,4 @@
-"""Calibration of the default accuracy limit (ti_spinorbit.accuracy).
+"""Calibration of the default accuracy limit (ti_spinorbit.engine.accuracy).
 
 Integrates 48 starts spread over the (θ_p, θ̇_p/n) plane of a catalogued system at
 tolerances 1e-2 ... 1e-14, in the planar and the 3-D model, and prints the largest relative
@@ -13,6 +13,7 @@ and 2004 DC); the default limit, 1000 × rtol × orbits capped at 1e-4, sits far
 Writes <out>/drift_calibration.png (ratio vs rtol, with the limit's factor) and .npz.
 """
 
+import ti_spinorbit
 import time
 
 import numpy as np
@@ -29,7 +30,7 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import accuracy
+    from ti_spinorbit.engine import accuracy
 
     orbits = min(args.orbits, 10.0) if args.quick else args.orbits
     models = ("planar",) if args.quick else ("planar", "3d")
@@ -49,7 +50,8 @@ def main():
     for i, model in enumerate(models):
         for j, rtol in enumerate(tolerances):
             t0 = time.perf_counter()
-            s = tso.surface_of_section(system, tp, td, orbits=orbits, rtol=rtol, model=model)
+            s = tso.surface_of_section(system, tp, td, orbits=orbits, rtol=rtol,
+                                       integrator=ti_spinorbit.Integrator(model=model))
             ok = np.isin(s.status_names, ("done", "inaccurate"))
             finished[i, j], flagged[i, j], limit[i, j] = ok.sum(), s.n_inaccurate, s.max_drift
             if ok.any():

@@ -5,13 +5,14 @@ entry point (kernels compiled, allocator warm), resets the peak RSS to the curre
 ``/proc/self/clear_refs``; compiling can leave a high-water mark above what the case needs),
 reads the RSS, runs the case and reads the peak RSS (``VmHWM``; ``ru_maxrss`` where there is
 no /proc: on Linux ru_maxrss inherits the parent's peak, see :func:`peak_rss`). The growth is compared with the estimate the entry point itself computed
-before any work (``ti_spinorbit.resources.check_memory``, captured here). The estimate must be
+before any work (``ti_spinorbit.engine.resources.check_memory``, captured here). The estimate must be
 within a factor 1.5 of the growth; the ratio column shows it.
 
     python experiments/memory_estimate.py            # full sizes (a few GiB at most, ~2 min)
     python experiments/memory_estimate.py --quick    # small sizes (CI)
 """
 
+import ti_spinorbit
 import json
 import os
 import subprocess
@@ -90,7 +91,8 @@ def run_case(entry, kw):
     """One case in this process; returns (estimate bytes, peak RSS growth bytes, warm-up
     seconds)."""
     import ti_spinorbit as tso
-    from ti_spinorbit import cli, resources
+    from ti_spinorbit import cli
+    from ti_spinorbit.engine import resources
 
     estimates = []
     check = resources.check_memory
@@ -108,11 +110,12 @@ def run_case(entry, kw):
         members = kw.get("members", 1) if scale == 1 else min(kw.get("members", 1), 4)
         if entry == "surface_of_section":
             tso.surface_of_section(vh, 0.0, np.linspace(0.9, 1.3, members), orbits,
-                                   model=kw.get("model", "auto"))
+                                   integrator=ti_spinorbit.Integrator(model=kw.get("model", "auto")))
         elif entry == "time_series":
             tso.time_series(vh, 0.0, np.linspace(0.9, 1.3, members), orbits,
-                            samples_per_orbit=kw["samples_per_orbit"], model=kw.get("model", "auto"),
-                            states=kw.get("states", False))
+                            samples_per_orbit=kw["samples_per_orbit"],
+                            states=kw.get("states", False),
+                            integrator=ti_spinorbit.Integrator(model=kw.get("model", "auto")))
         elif entry == "energy":
             out = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"memory_estimate_{os.getpid()}")
             status = cli.main(["energy", "--quiet", "--orbits", f"{orbits:g}", "--samples-per-orbit",

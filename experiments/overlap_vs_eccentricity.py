@@ -2,7 +2,7 @@
 Chirikov estimate ω0^RO = 1/(2 + sqrt(14 e)) for the 1:1 and 3:2 resonances).
 
 1991 VH with its eccentricity replaced by each value of a grid; at each e the elongation a/b
-is scanned in steps of 0.01 (ti_spinorbit.overlap) with MEGNO evidence for every connecting
+is scanned in steps of 0.01 (ti_spinorbit.studies.overlap) with MEGNO evidence for every connecting
 trajectory. Higher e widens the 3:2 island (half-width ω0 sqrt(7e/2)), so overlap sets in at
 smaller elongation.
 
@@ -18,8 +18,8 @@ def main():
     args, started = parse(__doc__.splitlines()[0])
     import matplotlib.pyplot as plt
 
-    from ti_spinorbit import analytic
-    from ti_spinorbit.overlap import overlap_vs_eccentricity
+    from ti_spinorbit.model import analytic
+    from ti_spinorbit.studies.overlap import overlap_vs_eccentricity
 
     if args.quick:
         ecc, elong, kw = [0.05, 0.3], [1.01, 1.03, 1.06], dict(orbits=120, centre_starts=24,

@@ -1,6 +1,6 @@
 """Parameter map: chaotic fraction of 1991 VH over elongation a/b and eccentricity e.
 
-At every (a/b, e) the default starts of ti_spinorbit.chaosmap.parameter_map (θ_p ∈ {0°, 90°}
+At every (a/b, e) the default starts of ti_spinorbit.studies.chaosmap.parameter_map (θ_p ∈ {0°, 90°}
 × 12 rates θ̇_p/n from 0.6 to 2.0, the band of the 1:1 and 3:2 resonances) run with MEGNO, all
 grid points in one launch. Overlaid: the analytic overlap line a/b at ω0 = ω0^RO(e) =
 1/(2 + sqrt(14e)) and contours of the chaotic-layer half-width ΔE/E0 (14π form;
@@ -25,8 +25,8 @@ def main():
     args, started = parse(__doc__.splitlines()[0])
     import matplotlib.pyplot as plt
 
-    from ti_spinorbit import analytic
-    from ti_spinorbit.chaosmap import (PARAMETER_MAP_THETA_P, PARAMETER_MAP_THETADOT_P,
+    from ti_spinorbit.model import analytic
+    from ti_spinorbit.studies.chaosmap import (PARAMETER_MAP_THETA_P, PARAMETER_MAP_THETADOT_P,
                                        parameter_map)
 
     if args.quick:

@@ -40,7 +40,7 @@ def grid(n_theta, n_thetadot):
 def shares(planar, full):
     """Planar-regular area and the shares of it that turn chaotic in full space, tilt past
     TILT_LIMIT, or either (members usable in both runs only)."""
-    from ti_spinorbit import accuracy
+    from ti_spinorbit.engine import accuracy
 
     ok = accuracy.usable(planar.status) & accuracy.usable(full.status)
     regular = ok & (planar.megno < MEGNO_CHAOTIC)

@@ -423,7 +423,7 @@ def member_inputs(n):
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import bench_throughput as bt
 
-    from ti_spinorbit import planar
+    from ti_spinorbit.model import planar
 
     par, y0 = bt.member_table(n)
     return planar.parameter_rows(par), planar.to_planar(y0)

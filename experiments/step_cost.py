@@ -1,5 +1,5 @@
 """Calibration of the step estimate behind the step budget and the long-run warning
-(ti_spinorbit.cost).
+(ti_spinorbit.engine.cost).
 
 Integrates two starts (θ̇_p/n = 0.5 and 1.2) of every catalogued system for a few orbits
 with each Runge-Kutta pair at three tolerances, and prints the measured steps per orbit
@@ -24,8 +24,8 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import cost
-    from ti_spinorbit.members import Members
+    from ti_spinorbit.engine import cost
+    from ti_spinorbit.engine.members import Members
 
     names = ["1991 VH", "2004 DC", "test"] if args.quick else tso.catalog.names()
     tolerances = (1e-8, 1e-12) if args.quick else (1e-8, 1e-12, 1e-15)

@@ -43,8 +43,8 @@ def main():
     from matplotlib.ticker import NullFormatter, ScalarFormatter
 
     import ti_spinorbit as tso
-    from ti_spinorbit import analytic
-    from ti_spinorbit.libration import relaxed_libration
+    from ti_spinorbit.model import analytic
+    from ti_spinorbit.studies.libration import relaxed_libration
 
     rho_s = tso.catalog.entry(SYSTEM)["rho_s"]
     factors = DENSITY_FACTORS_QUICK if args.quick else DENSITY_FACTORS

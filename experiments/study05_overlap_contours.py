@@ -28,7 +28,7 @@ def main():
     from matplotlib.colors import LogNorm
 
     import ti_spinorbit as tso
-    from ti_spinorbit import analytic
+    from ti_spinorbit.model import analytic
 
     n_q, n_e = (201, 161) if args.quick else (801, 641)
     # (a) the paper's linear a/b axis; (b) a/b − 1 on a log axis, where the layer's

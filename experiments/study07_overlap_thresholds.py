@@ -3,7 +3,7 @@ overlap, numerically and from the decoupled theory ω0^RO = 1/(2 + sqrt(14 e)).
 
 For each system (1991 VH, 2003 YT1, 2004 DC) the elongation a/b is scanned in steps of
 0.01; at each value an ensemble of trajectories decides whether a single chaotic orbit
-connects the synchronous and 3:2 zones (ti_spinorbit.overlap). A decision at a fixed orbit
+connects the synchronous and 3:2 zones (ti_spinorbit.studies.overlap). A decision at a fixed orbit
 count is only an upper bound on the threshold, so the scan doubles the integration length
 (300, 600, 1200, 2400 orbits in full mode; 50, 100 in quick mode) until two successive
 lengths agree at every elongation and no elongation is still "separate" where the MEGNO
@@ -39,7 +39,7 @@ def main():
     args, started = parse(__doc__.splitlines()[0], flags)
     import matplotlib.pyplot as plt
 
-    from ti_spinorbit.overlap import overlap_threshold
+    from ti_spinorbit.studies.overlap import overlap_threshold
 
     orbits = args.orbits or (50 if args.quick else 300)
     max_orbits = args.max_orbits or (2 * orbits if args.quick else 8 * orbits)

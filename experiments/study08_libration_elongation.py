@@ -74,7 +74,7 @@ def minimum_amplitude(system, guess, orbits):
 
     Returns (centre, amplitude, resolved): NaN, NaN, False when no candidate librates;
     ``resolved`` is False when the last window's minimum sat on its edge."""
-    from ti_spinorbit.libration import libration_amplitude
+    from ti_spinorbit.studies.libration import libration_amplitude
 
     center, half_width, count = guess, MINIMUM_HALF_WIDTH, MINIMUM_CANDIDATES
     for _ in range(ZOOMS):
@@ -95,8 +95,8 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import analytic
-    from ti_spinorbit.libration import MAX_CENTER_EXTENT_DEG, relaxed_libration
+    from ti_spinorbit.model import analytic
+    from ti_spinorbit.studies.libration import MAX_CENTER_EXTENT_DEG, relaxed_libration
 
     names = list(QUICK_SYSTEMS) if args.quick else synchronous_systems()
     elongations = QUICK_ELONGATIONS if args.quick else ELONGATIONS

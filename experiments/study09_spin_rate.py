@@ -34,8 +34,8 @@ def apsidal_rate_at_start(system):
     """ϖ̇(0)/n of the §6.4 start (θ_p = 0; the force does not depend on the spins), from the
     full fourth-order force (docs/physics.md §6.7)."""
     import ti_spinorbit as tso
-    from ti_spinorbit.coordinates import apsidal_rate
-    from ti_spinorbit.systems import G
+    from ti_spinorbit.model.coordinates import apsidal_rate
+    from ti_spinorbit.system.systems import G
 
     a, e, n = system.a, system.e, system.mean_motion
     R = np.array([a * (1.0 - e), 0.0, 0.0])
@@ -55,8 +55,8 @@ def main():
     orbits = 20 if args.quick else 300
     ts = tso.time_series(vh, 0.0, STARTS, orbits=orbits, samples_per_orbit=32, rtol=1e-12,
                          coordinates=COORDINATES)
-    from ti_spinorbit.classify import classify_section
-    from ti_spinorbit.plotting import CLASS_COLORS, run_title
+    from ti_spinorbit.studies.classify import classify_section
+    from ti_spinorbit.output.plotting import CLASS_COLORS, run_title
 
     section = tso.surface_of_section(vh, 0.0, STARTS, orbits=orbits, rtol=1e-12,
                                      coordinates=COORDINATES, indicators=True)

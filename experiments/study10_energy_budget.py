@@ -36,7 +36,7 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import analytic
+    from ti_spinorbit.model import analytic
 
     orbits = 120 if args.quick else 1000     # 1991 VH needs ~60 orbits to diverge
     names = list(CHAOTIC_STARTS)

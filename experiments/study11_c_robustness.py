@@ -37,7 +37,7 @@ def secondary_with_c(a, b, c, mass, name):
     """Uniform ellipsoid of semi-axes a, b, c (m) along x, y, z and mass (kg), any order of
     b and c: the second- and fourth-order inertia integrals T^lmn = 3 m a^l b^m c^n
     (l−1)!!(m−1)!!(n−1)!!/(l+m+n+3)!! (docs/physics.md §2.2), as ``Ellipsoid`` builds them."""
-    from ti_spinorbit.bodies import Body
+    from ti_spinorbit.system.bodies import Body
 
     integrals = {}
     for order in (2, 4):
@@ -53,8 +53,8 @@ def secondary_with_c(a, b, c, mass, name):
 def system_with_c(factor):
     """1991 VH at a/b = 1.5 with the secondary's c scaled by ``factor`` (density fixed)."""
     import ti_spinorbit as tso
-    from ti_spinorbit.bodies import Sphere
-    from ti_spinorbit.systems import BinarySystem
+    from ti_spinorbit.system.bodies import Sphere
+    from ti_spinorbit.system.systems import BinarySystem
 
     d = tso.catalog.entry(SYSTEM)
     a_s, b_s = math.sqrt(d["ab"] * ELONGATION), math.sqrt(d["ab"] / ELONGATION)
@@ -70,8 +70,8 @@ def main():
     import matplotlib.pyplot as plt
 
     import ti_spinorbit as tso
-    from ti_spinorbit import analytic
-    from ti_spinorbit.libration import relaxed_libration
+    from ti_spinorbit.model import analytic
+    from ti_spinorbit.studies.libration import relaxed_libration
 
     starts = tso.catalog.section_starts(SYSTEM)
     orbits = 150 if args.quick else 600

@@ -37,9 +37,9 @@ def main():
     import ti_spinorbit as tso
     from matplotlib.colors import ListedColormap
 
-    from ti_spinorbit import analytic
-    from ti_spinorbit.classify import classify_section
-    from ti_spinorbit.libration import relaxed_libration
+    from ti_spinorbit.model import analytic
+    from ti_spinorbit.studies.classify import classify_section
+    from ti_spinorbit.studies.libration import relaxed_libration
 
     numbers = {}
     arrays = {}

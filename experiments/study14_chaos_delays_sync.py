@@ -128,7 +128,7 @@ def decoupled_despin(round_system, nominal, tau_orbits, thetadot_p):
     reaches the synchronous island's separatrix 1 + ω0' sqrt|H(1, e)| (units of n) after
     ln((ω_i − N/Ω) / (1 + w − N/Ω)) / (γ' Ω) if N/Ω lies below it, else never. Returns
     (N/Ω, w, times in orbits per start, inf where never)."""
-    from ti_spinorbit import analytic
+    from ti_spinorbit.model import analytic
 
     big_omega, big_n = analytic.tidal_torque_factors(round_system.e)
     ps = big_n / big_omega
@@ -168,8 +168,8 @@ def run_ensemble(system, theta_p, thetadot_p, perturbations, orbits):
     history (one value per orbit) for the figure; plus the run's seconds and the result's
     perturbations (described for the archive)."""
     import ti_spinorbit as tso
-    from ti_spinorbit.accuracy import usable
-    from ti_spinorbit.perturbations import describe
+    from ti_spinorbit.engine.accuracy import usable
+    from ti_spinorbit.model.perturbations import describe
 
     window = max(20.0, WINDOW_FRACTION * orbits)
     spo, P = SAMPLES_PER_ORBIT, system.orbital_period
@@ -223,7 +223,7 @@ def chaotic_starts(system, band, members, rng, quick):
     """``members`` starts in the band that are chaotic at t = 0 (MEGNO > 4 without tides),
     drawn from candidates; also returns the candidates' chaotic share."""
     import ti_spinorbit as tso
-    from ti_spinorbit.accuracy import usable
+    from ti_spinorbit.engine.accuracy import usable
 
     n = 3 * members
     tp, td = rng.uniform(0.0, 180.0, n), rng.uniform(band[0], band[1], n)

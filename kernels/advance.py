@@ -18,7 +18,7 @@ end: the last step lands on it exactly). On the way it records
   land on it) for libration and spin-rate time series.
 
 Observables (θ_p, θ̇_p, α, osculating elements, energies) are derived from the recorded
-states afterwards (``ti_spinorbit.observables``), which keeps the kernel small.
+states afterwards (``ti_spinorbit.model.observables``), which keeps the kernel small.
 
 The member loop is a state machine with exactly one call site of the right-hand side: each
 pass of the while loop evaluates one stage of a trial step, or the derivative at an accepted
@@ -457,14 +457,18 @@ PLANAR = make_kernels(planar_eom)
 _KERNEL_SETS = {("3d", DEFAULT_METHOD): SPATIAL, ("planar", DEFAULT_METHOD): PLANAR}
 
 
-def kernels_for(model, method=DEFAULT_METHOD, perturbed=False):
+def kernels_for(model, method=DEFAULT_METHOD, perturbed=False, controller=None):
     """The kernel set of ``model`` ("planar" or "3d") integrating with ``method`` (a name of
-    ``tableau.METHODS``), with or without perturbations, built once per process (Taichi
-    compiles each on first launch)."""
-    key = (model, check_method(method)) + (("perturbed",) if perturbed else ())
+    ``tableau.METHODS``), with or without perturbations, under ``controller`` (None: the
+    default step-size policy), built once per process (Taichi compiles each on first
+    launch)."""
+    if controller == DEFAULT_CONTROLLER:
+        controller = None
+    key = (model, check_method(method)) + (("perturbed",) if perturbed else ()) + \
+        ((controller,) if controller is not None else ())
     if key not in _KERNEL_SETS:
         _KERNEL_SETS[key] = make_kernels(planar_eom if model == "planar" else eom, METHODS[method],
-                                         DEFAULT_CONTROLLER, perturbed=perturbed)
+                                         controller or DEFAULT_CONTROLLER, perturbed=perturbed)
     return _KERNEL_SETS[key]
 advance = SPATIAL.advance
 evaluate_rhs = SPATIAL.evaluate_rhs

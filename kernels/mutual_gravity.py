@@ -15,7 +15,7 @@ vectors into A; U = -G ∫∫ dm dm / |R + S x_B - x_A|; ``dUdR`` = ∂U/∂R (t
 -dUdR); mu2 = torque on B, mu1 = torque on A (δU = -mu·δθ for a rotation of one body).
 
 Body parameters are read from a row of a 2-D f64 field in the order of
-``ti_spinorbit.bodies.Body.as_row``: mass, (T200, T020, T002), 10 third-order and 15
+``ti_spinorbit.system.bodies.Body.as_row``: mass, (T200, T020, T002), 10 third-order and 15
 fourth-order integrals in ``EXPONENTS_3`` / ``EXPONENTS_4`` order.
 
 Static switches compile away what a model does not need: ``order`` in {0, 2, 3, 4} and

@@ -1,7 +1,7 @@
 """Dissipative and radiative perturbations in the equations of motion (Taichi funcs):
 constant-time-lag (or constant-Q) tides, YORP and BYORP (docs/physics.md §13).
 
-The host objects (``ti_spinorbit.perturbations``) turn SI parameters into a block of
+The host objects (``ti_spinorbit.model.perturbations``) turn SI parameters into a block of
 ``NPERT`` scaled numbers appended to each member's kernel parameter row (after the model's
 own ``NPAR`` columns). A kernel variant built with perturbations also carries ``NACC``
 accumulators after the model's state:

@@ -33,7 +33,7 @@ Potential (the 3-D model's 4th-order truncation restricted to the plane, docs/ph
 
 P_n = mB L_n^A and Q_n = ±mA L_n^B (− for odd n) are trigonometric polynomials of degree n;
 their Fourier coefficients are computed once per member on the host
-(``ti_spinorbit.planar.parameter_rows``) by contracting each body's moment tensors with the
+(``ti_spinorbit.model.planar.parameter_rows``) by contracting each body's moment tensors with the
 Legendre polynomial P_n, a different route from the 3-D kernel's monomial tables. The
 quadrupole-quadrupole term is
 
@@ -54,7 +54,7 @@ from ti_spinorbit.layout import planar as _L
 from . import perturb
 
 # The state offsets and the member parameter row (scaled units) are ti_spinorbit.layout's,
-# shared with the host (ti_spinorbit.planar fills the row).
+# shared with the host (ti_spinorbit.model.planar fills the row).
 NSTATE = _L.NSTATE
 Y_R, Y_VR, Y_L, Y_LAM, Y_CA, Y_SA = _L.Y_R, _L.Y_VR, _L.Y_L, _L.Y_LAM, _L.Y_CA, _L.Y_SA
 Y_W1, Y_CB, Y_SB, Y_W2 = _L.Y_W1, _L.Y_CB, _L.Y_SB, _L.Y_W2

@@ -2,6 +2,7 @@
 default), small systems used across the suite, and 1991 VH with one cheap result of every
 kind (module scope, like the per-file fixtures they replace)."""
 
+import dataclasses
 import os
 import subprocess
 import sys
@@ -11,6 +12,18 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
+
+
+#: The keywords an entry point takes inside its ``run=tso.Run(...)``.
+RUN_FIELDS = frozenset(f.name for f in dataclasses.fields(tso.Run))
+
+
+def run_options(**kw):
+    """Keywords of an entry point with the run options among them (progress, checkpoint,
+    resume, overwrite, window_orbits, ...) gathered into ``run=tso.Run(...)``: tests that
+    vary one run option per case write it as a keyword."""
+    run = {k: kw.pop(k) for k in list(kw) if k in RUN_FIELDS}
+    return {**kw, "run": tso.Run(**run)}
 
 
 def run_cli(*args, cwd, env=None, timeout=600):

@@ -1,6 +1,6 @@
 """Exact (or exact-to-roundoff) references for testing the mutual potential.
 
-Test-only code; scipy is allowed here. Conventions are those of ti_spinorbit.reference
+Test-only code; scipy is allowed here. Conventions are those of ti_spinorbit.model.reference
 (docs/physics.md §1.3–1.4): A frame, R from A's centre of mass to B's, C takes B-frame vectors
 to the A frame, force_on_b = −∂U/∂R, torques defined by δU = −μ·δθ for a rotation of one body.
 

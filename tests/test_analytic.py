@@ -1,4 +1,4 @@
-"""Analytic spin-orbit theory (ti_spinorbit.analytic) against hand values, tables and
+"""Analytic spin-orbit theory (ti_spinorbit.model.analytic) against hand values, tables and
 independent routes.
 
 * ψ_A and the mean-direction amplitude at hand values, and against an independent RK4
@@ -19,9 +19,9 @@ import math
 import numpy as np
 import pytest
 
-from ti_spinorbit import analytic as an
-from ti_spinorbit import catalog
-from ti_spinorbit.systems import G
+from ti_spinorbit.model import analytic as an
+from ti_spinorbit.system import catalog
+from ti_spinorbit.system.systems import G
 
 SERIES_P = (-0.5, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
 #: First power of e the tabulated series leave out, per p.

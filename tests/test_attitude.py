@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import attitude as att
-from ti_spinorbit import initial as I
-from ti_spinorbit.ensemble import Ensemble
-from ti_spinorbit.observables import derive
+from ti_spinorbit.model import attitude as att
+from ti_spinorbit.system import initial as I
+from ti_spinorbit.engine.ensemble import Ensemble
+from ti_spinorbit.model.observables import derive
 
 
 @pytest.fixture(scope="module")
@@ -117,10 +117,9 @@ def test_hyperion_like_synchronous_state_is_attitude_unstable(didymos):
         sys.path.pop(0)
     hyp = hyperion_system()
     centre = 0.544395            # its synchronous island centre (relaxed_libration, 50 orbits)
-    ts = tso.time_series([hyp, didymos], orbits=14, samples_per_orbit=16, rtol=1e-12,
-                         model="3d", states=True, progress=False,
-                         initial_states=[hyp.tilted_start(0.0, centre, roll=1e-4),
-                                         didymos.tilted_start(0.0, 1.0, roll=1e-4)])
+    ts = tso.time_series([hyp, didymos], orbits=14, samples_per_orbit=16, rtol=1e-12, states=True,
+                         initial_states=[hyp.tilted_start(0.0, centre, roll=1e-4),                                          didymos.tilted_start(0.0, 1.0, roll=1e-4)],
+                         integrator=tso.Integrator(model="3d"), run=tso.Run(progress=False))
     assert np.all(ts.status == tso.Status.DONE)
     tilt = ts.pole_tilt
     assert np.nanmax(tilt[0]) > 0.1 and np.nanmax(tilt[1]) < 1e-3       # grew 1000x / did not
@@ -139,7 +138,7 @@ def test_classify_crossings_rule():
 
 def test_chaos_maps_carry_attitude_classes(tmp_path):
     grid = dict(theta_p=[0.0, 90.0], thetadot_p=[0.43, 1.63], orbits=40, rtol=1e-10,
-                progress=False)
+                run=tso.Run(progress=False))
     flat = tso.chaos_map("1991 VH", **grid)
     tilted = tso.chaos_map("1991 VH", **grid, tilt=(5.0, 0.0))
     # planar: synchronous-island starts librate in the plane, the others circulate

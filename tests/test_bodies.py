@@ -15,9 +15,9 @@ import math
 import numpy as np
 import pytest
 
-from ti_spinorbit.bodies import Body, Ellipsoid, Sphere
+from ti_spinorbit.system.bodies import Body, Ellipsoid, Sphere
 from ti_spinorbit.layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
-from ti_spinorbit.systems import BinarySystem
+from ti_spinorbit.system.systems import BinarySystem
 
 AXES = (3.1, 1.7, 0.9)          # a > b > c, m: nothing degenerate
 DENSITY = 2100.0                # kg m^-3
@@ -249,7 +249,7 @@ def test_centrally_symmetric_cloud_has_no_third_order_integrals():
     pts = pts - pts.mean(0)
     sym_pts = np.concatenate([pts, -pts]) + np.array([1.0, 2.0, 3.0])
     body, _ = Body.from_point_masses(sym_pts, np.concatenate([masses, masses]))
-    from ti_spinorbit.bodies import EXPONENTS_3
+    from ti_spinorbit.system.bodies import EXPONENTS_3
     assert all(body.integral(*k) == 0.0 for k in EXPONENTS_3)
     assert any(body.integral(*k) != 0.0 for k in ((3, 1, 0), (1, 3, 0), (0, 1, 3)))
 

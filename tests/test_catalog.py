@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import catalog
+from ti_spinorbit.system import catalog
 
 TABLE = {  # name: (R_p, rho_p, c, ab, a/b, rho_s, a, e) from docs/physics.md §7
     "1991 VH": (600, 1581, 190, 57600, 1.50, 2618, 3300, 0.05),

@@ -1,4 +1,4 @@
-"""Chaos maps and parameter maps (ti_spinorbit.chaosmap): shapes, physics, robustness.
+"""Chaos maps and parameter maps (ti_spinorbit.studies.chaosmap): shapes, physics, robustness.
 
 Tiny grids and short runs keep the module well under a minute on two CPU cores."""
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit.chaosmap import ChaosMap, ParameterMap, chaos_map, parameter_map
+from ti_spinorbit.studies.chaosmap import ChaosMap, ParameterMap, chaos_map, parameter_map
 
 #: 4 θ_p × 6 θ̇_p/n starts of 1991 VH (a/b = 1.5): the 1:1 island (~0.45), the chaotic sea of
 #: the merged 1:1-3:2 zone (0.9-1.7), and circulating tori above the 2:1 island (2.55).

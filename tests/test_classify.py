@@ -10,8 +10,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import ti_spinorbit as tso
-from ti_spinorbit.analytic import omega0_effective
-from ti_spinorbit.classify import (COLORS, ORDER_RATIO_CHAOTIC, SectionClassification,
+from ti_spinorbit.model.analytic import omega0_effective
+from ti_spinorbit.studies.classify import (COLORS, ORDER_RATIO_CHAOTIC, SectionClassification,
                                    classify_points, classify_section, horizontal_extent,
                                    island_centres, libration_arc, order_ratio)
 

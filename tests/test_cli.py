@@ -16,7 +16,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import cli
-from ti_spinorbit.io import read_metadata
+from ti_spinorbit.output.io import read_metadata
 
 from conftest import run_cli
 
@@ -82,7 +82,7 @@ def test_overlap_scan_command(tmp_path):
                 "--orbits", "120", "--out", "ov.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "ov.png").read_bytes()[:8] == PNG
-    scan = tso.io.load(tmp_path / "ov.npz")
+    scan = tso.output.io.load(tmp_path / "ov.npz")
     assert scan.name == "2004 DC" and len(scan.decisions) == 2
     assert "first overlap" in p.stdout
 
@@ -93,7 +93,7 @@ def test_map_command(tmp_path):
     assert p.returncode == 0, p.stderr
     with np.load(tmp_path / "m.npz") as d:
         assert d["megno"].shape == (3, 4) and np.all(np.isfinite(d["megno"]))
-    cmap = tso.io.load(tmp_path / "m.npz")
+    cmap = tso.output.io.load(tmp_path / "m.npz")
     assert 0.0 <= cmap.chaotic_fraction <= 1.0
 
 
@@ -102,7 +102,7 @@ def test_libration_command(tmp_path):
                 "--out", "lib.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "lib.png").read_bytes()[:8] == PNG
-    result = tso.io.load(tmp_path / "lib.npz")
+    result = tso.output.io.load(tmp_path / "lib.npz")
     assert 0.0 < result.amplitude < 90.0 and result.converged
     # the printed numbers are the saved ones
     assert f"amplitude {result.amplitude:.4f} deg" in p.stdout
@@ -342,7 +342,7 @@ def test_no_progress_hides_the_bar_but_not_the_summary(tmp_path, monkeypatch, ca
     assert cli.main(SMALL_SECTION + ["--out", "s.png", "--no-progress"]) == 0
     captured = capsys.readouterr()
     assert "%" not in captured.err and "wrote s.png and s.npz" in captured.out
-    monkeypatch.setattr("ti_spinorbit.progress.DELAY_S", 0.0)    # as if the run were long
+    monkeypatch.setattr("ti_spinorbit.engine.progress.DELAY_S", 0.0)    # as if the run were long
     assert cli.main(SMALL_SECTION + ["--out", "t.png"]) == 0
     assert capsys.readouterr().err.strip().splitlines()[-1].startswith("section: 100%")
 

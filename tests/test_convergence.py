@@ -10,10 +10,11 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import io, libration
-from ti_spinorbit.chaosmap import chaos_map, fraction_evidence
-from ti_spinorbit.libration import relaxed_libration
-from ti_spinorbit.overlap import OverlapScan, _lengths, megno_connects, overlap_threshold
+from ti_spinorbit.output import io
+from ti_spinorbit.studies import libration
+from ti_spinorbit.studies.chaosmap import chaos_map, fraction_evidence
+from ti_spinorbit.studies.libration import relaxed_libration
+from ti_spinorbit.studies.overlap import OverlapScan, _lengths, megno_connects, overlap_threshold
 
 from conftest import run_cli
 

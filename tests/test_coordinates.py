@@ -1,4 +1,4 @@
-"""Section coordinates, inertial and apsidal (docs/physics.md §6.7; ti_spinorbit.coordinates).
+"""Section coordinates, inertial and apsidal (docs/physics.md §6.7; ti_spinorbit.model.coordinates).
 
 Every check has an independent route: the Kepler identities, Gauss's planetary equation for
 the argument of pericentre, the NumPy reference potential, finite differences of the apsidal
@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import coordinates as C
-from ti_spinorbit import reference
-from ti_spinorbit.classify import classify_section
-from ti_spinorbit.members import Members
+from ti_spinorbit.model import coordinates as C
+from ti_spinorbit.model import reference
+from ti_spinorbit.studies.classify import classify_section
+from ti_spinorbit.engine.members import Members
+from ti_spinorbit.engine.evaluation import apsidal_rates
 
 from conftest import run_cli
 
@@ -52,7 +53,7 @@ def test_rv_vanishes_exactly_at_osculating_pericentre(e):
 def test_recorded_pericentre_passages_are_osculating_f_zero(model):
     """The integrator's events (R·V = 0 rising, located by Newton on Cash-Karp sub-steps)
     are at osculating true anomaly 0 to the integration accuracy, in the coupled problem."""
-    from ti_spinorbit.ensemble import Ensemble
+    from ti_spinorbit.engine.ensemble import Ensemble
     from ti_spinorbit.kernels import eom
 
     vh = tso.catalog.system("1991 VH")
@@ -114,7 +115,7 @@ def test_initial_apsidal_rate_against_reference_potential(name, elongation, thet
     system = tso.catalog.system(name, elongation=elongation)
     table = Members.from_starts(system, theta_p, 1.3)
     par, y0 = table.par, table.y0
-    rate = C.states_rate(par, y0)[0] * system.mean_motion           # rad/s
+    rate = apsidal_rates(par, y0)[0] * system.mean_motion           # rad/s
     R, P, _, _, S, _ = reference.unpack_state(system.to_physical(y0[0]))
     _, force, _, _ = reference.mutual_potential(
         tso.G, system.primary.mass, reference.body_tensors(system.primary),
@@ -132,15 +133,15 @@ def test_initial_rate_does_not_depend_on_spin_and_converts_the_start():
     the integrated inertial spin is θ̇_p + ϖ̇(0) (about +0.0157 n for 1991 VH at a/b = 1.01,
     the difference the paper's coordinates make)."""
     from ti_spinorbit.kernels import eom
-    from ti_spinorbit.observables import derive
+    from ti_spinorbit.model.observables import derive
 
     vh = tso.catalog.system("1991 VH", elongation=1.01)
     table = Members.from_starts(vh, 0.0, 0.5)
     par, y_slow = table.par, table.y0
     table = Members.from_starts(vh, 0.0, 2.5)
     y_fast = table.y0
-    assert C.states_rate(par, y_slow)[0] == C.states_rate(par, y_fast)[0]
-    rate = C.states_rate(par, y_slow)[0]
+    assert apsidal_rates(par, y_slow)[0] == apsidal_rates(par, y_fast)[0]
+    rate = apsidal_rates(par, y_slow)[0]
     assert rate == pytest.approx(0.0157, abs=5e-4)
     table = Members.from_starts(vh, 0.0, 1.08, coordinates="apsidal")
     par, y_aps, td = table.par, table.y0, table.thetadot_p
@@ -156,7 +157,7 @@ def test_section_in_both_coordinates_records_the_same_events():
     vh = tso.catalog.system("1991 VH", elongation=1.06)
     table = Members.from_starts(vh, 0.0, 1.0)
     par, y0 = table.par, table.y0
-    rate0 = C.states_rate(par, y0)[0]
+    rate0 = apsidal_rates(par, y0)[0]
     starts = np.array([1.13, 1.70])
     aps = tso.surface_of_section(vh, 0.0, starts, orbits=20, rtol=1e-12, coordinates="apsidal")
     ine = tso.surface_of_section(vh, 0.0, starts + rate0, orbits=20, rtol=1e-12)
@@ -190,8 +191,10 @@ def test_models_agree_on_the_apsidal_rate():
     """The planar and the 3-D equations give the same apsidal section (to the tolerance)."""
     vh = tso.catalog.system("1991 VH")
     kw = dict(orbits=3, rtol=1e-12, coordinates="apsidal")
-    planar = tso.surface_of_section(vh, 0.0, [0.45, 1.7], model="planar", **kw)
-    spatial = tso.surface_of_section(vh, 0.0, [0.45, 1.7], model="3d", **kw)
+    planar = tso.surface_of_section(vh, 0.0, [0.45, 1.7], **kw,
+                                    integrator=tso.Integrator(model="planar"))
+    spatial = tso.surface_of_section(vh, 0.0, [0.45, 1.7], **kw,
+                                     integrator=tso.Integrator(model="3d"))
     np.testing.assert_allclose(planar.apsidal_rate, spatial.apsidal_rate, atol=1e-8)
     np.testing.assert_allclose(planar.thetadot_p, spatial.thetadot_p, atol=1e-8)
 
@@ -206,7 +209,7 @@ def test_apsidal_start_below_the_eccentricity_floor_is_refused():
     # its ϖ̇ would be several n: the apsidal θ̇ would describe the orbit, not the spin
     table = Members.from_starts(kw4, 0.0, 1.0)
     par, y0 = table.par, table.y0
-    assert abs(C.states_rate(par, y0)[0]) > 1.0
+    assert abs(apsidal_rates(par, y0)[0]) > 1.0
 
 
 def test_small_eccentricity_points_become_nan_with_a_warning():
@@ -288,7 +291,7 @@ def test_relaxed_libration_centre_shifts_by_the_initial_apsidal_rate():
         aps = tso.relaxed_libration(vh, coordinates="apsidal", **kw)
     table = Members.from_starts(vh, 0.0, 1.0)
     par, y0 = table.par, table.y0
-    rate0 = C.states_rate(par, y0)[0]
+    rate0 = apsidal_rates(par, y0)[0]
     assert aps.coordinates == "apsidal"
     assert aps.centre_thetadot_p == pytest.approx(ine.centre_thetadot_p - rate0, abs=2e-4)
     assert aps.amplitude == pytest.approx(ine.amplitude, abs=0.05)

@@ -57,7 +57,8 @@ def run_on_cuda(tmp_path, model):
 @pytest.mark.parametrize("model", ["planar", "3d"])
 def test_cuda_sections_equal_cpu_to_near_the_tolerance(tmp_path, model):
     gpu = run_on_cuda(tmp_path, model)
-    cpu = tso.surface_of_section(tso.catalog.system("1991 VH"), 0.0, STARTS, model=model, **RUN)
+    cpu = tso.surface_of_section(tso.catalog.system("1991 VH"), 0.0, STARTS, **RUN,
+                                 integrator=tso.Integrator(model=model))
     np.testing.assert_array_equal(gpu["status"], cpu.status)
     np.testing.assert_array_equal(gpu["count"], cpu.count)
     regular = [0, 1, 3]            # the chaotic start (1.63) diverges like any perturbation

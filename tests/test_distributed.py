@@ -1,4 +1,4 @@
-"""Scale-out over Dask (ti_spinorbit.distributed): chunked runs on worker processes give the
+"""Scale-out over Dask (ti_spinorbit.studies.distributed): chunked runs on worker processes give the
 single-process result bit for bit, in member order; failed chunks are retried, and a chunk
 that keeps failing raises an error naming it.
 
@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import distributed as tsd
-from ti_spinorbit.chaosmap import chaos_map, parameter_map
-from ti_spinorbit.overlap import overlap_threshold, overlap_vs_eccentricity
-from ti_spinorbit.section import SectionResult
+from ti_spinorbit.studies import distributed as tsd
+from ti_spinorbit.studies.chaosmap import chaos_map, parameter_map
+from ti_spinorbit.studies.overlap import overlap_threshold, overlap_vs_eccentricity
+from ti_spinorbit.studies.section import SectionResult
 
 from conftest import lumpy_body
 
@@ -65,16 +65,16 @@ def assert_sections_equal(got, want):
 
 
 def test_importing_the_package_does_not_import_dask():
-    code = ("import sys, ti_spinorbit, ti_spinorbit.chaosmap, ti_spinorbit.overlap, "
-            "ti_spinorbit.distributed; "
+    code = ("import sys, ti_spinorbit, ti_spinorbit.studies.chaosmap, ti_spinorbit.studies.overlap, "
+            "ti_spinorbit.studies.distributed; "
             "assert not {'dask', 'distributed'} & set(sys.modules), 'dask imported'")
     subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
 
 
 def test_chaos_map_with_client_equals_local(client, vh, vh_local):
     fractions = []
-    cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL, client=client,
-                     progress=fractions.append)
+    cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL,
+                     run=tso.Run(client=client, progress=fractions.append))
     for name in ("theta_p", "thetadot_p", "megno", "lyapunov", "classification", "mean_thetadot",
                  "status"):
         np.testing.assert_array_equal(getattr(cmap, name), getattr(vh_local, name),
@@ -90,8 +90,8 @@ def test_chaos_map_with_client_equals_local(client, vh, vh_local):
 
 @pytest.mark.parametrize("chunk_size", [1, 5, 12, 100])
 def test_uneven_chunks_come_back_in_order(client, vh, vh_local, chunk_size):
-    cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL, client=client,
-                     chunk_size=chunk_size)
+    cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL,
+                     run=tso.Run(client=client, chunk_size=chunk_size))
     np.testing.assert_array_equal(cmap.section.initial_theta_p,
                                   vh_local.section.initial_theta_p)
     np.testing.assert_array_equal(cmap.section.initial_thetadot_p,
@@ -117,7 +117,7 @@ def test_parameter_map_with_client_equals_local(client):
     kwargs = dict(elongations=[1.1, 1.4], eccentricities=[0.05], orbits=ORBITS,
                   thetadot_p=[0.7, 1.5], theta_p=[0.0], rtol=RTOL)
     local = parameter_map("1991 VH", **kwargs)
-    got = parameter_map("1991 VH", client=client, chunk_size=3, **kwargs)
+    got = parameter_map("1991 VH", **kwargs, run=tso.Run(client=client, chunk_size=3))
     for name in ("chaotic_fraction", "megno", "classification", "status", "theta_p", "thetadot_p"):
         np.testing.assert_array_equal(getattr(got, name), getattr(local, name), err_msg=name)
 
@@ -126,7 +126,7 @@ def test_overlap_scans_with_client_equal_local(client):
     kwargs = dict(elongations=[1.01, 1.08], orbits=8, rtol=RTOL, centre_starts=6,
                   separatrix_starts=4)
     local = overlap_threshold("1991 VH", **kwargs)
-    got = overlap_threshold("1991 VH", client=client, **kwargs)
+    got = overlap_threshold("1991 VH", **kwargs, run=tso.Run(client=client))
     np.testing.assert_array_equal(got.overlaps, local.overlaps)
     assert got.decisions == local.decisions or all(  # NaN != NaN in the evidence
         repr(a) == repr(b) for a, b in zip(got.decisions, local.decisions))
@@ -146,7 +146,7 @@ def _install_fault(mode, marker=None):
     """Replace the worker's runner, section_of. ``mode`` "once": chunks holding BAD_MEMBER
     fail while the file ``marker`` exists (the first attempt removes it); "always": they fail
     every time; "report": every chunk fails, naming the model its member table carries."""
-    from ti_spinorbit import section
+    from ti_spinorbit.studies import section
 
     original = getattr(section, "_unfaulted", section.section_of)
 
@@ -170,7 +170,7 @@ def _install_fault(mode, marker=None):
 
 
 def _remove_fault():
-    from ti_spinorbit import section
+    from ti_spinorbit.studies import section
 
     if hasattr(section, "_unfaulted"):
         section.section_of = section._unfaulted
@@ -187,7 +187,8 @@ def test_failed_chunk_is_retried(client, vh, vh_local, faulty_workers, tmp_path)
     marker = tmp_path / "fail-once"
     marker.touch()
     faulty_workers("once", str(marker))
-    cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL, client=client, chunk_size=5)
+    cmap = chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL,
+                     run=tso.Run(client=client, chunk_size=5))
     assert not marker.exists()   # the fault did fire
     assert_sections_equal(cmap.section, vh_local.section)
 
@@ -241,7 +242,8 @@ def test_full_space_chaos_map_with_client_equals_local(client, vh):
     the map equals the single-process one bit for bit (docs/physics.md §10.4)."""
     kw = dict(rtol=RTOL, indicator_space="full", fraction_orbits=(), progress=False)
     local = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, **kw)
-    remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, client=client, chunk_size=2, **kw)
+    remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, **kw,
+                       run=tso.Run(client=client, chunk_size=2))
     assert remote.indicator_space == local.indicator_space == "full"
     assert_sections_equal(remote.section, local.section)
 
@@ -252,7 +254,8 @@ def test_tilted_and_explicit_starts_go_to_the_cluster(client, vh):
     (they were refused with a client before)."""
     kw = dict(rtol=RTOL, tilt=(5.0, 2.0), fraction_orbits=(), progress=False)
     local = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, **kw)
-    remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, client=client, chunk_size=2, **kw)
+    remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, **kw,
+                       run=tso.Run(client=client, chunk_size=2))
     assert remote.section.max_tilt.max() > 1.0           # really out of the plane
     assert_sections_equal(remote.section, local.section)
     starts = [vh.tilted_start(30.0, 1.2, roll=3.0, pitch=0.0),

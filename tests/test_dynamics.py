@@ -5,11 +5,13 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import reference
-from ti_spinorbit.ensemble import Ensemble
+
+from conftest import run_options
+from ti_spinorbit.model import reference
+from ti_spinorbit.engine.ensemble import Ensemble
 from ti_spinorbit.kernels import eom
 from ti_spinorbit.kernels.advance import COLLISION, DONE, ESCAPE, NONFINITE, RUNNING
-from ti_spinorbit.members import Members
+from ti_spinorbit.engine.members import Members
 
 DAY = 86400.0
 
@@ -41,7 +43,7 @@ def test_kepler_time_series_matches_analytic_radius():
 
 def test_planar_start_stays_planar(vh):
     table = Members.from_starts(vh, [0.0, 40.0], [0.8, 1.6])
-    members, par, y0 = table.systems, table.par, table.y0
+    par, y0 = table.par, table.y0
     ens = Ensemble(par, y0, rtol=1e-11)
     out = ens.run(2 * np.pi * 5)
     z = [eom.Y_R + 2, eom.Y_V + 2, eom.Y_W1, eom.Y_W1 + 1, eom.Y_W2, eom.Y_W2 + 1,
@@ -55,7 +57,7 @@ def test_member_result_independent_of_ensemble_size_and_slot(vh):
     small = tso.surface_of_section(vh, 10.0, [0.83, 1.63], orbits=6, rtol=1e-11)
     grid = np.linspace(0.5, 2.5, 37)
     big = tso.surface_of_section(vh, 10.0, np.concatenate([grid[:20], [1.63], grid[20:], [0.83]]),
-                                 orbits=6, rtol=1e-11, window_orbits=2)
+                                 orbits=6, rtol=1e-11, run=tso.Run(window_orbits=2))
     for i_small, i_big in ((0, -1), (1, 20)):
         n = small.count[i_small]
         assert big.count[i_big] == n
@@ -76,7 +78,7 @@ def _energy_test_run(rtol, days=5.0):
     system = tso.catalog.system("test")
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
     table = Members.from_starts(system, 0.0, spin2)
-    members, par, y0 = table.systems, table.par, table.y0
+    par, y0 = table.par, table.y0
     ens = Ensemble(par, y0, rtol=rtol)
     out = ens.run(days * DAY * system.mean_motion)
     d0, d1 = out.diag_start, out.diag_end
@@ -110,7 +112,7 @@ def test_kernel_trajectory_matches_scipy_reference():
     system = tso.catalog.system("test")
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
     table = Members.from_starts(system, 20.0, spin2)
-    members, par, y0 = table.systems, table.par, table.y0
+    par, y0 = table.par, table.y0
     t_end = np.pi
     out = Ensemble(par, y0, rtol=1e-13).run(t_end)
     got = system.to_physical(out.y[0])
@@ -125,7 +127,7 @@ def test_failed_members_are_flagged_and_the_rest_go_on(vh):
     """A NaN start, an infalling and an outbound-hyperbolic member stop with their status;
     the good members' results equal a run without the bad ones."""
     table = Members.from_starts(vh, 0.0, [0.9, 1.1, 1.2, 1.3, 1.7])
-    members, par, y0 = table.systems, table.par, table.y0
+    par, y0 = table.par, table.y0
     bad = y0.copy()
     bad[1, eom.Y_R] = np.nan
     bad[2, eom.Y_V:eom.Y_V + 3] = (-3.0, 0.0, 0.0)          # straight in: collision
@@ -158,8 +160,10 @@ def test_tolerance_1e15_works(vh):
 def test_bad_run_inputs_raise_clear_errors(vh, kwargs, message):
     args = dict(theta_p=0.0, thetadot_p=1.0, orbits=1, rtol=1e-10)
     args.update(kwargs)
-    with pytest.raises(ValueError, match=message):
-        tso.surface_of_section(vh, **args)
+    integrator = {k: args.pop(k) for k in ("atol", "order") if k in args}
+    with pytest.raises(ValueError, match=message):   # raised by the options objects too
+        tso.surface_of_section(vh, **run_options(**args),
+                               integrator=tso.Integrator(**integrator) if integrator else None)
 
 
 @pytest.mark.parametrize("build, message", [
@@ -196,7 +200,7 @@ def test_time_series_energy_split_exchanges_but_total_is_conserved(model):
     system = tso.catalog.system("test")
     spin2 = 2 * np.pi / tso.catalog.secondary_spin_period("test") / system.mean_motion
     ts = tso.time_series(system, 0.0, spin2, orbits=1, samples_per_orbit=40, rtol=1e-12,
-                         model=model)
+                         integrator=tso.Integrator(model=model))
     e_tot = ts.energy_orbit[0] + ts.energy_primary[0] + ts.energy_secondary[0]
     np.testing.assert_allclose(ts.energy[0], e_tot)
     drift = np.abs(e_tot - e_tot[0]).max() / abs(e_tot[0])

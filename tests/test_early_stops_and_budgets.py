@@ -19,10 +19,12 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import accuracy, cli, cost, perturbations
-from ti_spinorbit.ensemble import Ensemble
-from ti_spinorbit.initial import tilted_start
-from ti_spinorbit.results import STATUS_NAMES, Status
+from ti_spinorbit import cli
+from ti_spinorbit.engine import accuracy, cost
+from ti_spinorbit.model import perturbations
+from ti_spinorbit.engine.ensemble import Ensemble
+from ti_spinorbit.system.initial import tilted_start
+from ti_spinorbit.engine.results import STATUS_NAMES, Status
 
 VH = tso.catalog.system("1991 VH")
 
@@ -131,7 +133,7 @@ def test_yorp_spin_change_per_orbit_is_the_torque_the_run_delivers():
 # ---- the step budget -----------------------------------------------------------------------
 
 def _members(thetadots):
-    from ti_spinorbit.members import Members
+    from ti_spinorbit.engine.members import Members
     table = Members.from_starts(VH, [30.0] * len(thetadots), thetadots, 50.0)
     return table.par, table.y0
 
@@ -198,7 +200,7 @@ def test_step_estimate_bounds_the_measured_steps(method):
     """The estimate is an upper bound within a factor of eight of the steps a run takes, for a
     slow and a fast (15 n) primary, e = 0.05 and 0.3, two tolerances: far inside the budget's
     factor of 100, and a wrong exponent or spin term would leave the band."""
-    from ti_spinorbit.members import Members
+    from ti_spinorbit.engine.members import Members
     for name in ("1991 VH", "2004 DC", "test"):
         system = tso.catalog.system(name)
         for rtol in (1e-8, 1e-12):

@@ -32,13 +32,14 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import checkpoint as C
-from ti_spinorbit import cli, files, io, plotting
+from ti_spinorbit.engine import checkpoint as C
+from ti_spinorbit import cli, files
+from ti_spinorbit.output import io, plotting
 from ti_spinorbit.cli import common
-from ti_spinorbit.io import ArchiveError
-from ti_spinorbit.libration import RelaxedLibration
+from ti_spinorbit.output.io import ArchiveError
+from ti_spinorbit.studies.libration import RelaxedLibration
 
-from conftest import run_cli
+from conftest import run_cli, run_options
 
 SECTION = ["section", "--system", "1991 VH", "--orbits", "3", "--thetadot", "0.83", "1.63",
            "--rtol", "1e-9", "--quiet"]
@@ -66,7 +67,8 @@ def stray(folder):
 
 @pytest.fixture(scope="module")
 def small(vh):
-    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], orbits=3, rtol=1e-9, progress=False)
+    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], orbits=3, rtol=1e-9,
+                                  run=tso.Run(progress=False))
 
 
 @pytest.fixture
@@ -308,7 +310,7 @@ def test_default_names_of_catalogued_systems_are_unchanged():
 # ---- 4. the same command again finishes a run ----------------------------------------------
 KILL_BEFORE_FIGURE = """
 import os, signal, sys
-import ti_spinorbit.plotting as plotting
+import ti_spinorbit.output.plotting as plotting
 plotting.save_figure = lambda ax, path: os.kill(os.getpid(), signal.SIGKILL)
 from ti_spinorbit.cli import main
 sys.exit(main(sys.argv[1:]))
@@ -407,13 +409,13 @@ ARGS = dict(orbits=6, rtol=1e-10, window_orbits=2, progress=False)
 
 @pytest.fixture(scope="module")
 def whole(vh):
-    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], **ARGS)
+    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS))
 
 
 @pytest.fixture(scope="module")
 def finished(vh, tmp_path_factory):
     path = tmp_path_factory.mktemp("ro") / "run.ckpt"
-    tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=path, **ARGS)
+    tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS, checkpoint=path))
     return path
 
 
@@ -432,8 +434,7 @@ def test_finished_checkpoint_in_a_read_only_folder_resumes(vh, finished, tmp_pat
     shutil.copytree(finished, ckpt)
     before = snapshot(ckpt)
     with read_only(monkeypatch, ckpt):
-        resumed = tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=ckpt, resume=True,
-                                         **ARGS)
+        resumed = tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS, checkpoint=ckpt, resume=True))
     same_arrays(whole, resumed)
     assert snapshot(ckpt) == before                     # nothing written, nothing removed
 
@@ -446,12 +447,11 @@ def test_unfinished_checkpoint_in_a_read_only_folder_is_refused_in_one_line(vh, 
         if 0 < fraction < 1:
             raise KeyboardInterrupt
     with pytest.raises(KeyboardInterrupt):
-        tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=ckpt,
-                               **{**ARGS, "progress": stop})
+        tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**{**ARGS, "progress": stop}, checkpoint=ckpt))
     assert C.holds_checkpoint(ckpt)
     before = snapshot(ckpt)
     with read_only(monkeypatch, ckpt), pytest.raises(C.CheckpointError) as info:
-        tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=ckpt, resume=True, **ARGS)
+        tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS, checkpoint=ckpt, resume=True))
     text = str(info.value)
     assert "cannot be written and its run is not finished (2 of 2 members still running)" \
         in text and "copy the directory elsewhere" in text and "\n" not in text
@@ -468,8 +468,7 @@ def test_finished_checkpoint_in_a_chmod_read_only_folder_resumes(vh, finished, t
     before = snapshot(ckpt)
     os.chmod(ckpt, 0o555)
     try:
-        resumed = tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=ckpt, resume=True,
-                                         **ARGS)
+        resumed = tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS, checkpoint=ckpt, resume=True))
     finally:
         os.chmod(ckpt, 0o755)
     same_arrays(whole, resumed)
@@ -564,8 +563,8 @@ def test_bit_flips_of_a_checkpoint_state_are_checkpoint_damaged(vh, tmp_path):
     CheckpointDamaged (one line) or loads the same state; never RuntimeError, TokenError,
     a changed number."""
     ckpt = tmp_path / "one.ckpt"
-    tso.surface_of_section(vh, 0.0, [1.0], orbits=1, rtol=1e-8, window_orbits=1,
-                           indicators=False, checkpoint=ckpt, progress=False)
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=1, rtol=1e-8, indicators=False,
+                           run=tso.Run(window_orbits=1, checkpoint=ckpt, progress=False))
     with np.load(ckpt / C.STATE) as f:
         header = json.loads(str(f["header"]))
     settings, fingerprint = header["settings"], header["fingerprint"]
@@ -626,7 +625,7 @@ def test_the_two_leaks_found_by_fuzzing_are_archive_errors(tmp_path, vh):
         tso.load(path)
     ckpt = tmp_path / "c.ckpt"
     tso.surface_of_section(vh, 0.0, [1.0], orbits=1, rtol=1e-8, indicators=False,
-                           checkpoint=ckpt, progress=False)
+                           run=tso.Run(checkpoint=ckpt, progress=False))
     with np.load(ckpt / C.STATE) as f:
         header = json.loads(str(f["header"]))
     _set_encrypted_flag(ckpt / C.STATE)
@@ -639,9 +638,9 @@ def test_the_two_leaks_found_by_fuzzing_are_archive_errors(tmp_path, vh):
 def saved(vh, chaos_map, parameter_map, overlap_scan, relaxed_libration, tmp_path_factory):
     folder = tmp_path_factory.mktemp("edited")
     perturbed = tso.time_series(vh, 0.0, [0.8], orbits=1, samples_per_orbit=8, rtol=1e-9,
-                                states=True, progress=False,
-                                perturbations=[tso.Tides(body="secondary", time_lag=600,
-                                                         strength=1e6)])
+                                states=True,
+                                perturbations=[tso.Tides(body="secondary", time_lag=600,                                                          strength=1e6)],
+                                run=tso.Run(progress=False))
     kinds = {"time_series": perturbed, "chaos_map": chaos_map, "parameter_map": parameter_map,
              "overlap_scan": overlap_scan, "relaxed_libration": relaxed_libration}
     return {k: io.save(r, folder / f"{k}.npz") for k, r in kinds.items()}
@@ -711,13 +710,13 @@ FLATTENED = {"candidates": "thetadot_p", "extents": "extent"}
 @pytest.fixture(scope="module")
 def with_states(vh):
     return tso.time_series(vh, 0.0, [0.83, 1.63], orbits=1, samples_per_orbit=8, rtol=1e-9,
-                           states=True, progress=False)
+                           states=True, run=tso.Run(progress=False))
 
 
 @pytest.fixture(scope="module")
 def tilted(vh):
     return tso.surface_of_section(vh, initial_states=[vh.tilted_start(0.0, 1.0, roll=5.0)],
-                                  orbits=2, rtol=1e-9, progress=False)
+                                  orbits=2, rtol=1e-9, run=tso.Run(progress=False))
 
 
 @pytest.mark.parametrize("kind", ["with_states", "tilted", "chaos_map", "parameter_map",
@@ -762,7 +761,8 @@ def test_to_xarray_labels_state_columns_and_attitude_classes(with_states, chaos_
 @pytest.mark.parametrize("bad", [123, 1.5, ["dir"], b"bytes"], ids=repr)
 def test_checkpoint_that_is_not_a_path_is_a_type_error(vh, bad):
     with pytest.raises(TypeError) as info:
-        tso.surface_of_section(vh, 0.0, [1.0], orbits=1, checkpoint=bad, progress=False)
+        tso.surface_of_section(vh, 0.0, [1.0], orbits=1,
+                               run=tso.Run(checkpoint=bad, progress=False))
     text = str(info.value)
     assert text.startswith("checkpoint must be a directory path (str or os.PathLike) or None "
                            f"(got {type(bad).__name__} ") and "\n" not in text

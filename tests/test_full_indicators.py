@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import models
-from ti_spinorbit.ensemble import Ensemble
-from ti_spinorbit.initial import rotation
+from ti_spinorbit.model import models
+from ti_spinorbit.engine.ensemble import Ensemble
+from ti_spinorbit.system.initial import rotation
 
 #: The Hyperion-like system's synchronous island centre θ̇_p/n at θ_p = 0 (relaxed_libration;
 #: planar-regular, attitude-unstable with an e-folding of the tilt of ≈ 1.4 orbits).
@@ -32,9 +32,11 @@ def runs():
     systems = [hyperion(), tso.catalog.system("Didymos")]
     out = {}
     for space, model in (("planar", "auto"), ("planar", "3d"), ("full", "auto")):
-        out[space, model] = tso.surface_of_section(
-            systems, 0.0, [HYPERION_CENTRE, 1.0], orbits=40, rtol=1e-11, indicators=True,
-            indicator_space=space, model=model, progress=False)
+        out[space, model] = tso.surface_of_section(systems, 0.0, [HYPERION_CENTRE, 1.0], orbits=40,
+                                                   rtol=1e-11, indicators=True,
+                                                   indicator_space=space,
+                                                   integrator=tso.Integrator(model=model),
+                                                   run=tso.Run(progress=False))
     return out
 
 
@@ -111,10 +113,11 @@ def test_full_space_with_planar_model_refused(call):
     msg = r"^indicator_space='full' needs the 3-D model .*use model='auto' or '3d'$"
     with pytest.raises(ValueError, match=msg):
         if call == "section":
-            tso.surface_of_section(vh, 0.0, 1.0, orbits=1, indicators=True, model="planar",
-                                   indicator_space="full")
+            tso.surface_of_section(vh, 0.0, 1.0, orbits=1, indicators=True, indicator_space="full",
+                                   integrator=tso.Integrator(model="planar"))
         elif call == "chaos_map":
-            tso.chaos_map(vh, [0.0], [1.0], orbits=1, model="planar", indicator_space="full")
+            tso.chaos_map(vh, [0.0], [1.0], orbits=1, indicator_space="full",
+                          integrator=tso.Integrator(model="planar"))
         else:
             Ensemble(vh.parameter_row()[None], vh.initial_state(0.0, 1.0)[None],
                      model="planar").run(1.0, indicators=True, indicator_space="full")
@@ -141,8 +144,8 @@ def test_auto_ensemble_turns_3d_for_full_space_only_with_indicators():
 def test_full_space_recorded_saved_and_in_checkpoint_settings(tmp_path):
     vh = tso.catalog.system("1991 VH")
     r = tso.surface_of_section(vh, 0.0, 1.0, orbits=2, rtol=1e-10, indicators=True,
-                               indicator_space="full", checkpoint=tmp_path / "ck",
-                               progress=False)
+                               indicator_space="full",
+                               run=tso.Run(checkpoint=tmp_path / "ck", progress=False))
     loaded = tso.load(tso.save(r, tmp_path / "r.npz"))
     assert loaded.indicator_space == "full"
     assert "planar" in type(r).units()["indicator_space"]
@@ -150,15 +153,15 @@ def test_full_space_recorded_saved_and_in_checkpoint_settings(tmp_path):
     with pytest.raises(ValueError, match=r"other settings: .*indicator_space \(checkpoint "
                                          r"'full', now 'planar'\)"):
         tso.surface_of_section(vh, 0.0, 1.0, orbits=2, rtol=1e-10, indicators=True,
-                               model="3d", checkpoint=tmp_path / "ck", resume=True,
-                               progress=False)
+                               integrator=tso.Integrator(model="3d"),
+                               run=tso.Run(checkpoint=tmp_path / "ck", resume=True, progress=False))
 
 
 def test_chaos_map_tilt_and_max_tilt(tmp_path):
     """A small start tilt (0.01° roll) on the Hyperion-like island centre grows past 10° in
     40 orbits; the planar map records zero tilt; both are saved with the map."""
     hyp = hyperion()
-    common = dict(orbits=40, rtol=1e-10, fraction_orbits=(), progress=False)
+    common = dict(orbits=40, rtol=1e-10, fraction_orbits=(), run=tso.Run(progress=False))
     tilted = tso.chaos_map(hyp, [0.0], [HYPERION_CENTRE, 2.5], tilt=(0.01, 0.0), **common)
     assert tilted.max_tilt.shape == (1, 2) and tilted.tilt.tolist() == [0.01, 0.0]
     assert tilted.max_tilt[0, 0] > 10.0                # the synchronous centre tumbles
@@ -179,5 +182,5 @@ def test_chaos_map_bad_tilt_refused(tilt):
 
 def test_parameter_map_records_full_space():
     pm = tso.parameter_map("1991 VH", [1.5], [0.05], orbits=2, theta_p=[0.0], thetadot_p=[1.0],
-                           fraction_orbits=(), indicator_space="full", progress=False)
+                           fraction_orbits=(), indicator_space="full", run=tso.Run(progress=False))
     assert pm.indicator_space == "full" and np.isfinite(pm.megno).all()

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import initial as I
-from ti_spinorbit.initial import InitialState
-from ti_spinorbit import accuracy, ensemble, planar
+from ti_spinorbit.system import initial as I
+from ti_spinorbit.system.initial import InitialState
+from ti_spinorbit.engine import accuracy, ensemble
+from ti_spinorbit.model import planar
 
 
 def random_rotation(rng):
@@ -43,7 +44,7 @@ def test_untilted_start_qualifies_for_the_planar_model_and_a_tilted_one_does_not
     par = vh.parameter_row()
     flat = I.tilted_start(vh, 20.0, 1.1).to_scaled(vh)
     tilted = I.tilted_start(vh, 20.0, 1.1, roll=1e-3).to_scaled(vh)
-    assert planar.qualifies(par, flat)[0] and not tso.planar.qualifies(par, tilted)[0]
+    assert planar.qualifies(par, flat)[0] and not tso.model.planar.qualifies(par, tilted)[0]
 
 
 def test_scaled_round_trip(spun_vh):

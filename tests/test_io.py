@@ -1,4 +1,4 @@
-"""Saved results (ti_spinorbit.io, ti_spinorbit.xarray_io): every result kind survives
+"""Saved results (ti_spinorbit.output.io, ti_spinorbit.output.xarray_io): every result kind survives
 save -> load unchanged (arrays bit-identical, NaN padding included; scalars equal; systems with
 identical parameter rows and initial states), files describe themselves (units, provenance,
 status), bad files fail with a message that says why, and results convert to labelled xarray.
@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import io
-from ti_spinorbit.chaosmap import ChaosMap, ParameterMap
-from ti_spinorbit.libration import RelaxedLibration
-from ti_spinorbit.overlap import OverlapScan
-from ti_spinorbit.section import SectionResult, TimeSeriesResult
+from ti_spinorbit.output import io
+from ti_spinorbit.studies.chaosmap import ChaosMap, ParameterMap
+from ti_spinorbit.studies.libration import RelaxedLibration
+from ti_spinorbit.studies.overlap import OverlapScan
+from ti_spinorbit.studies.section import SectionResult, TimeSeriesResult
 
 from conftest import lumpy_body
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import reference
+from ti_spinorbit.model import reference
 from ti_spinorbit.kernels import advance as K
 
 from conftest import lumpy_body, random_rotation

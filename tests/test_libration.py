@@ -10,8 +10,8 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
 import ti_spinorbit as tso
-from ti_spinorbit.classify import wrap_half_turn
-from ti_spinorbit.libration import (RelaxedLibration, _fit_v, libration_amplitude,
+from ti_spinorbit.studies.classify import wrap_half_turn
+from ti_spinorbit.studies.libration import (RelaxedLibration, _fit_v, libration_amplitude,
                                     relaxed_libration)
 
 ORBITS = 60
@@ -174,7 +174,7 @@ def test_chaotic_zone_is_not_reported_as_a_centre():
     import warnings
 
     import ti_spinorbit as tso
-    from ti_spinorbit.libration import relaxed_libration
+    from ti_spinorbit.studies.libration import relaxed_libration
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -14,9 +14,13 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import attitude, cli, distributed, layout, resources, runners, section
-from ti_spinorbit.ensemble import check_tolerances
-from ti_spinorbit.initial import InitialState, orbit_frame, quaternion_to_matrix, rotation
+from ti_spinorbit import cli, layout
+from ti_spinorbit.model import attitude
+from ti_spinorbit.studies import section
+from ti_spinorbit.engine import options
+from ti_spinorbit.engine import resources
+from ti_spinorbit.engine.ensemble import check_tolerances
+from ti_spinorbit.system.initial import InitialState, orbit_frame, quaternion_to_matrix, rotation
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -35,18 +39,10 @@ def no_integration(monkeypatch):
     monkeypatch.setattr(section, "section_of", forbidden)
 
 
-@pytest.mark.parametrize("call", [
-    lambda vh: runners.run_section(object(), vh, 0.0, 1.0, 2),
-    lambda vh: distributed.run_sections(object(), vh, 0.0, 1.0, 2),
-    lambda vh: tso.chaos_map(vh, [0.0, 90.0], [1.0, 1.5], 2, client=object()),
-    lambda vh: tso.parameter_map("1991 VH", [1.2], [0.1], 2, theta_p=[0.0],
-                                 thetadot_p=[1.0], client=object()),
-    lambda vh: tso.overlap_threshold("1991 VH", elongations=[1.05], orbits=2, centre_starts=2,
-                                     separatrix_starts=2, client=object()),
-], ids=["run_section", "run_sections", "chaos_map", "parameter_map", "overlap_threshold"])
-def test_client_that_is_not_a_client_is_a_one_line_type_error(vh, no_integration, call):
+def test_client_that_is_not_a_client_is_a_one_line_type_error(no_integration):
+    """Every entry point takes its client in a Run, which refuses a non-client when made."""
     with pytest.raises(TypeError, match=CLIENT_MESSAGE) as info:
-        call(vh)
+        tso.Run(client=object())
     assert "\n" not in str(info.value)
 
 
@@ -55,12 +51,12 @@ def test_check_client_names_the_type_given():
         def nthreads(self):
             return {}
 
-    assert runners.check_client(None) is None
+    assert options.check_client(None) is None
     with pytest.raises(TypeError, match=r"^client must be a dask\.distributed\.Client or "
                                         r"None, not FakeClient$"):
-        runners.check_client(FakeClient())
+        options.check_client(FakeClient())
     with pytest.raises(TypeError, match=r", not str$"):
-        runners.check_client("tcp://127.0.0.1:8786")
+        options.check_client("tcp://127.0.0.1:8786")
 
 
 # ---- 2. kicked() when V is parallel to R ----------------------------------------------------
@@ -273,9 +269,9 @@ def test_atol_out_of_range_is_refused(atol, shown):
 
 def test_atol_out_of_range_is_refused_before_any_work(vh, no_integration):
     with pytest.raises(ValueError, match=ATOL.format("10000000000")):
-        tso.surface_of_section(vh, 0.0, 1.0, 2, atol=1e10)
+        tso.surface_of_section(vh, 0.0, 1.0, 2, integrator=tso.Integrator(atol=1e10))
     with pytest.raises(ValueError, match=ATOL.format("10000000000")):
-        tso.time_series(vh, 0.0, 1.0, 2, atol=1e10)
+        tso.time_series(vh, 0.0, 1.0, 2, integrator=tso.Integrator(atol=1e10))
 
 
 @pytest.mark.parametrize("atol", [1e-2, 1e-10, 1e-15, 1e-20, 1e-300, None])
@@ -340,12 +336,12 @@ def test_libration_not_converged_accepted_with_allow_inaccurate(tmp_path, capsys
 
 def test_a_local_map_never_imports_the_dask_module():
     """The runner is chosen by client: without one, the maps and scans never import
-    ti_spinorbit.distributed (nor dask)."""
+    ti_spinorbit.studies.distributed (nor dask)."""
     code = ("import sys, ti_spinorbit as tso\n"
-            "tso.chaos_map('1991 VH', [0.0], [1.0], 1, fraction_orbits=(), progress=False)\n"
+            "tso.chaos_map('1991 VH', [0.0], [1.0], 1, fraction_orbits=(), run=tso.Run(progress=False))\n"
             "tso.overlap_threshold('1991 VH', elongations=[1.05], orbits=1, max_orbits=1,\n"
-            "                      centre_starts=2, separatrix_starts=2, progress=False)\n"
-            "print(sorted(m for m in sys.modules if m in ('ti_spinorbit.distributed', 'dask',\n"
+            "                      centre_starts=2, separatrix_starts=2, run=tso.Run(progress=False))\n"
+            "print(sorted(m for m in sys.modules if m in ('ti_spinorbit.studies.distributed', 'dask',\n"
             "             'distributed')))\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env=dict(os.environ, MPLBACKEND="Agg"), timeout=600)

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit.checkpoint import CheckpointError
-from ti_spinorbit.ensemble import Ensemble
+from ti_spinorbit.engine.checkpoint import CheckpointError
+from ti_spinorbit.engine.ensemble import Ensemble
 
 from conftest import run_cli
 
@@ -116,9 +116,9 @@ def test_unknown_method_is_refused(members, method):
 def test_results_and_files_record_the_method(vh, tmp_path, method):
     res = tso.surface_of_section(vh, 0.0, [1.3], orbits=2, rtol=1e-10, method=method)
     assert res.method == method
-    path = tso.io.save(res, tmp_path / "s.npz")
-    assert tso.io.load(path).method == method
-    assert tso.io.read_metadata(path)["method"] == method
+    path = tso.output.io.save(res, tmp_path / "s.npz")
+    assert tso.output.io.load(path).method == method
+    assert tso.output.io.read_metadata(path)["method"] == method
     default = tso.surface_of_section(vh, 0.0, [1.3], orbits=2, rtol=1e-10)
     assert default.method == "cash-karp"
 
@@ -177,7 +177,7 @@ def test_cli_method_flag(tmp_path, method):
     p = run_cli("section", "--system", "1991 VH", "--thetadot", "1.3", "--orbits", "2",
                 "--method", method, "--quiet", "--out", str(tmp_path / "s.png"), cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert tso.io.read_metadata(tmp_path / "s.npz")["method"] == method
+    assert tso.output.io.read_metadata(tmp_path / "s.npz")["method"] == method
     bad = run_cli("section", "--method", "rk4", cwd=tmp_path)
     assert bad.returncode == 2 and "--method: invalid choice: 'rk4'" in bad.stderr
 
@@ -185,7 +185,7 @@ def test_cli_method_flag(tmp_path, method):
 def test_warmup_knows_every_method():
     # compiling keeps its own copy of the names so that importing the package stays free of
     # the kernel modules: it must list the same methods
-    from ti_spinorbit.compiling import METHODS
+    from ti_spinorbit.engine.compiling import METHODS
     from ti_spinorbit.kernels.tableau import METHODS as kernel_methods
     assert tuple(METHODS) == tuple(kernel_methods)
 

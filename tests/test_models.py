@@ -1,11 +1,11 @@
-"""The host-side model objects (ti_spinorbit/models.py): one decision for "auto", the
+"""The host-side model objects (ti_spinorbit/model/models.py): one decision for "auto", the
 conversions and the shadow direction of each model, and that Ensemble uses them."""
 
 import numpy as np
 import pytest
 
-from ti_spinorbit import models
-from ti_spinorbit.ensemble import Ensemble
+from ti_spinorbit.model import models
+from ti_spinorbit.engine.ensemble import Ensemble
 
 
 @pytest.fixture(scope="module")

@@ -10,10 +10,10 @@ import pytest
 
 pytest.importorskip("numba")
 
-from ti_spinorbit import planar as PL  # noqa: E402
-from ti_spinorbit.ensemble import Ensemble  # noqa: E402
+from ti_spinorbit.model import planar as PL  # noqa: E402
+from ti_spinorbit.engine.ensemble import Ensemble  # noqa: E402
 from ti_spinorbit.kernels import advance as K  # noqa: E402
-from ti_spinorbit.members import Members  # noqa: E402
+from ti_spinorbit.engine.members import Members  # noqa: E402
 
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                            "experiments")
@@ -78,7 +78,7 @@ def test_benchmark_skips_a_method_the_package_refuses(members):
 def test_benchmark_passes_method_only_when_not_the_default(monkeypatch, members, method, passed):
     """``method=`` reaches Ensemble only for a non-default method, so the benchmark runs on a
     package with and without the keyword."""
-    import ti_spinorbit.ensemble as E
+    import ti_spinorbit.engine.ensemble as E
 
     seen = []
 

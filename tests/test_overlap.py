@@ -4,8 +4,8 @@ elongations, monotonic in a/b, and the analytic threshold."""
 import numpy as np
 import pytest
 
-from ti_spinorbit import analytic
-from ti_spinorbit.overlap import overlap_threshold
+from ti_spinorbit.model import analytic
+from ti_spinorbit.studies.overlap import overlap_threshold
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +44,7 @@ def test_bad_inputs():
 
 def test_eccentricity_with_a_factory_is_refused_not_ignored():
     """A factory sets its systems' e: eccentricity= beside it was silently ignored."""
-    from ti_spinorbit import catalog
+    from ti_spinorbit.system import catalog
 
     factory = lambda q: catalog.system("1991 VH", elongation=q)  # noqa: E731
     with pytest.raises(TypeError, match=r"eccentricity=0\.3 applies to a catalogue name"):
@@ -64,7 +64,7 @@ def test_eccentricity_reaches_a_named_scan():
 
 
 def test_overlap_vs_eccentricity_reports_per_e():
-    from ti_spinorbit.overlap import overlap_vs_eccentricity
+    from ti_spinorbit.studies.overlap import overlap_vs_eccentricity
     ecc, first, analytic_ab, scans = overlap_vs_eccentricity(
         "2004 DC", [0.1, 0.3], elongations=[1.01, 1.06], orbits=150, centre_starts=24,
         separatrix_starts=12)

@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import catalog, cli
+from ti_spinorbit import cli
+from ti_spinorbit.system import catalog
 from ti_spinorbit.cli import common
-from ti_spinorbit.systems import G, ImplausibleInputWarning, NearCircularWarning
+from ti_spinorbit.system.systems import G, ImplausibleInputWarning, NearCircularWarning
 
 HOUR = 3600.0
 DIDYMOS_PERIOD_H = 11.92        # observed mutual orbit period of Didymos-Dimorphos

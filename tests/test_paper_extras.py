@@ -11,7 +11,7 @@ import re
 import numpy as np
 import pytest
 
-from ti_spinorbit import analytic
+from ti_spinorbit.model import analytic
 
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "experiments")
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import perturbations as tsp
+from ti_spinorbit.model import perturbations as tsp
 from test_checkpoint import killed_run   # the same kill-and-resume harness
 
 #: A tide 1e6 times its real strength and YORP 1e6 times on the secondary of 1991 VH, BYORP:
@@ -61,7 +61,8 @@ def test_section_with_indicators_and_perturbations(section, vh):
     assert not np.array_equal(section.megno, plain.megno)       # the equations changed
 
 
-@pytest.mark.parametrize("kw", [dict(model="3d"), dict(indicator_space="full")])
+@pytest.mark.parametrize("kw", [dict(integrator=tso.Integrator(model="3d")),
+                                dict(indicator_space="full")])
 def test_indicators_with_perturbations_in_3d(vh, kw):
     got = tso.surface_of_section(vh, 0.0, STARTS, indicators=True, perturbations=ALL,
                                  orbits=3, rtol=1e-10, **kw)
@@ -78,7 +79,7 @@ def test_saved_and_loaded_with_the_perturbations(fixture, request, tmp_path):
     assert back.perturbations == result.perturbations and back.perturbations
     assert all(type(p) in (tso.Tides, tso.YORP, tso.BYORP) for p in back.perturbations)
     assert_same(back, result)
-    meta = tso.io.read_metadata(path)
+    meta = tso.output.io.read_metadata(path)
     assert meta["units"]["perturbations"] == tsp.UNIT
     if fixture == "cmap":       # the nested section keeps them too
         assert back.section.perturbations == (TIDE,)
@@ -160,7 +161,7 @@ def test_libration_with_perturbations(vh):
     kw = dict(samples_per_orbit=32, rtol=1e-10)
     amp = tso.libration_amplitude(vh, [0.45, 0.5], 4, perturbations=P, **kw)
     ts = tso.time_series(vh, 0.0, [0.45, 0.5], 4, perturbations=P, **kw)
-    from ti_spinorbit.libration import _amplitudes
+    from ti_spinorbit.studies.libration import _amplitudes
     np.testing.assert_array_equal(amp, _amplitudes(ts))
     assert not np.array_equal(amp, tso.libration_amplitude(vh, [0.45, 0.5], 4, **kw))
     with warnings.catch_warnings():
@@ -229,13 +230,14 @@ def test_warmup_compiles_the_perturbed_variant():
 
 def test_resumed_perturbed_run_equals_an_uninterrupted_one(tmp_path, vh):
     ckpt = tmp_path / "ts.ckpt"
-    kw = dict(orbits=12, rtol=1e-10, window_orbits=4, samples_per_orbit=8)
+    kw = dict(orbits=12, rtol=1e-10, samples_per_orbit=8)
     killed_run(tmp_path, ckpt, kill_after=2, kind="series", starts=STARTS, args=kw,
                extra="perturbations=[tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6), "
                      "tso.BYORP(coefficient=1e-3, strength=1e6)],")
     kw["perturbations"] = [TIDE, tso.BYORP(coefficient=1e-3, strength=1e6)]
-    resumed = tso.time_series(vh, 0.0, STARTS, checkpoint=ckpt, resume=True, **kw)
-    whole = tso.time_series(vh, 0.0, STARTS, **kw)
+    resumed = tso.time_series(vh, 0.0, STARTS, **kw,
+                              run=tso.Run(checkpoint=ckpt, resume=True, window_orbits=4))
+    whole = tso.time_series(vh, 0.0, STARTS, **kw, run=tso.Run(window_orbits=4))
     assert_same(resumed, whole)
     assert np.all(np.isfinite(whole.work[:, -1])) and np.all(whole.work[:, -1] != 0)
 
@@ -243,20 +245,20 @@ def test_resumed_perturbed_run_equals_an_uninterrupted_one(tmp_path, vh):
 def test_checkpoint_of_other_perturbations_is_refused(tmp_path, vh):
     ckpt = tmp_path / "a.ckpt"
     kw = dict(orbits=2, rtol=1e-10)
-    tso.surface_of_section(vh, 0.0, STARTS, checkpoint=ckpt, **kw)
+    tso.surface_of_section(vh, 0.0, STARTS, **kw, run=tso.Run(checkpoint=ckpt))
     with pytest.raises(ValueError, match=r"other settings: perturbed \(checkpoint False, now "
                                          r"True\)"):
-        tso.surface_of_section(vh, 0.0, STARTS, checkpoint=ckpt, resume=True,
-                               perturbations=[TIDE], **kw)
-    tso.surface_of_section(vh, 0.0, STARTS, checkpoint=ckpt, overwrite_checkpoint=True,
-                           perturbations=[TIDE], **kw)
+        tso.surface_of_section(vh, 0.0, STARTS, perturbations=[TIDE], **kw,
+                               run=tso.Run(checkpoint=ckpt, resume=True))
+    tso.surface_of_section(vh, 0.0, STARTS, perturbations=[TIDE], **kw,
+                           run=tso.Run(checkpoint=ckpt, overwrite=True))
     with pytest.raises(ValueError, match=r"other settings: perturbed \(checkpoint True, now "
                                          r"False\)"):
-        tso.surface_of_section(vh, 0.0, STARTS, checkpoint=ckpt, resume=True, **kw)
+        tso.surface_of_section(vh, 0.0, STARTS, **kw, run=tso.Run(checkpoint=ckpt, resume=True))
     stronger = dataclasses.replace(TIDE, strength=2e6)       # the fingerprint hashes the rows
     with pytest.raises(ValueError, match="other inputs"):
-        tso.surface_of_section(vh, 0.0, STARTS, checkpoint=ckpt, resume=True,
-                               perturbations=[stronger], **kw)
+        tso.surface_of_section(vh, 0.0, STARTS, perturbations=[stronger], **kw,
+                               run=tso.Run(checkpoint=ckpt, resume=True))
 
 
 # ---- Dask --------------------------------------------------------------------------------
@@ -265,14 +267,14 @@ def test_dask_path_passes_them_and_equals_one_process(vh):
     pytest.importorskip("distributed")
     from distributed import Client, LocalCluster
 
-    from ti_spinorbit import distributed as tsd
-
     kw = dict(rtol=1e-10, indicators=True, perturbations=[TIDE])
     local = tso.surface_of_section(vh, 0.0, STARTS, 3, **kw)
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
                       env={"TI_SPINORBIT_ARCH": "cpu"}) as cluster, Client(cluster) as client:
         with pytest.raises(TypeError, match=r"perturbations\[0\] must be"):   # on the client
-            tsd.run_sections(client, vh, 0.0, STARTS, 3, perturbations=[1.0])
-        got = tsd.run_sections(client, vh, 0.0, STARTS, 3, chunk_size=1, **kw)
+            tso.surface_of_section(vh, 0.0, STARTS, 3, perturbations=[1.0],
+                                   run=tso.Run(client=client))
+        got = tso.surface_of_section(vh, 0.0, STARTS, 3, **kw,
+                                     run=tso.Run(client=client, chunk_size=1))
     assert got.perturbations == (TIDE,)
     assert_same(got, local)

@@ -1,5 +1,5 @@
 """Tides, YORP and BYORP in the equations (docs/physics.md §13): the integrated rates against
-the closed forms of ``ti_spinorbit.analytic`` (Hut 1981 for the constant-time-lag tide, the
+the closed forms of ``ti_spinorbit.model.analytic`` (Hut 1981 for the constant-time-lag tide, the
 constant-Q limit, BYORP and the tide-BYORP equilibrium of Jacobson & Scheeres 2011), the
 closed forms against an independent orbit average of the force law, the strength scaling,
 and the accounting of the energy and angular momentum the perturbations exchange.
@@ -18,9 +18,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import accuracy, analytic
-from ti_spinorbit.bodies import Sphere
-from ti_spinorbit.systems import G
+from ti_spinorbit.engine import accuracy
+from ti_spinorbit.model import analytic
+from ti_spinorbit.system.bodies import Sphere
+from ti_spinorbit.system.systems import G
 
 SPO = 64                      # samples per orbit
 ORBITS = 20
@@ -52,8 +53,8 @@ def secular(t, x):
 
 def run(system, perturbations, model="planar", thetadot=3.0, orbits=ORBITS, rtol=1e-12, **kw):
     return tso.time_series(system, 0.0, [thetadot], orbits=orbits, samples_per_orbit=SPO,
-                           perturbations=perturbations, model=model, rtol=rtol, states=True,
-                           **kw)
+                           perturbations=perturbations, rtol=rtol, states=True, **kw,
+                           integrator=tso.Integrator(model=model))
 
 
 def measured_rates(ts, system):
@@ -274,7 +275,8 @@ def test_tide_byorp_equilibrium_is_reached_from_both_sides():
     for start in (0.85, 1.15):
         system = spheres(a=start * a_eq, primary_spin_period=3 * 3600.0)
         ts = tso.time_series(system, 0.0, [1.0], orbits=orbits, samples_per_orbit=2,
-                             perturbations=perturbations, model="planar", rtol=1e-10, states=True)
+                             perturbations=perturbations, rtol=1e-10, states=True,
+                             integrator=tso.Integrator(model="planar"))
         assert accuracy.usable(ts.status).all()
         a, e = elements(ts, system)
         # weak on the orbital time scale: < 3e-3 of a per orbit; near-circular throughout
@@ -358,7 +360,8 @@ def test_planar_and_3d_models_agree_on_a_planar_perturbed_run():
                      tso.YORP("secondary", coefficient=1e-3, strength=1e6),
                      tso.BYORP(coefficient=1e-3, strength=1e3)]
     runs = [tso.time_series(system, 0.0, [1.2], orbits=3, samples_per_orbit=16,
-                            perturbations=perturbations, model=m, rtol=1e-13, states=True)
+                            perturbations=perturbations, rtol=1e-13, states=True,
+                            integrator=tso.Integrator(model=m))
             for m in ("planar", "3d")]
     planar, full = runs
     scale = np.abs(planar.states[0]).max(axis=0)
@@ -425,7 +428,8 @@ def test_3d_kernel_matches_an_independent_integration_with_tilted_spins():
     start = system.tilted_start(20.0, 2.5, pitch=30.0, roll=10.0, spin_x=0.4, inclination=10.0,
                                 primary_tilt=25.0)
     ts = tso.time_series(system, initial_states=[start], orbits=3, samples_per_orbit=8,
-                         perturbations=perturbations, model="3d", rtol=1e-12, states=True)
+                         perturbations=perturbations, rtol=1e-12, states=True,
+                         integrator=tso.Integrator(model="3d"))
     assert accuracy.usable(ts.status).all()
     st = ts.states[0]
     S1, S2 = st[:, 6:15].reshape(-1, 3, 3), st[:, 18:27].reshape(-1, 3, 3)
@@ -478,9 +482,9 @@ def test_a_perturbed_member_whose_accounting_fails_is_flagged_inaccurate():
      "system must be a ti_spinorbit.BinarySystem (got '1991 VH')"),
     (lambda: tso.Tides.rubble_pile(radius_m=-5.0), ValueError,
      "radius_m must be a finite number > 0"),
-    (lambda: tso.perturbations.check_perturbations([tso.Tides(), tso.Tides(k2=1e-3)]),
+    (lambda: tso.model.perturbations.check_perturbations([tso.Tides(), tso.Tides(k2=1e-3)]),
      ValueError, "perturbations[1]: a second tides on the secondary"),
-    (lambda: tso.perturbations.check_perturbations([tso.Tides(), "yorp"]), TypeError,
+    (lambda: tso.model.perturbations.check_perturbations([tso.Tides(), "yorp"]), TypeError,
      "perturbations[1] must be a Tides, YORP or BYORP object"),
 ])
 def test_perturbation_inputs_are_refused_in_one_line_naming_the_parameter(make, error, message):
@@ -491,7 +495,7 @@ def test_perturbation_inputs_are_refused_in_one_line_naming_the_parameter(make, 
 
 
 def test_a_tide_on_each_body_is_accepted():
-    items = tso.perturbations.check_perturbations([tso.Tides("primary"), tso.Tides("secondary"),
+    items = tso.model.perturbations.check_perturbations([tso.Tides("primary"), tso.Tides("secondary"),
                                                    tso.YORP("primary"), tso.YORP("secondary")])
     assert [p.slot for p in items] == [("tides", "primary"), ("tides", "secondary"),
                                        ("yorp", "primary"), ("yorp", "secondary")]

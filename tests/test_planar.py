@@ -1,7 +1,7 @@
 """The planar model (kernels/planar_eom.py) against the general 3-D model.
 
 Independent routes: the planar potential's coefficients come from moment-tensor contractions
-with Legendre polynomials (ti_spinorbit/planar.py), the 3-D kernel uses explicit monomial
+with Legendre polynomials (ti_spinorbit/model/planar.py), the 3-D kernel uses explicit monomial
 tables, and the 3-D kernel is itself checked against the NumPy tensor reference
 (test_reference.py). Here: the planar right-hand side equals the 3-D one mapped through the
 state conversion; trajectories converge to each other as the tolerance shrinks; the 3-D model
@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import planar as PL
-from ti_spinorbit.ensemble import Ensemble
+from ti_spinorbit.model import planar as PL
+from ti_spinorbit.engine.ensemble import Ensemble
 from ti_spinorbit.kernels import advance as K
-from ti_spinorbit.members import Members
+from ti_spinorbit.engine.members import Members
 
 
 def rz(t):
@@ -72,7 +72,7 @@ def test_planar_rhs_equals_the_3d_rhs(rng, which, order, odd):
     if odd != (which == 2) and order >= 3:
         pytest.skip("odd=True exactly for the body with odd integrals")
     table = Members.from_starts(system, [0.0] * 4, [1.0] * 4, 1000.0)
-    members, par, y0 = table.systems, table.par, table.y0
+    par, y0 = table.par, table.y0
     y = random_planar_states(rng, par, y0)
     f3 = np.zeros_like(y)
     K.SPATIAL.evaluate_rhs(par, y, f3, order, odd)
@@ -102,7 +102,7 @@ def test_fourier_coefficients_reproduce_the_legendre_terms(rng):
 def test_model_choice_and_clear_errors():
     vh = tso.catalog.system("1991 VH")
     table = Members.from_starts(vh, [0.0, 30.0], [1.0, 1.5], 1000.0)
-    members, par, y0 = table.systems, table.par, table.y0
+    par, y0 = table.par, table.y0
     assert np.all(PL.qualifies(par, y0))
     assert Ensemble(par, y0).model == "planar"
     assert Ensemble(par, y0, model="3d").model == "3d"

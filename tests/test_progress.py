@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import compiling, progress
-from ti_spinorbit.progress import Progress, eta_seconds, format_duration
+from ti_spinorbit.engine import compiling, progress
+from ti_spinorbit.engine.progress import Progress, eta_seconds, format_duration
 
 STARTS = [0.83, 1.63]
 
@@ -145,12 +145,12 @@ def test_compile_time_is_announced_and_left_out_of_elapsed_and_eta(tty):
 @pytest.mark.parametrize("value", [5, "bar", 1.0, [1]])
 def test_bad_progress_is_a_type_error_naming_the_argument(vh, value):
     with pytest.raises(TypeError, match=r"^progress must be True, False, None or a callable "):
-        tso.surface_of_section(vh, 0.0, STARTS, orbits=2, progress=value)
+        tso.surface_of_section(vh, 0.0, STARTS, orbits=2, run=tso.Run(progress=value))
 
 
 def test_results_are_identical_whatever_progress_is(vh, capsys):
     fractions = []
-    runs = [tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10, progress=p)
+    runs = [tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10, run=tso.Run(progress=p))
             for p in (None, False, True, fractions.append)]
     for r in runs[1:]:
         np.testing.assert_array_equal(r.theta_p, runs[0].theta_p)
@@ -185,17 +185,19 @@ def test_default_progress_is_on_in_jupyter(monkeypatch):
 
 ENTRY_POINTS = {
     "time_series": lambda vh, p: tso.time_series(vh, 0.0, STARTS, 2, samples_per_orbit=8,
-                                                 rtol=1e-10, progress=p),
-    "chaos_map": lambda vh, p: tso.chaos_map(vh, [0.0, 90.0], [1.0], orbits=8, progress=p),
+                                                 rtol=1e-10, run=tso.Run(progress=p)),
+    "chaos_map": lambda vh, p: tso.chaos_map(vh, [0.0, 90.0], [1.0], orbits=8,
+                                             run=tso.Run(progress=p)),
     "parameter_map": lambda vh, p: tso.parameter_map("1991 VH", [1.2], [0.05], orbits=8,
                                                      theta_p=[0.0], thetadot_p=[1.0],
-                                                     progress=p),
+                                                     run=tso.Run(progress=p)),
     "libration_amplitude": lambda vh, p: tso.libration_amplitude(vh, [0.8, 0.9], 2,
-                                                                 samples_per_orbit=16,
-                                                                 rtol=1e-10, progress=p),
-    "overlap_threshold": lambda vh, p: tso.overlap_threshold(
-        "1991 VH", elongations=[1.05], orbits=4, max_orbits=8, centre_starts=2,
-        separatrix_starts=2, progress=p),
+                                                                 samples_per_orbit=16, rtol=1e-10,
+                                                                 run=tso.Run(progress=p)),
+    "overlap_threshold": lambda vh, p: tso.overlap_threshold("1991 VH", elongations=[1.05],
+                                                             orbits=4, max_orbits=8,
+                                                             centre_starts=2, separatrix_starts=2,
+                                                             run=tso.Run(progress=p)),
 }
 
 
@@ -216,7 +218,7 @@ def test_chaos_map_progress_covers_the_shorter_lengths(vh):
     """The fraction-against-length runs (orbits/4, orbits/2 first) are 3/7 of the work: the
     bar moves during them instead of waiting at 0 %."""
     fractions = []
-    tso.chaos_map(vh, [0.0, 90.0], [1.0], orbits=8, progress=fractions.append)
+    tso.chaos_map(vh, [0.0, 90.0], [1.0], orbits=8, run=tso.Run(progress=fractions.append))
     assert min(fractions) < 3.0 / 7.0 + 1e-12
     assert any(abs(f - 3.0 / 7.0) < 1e-12 for f in fractions)   # end of the shorter runs
 
@@ -244,8 +246,10 @@ def cold(monkeypatch, tmp_path):
 def test_compile_is_announced_once_and_left_out_of_seconds_and_rates(vh, cold, tmp_path):
     stream = io.StringIO()
     bar = Progress("section", stream=stream, tty=False)
-    first = tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10, progress=bar)
-    again = tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10, progress=bar)
+    first = tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10,
+                                   run=tso.Run(progress=bar))
+    again = tso.surface_of_section(vh, 0.0, STARTS, orbits=4, rtol=1e-10,
+                                   run=tso.Run(progress=bar))
     bar.close()
     text = stream.getvalue()
     assert text.count("compiling kernels") == 1 and len(cold) == 1
@@ -263,25 +267,25 @@ def test_compile_is_announced_once_and_left_out_of_seconds_and_rates(vh, cold, t
 def test_a_variant_in_the_disk_cache_is_not_announced(vh, cold, monkeypatch):
     stream = io.StringIO()
     tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10,
-                           progress=Progress("s", stream=stream, tty=False))
+                           run=tso.Run(progress=Progress("s", stream=stream, tty=False)))
     assert stream.getvalue().count("compiling kernels") == 1
     monkeypatch.setattr(compiling, "_SEEN", set())     # a new process, same disk cache
     stream = io.StringIO()
     tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10,
-                           progress=Progress("s", stream=stream, tty=False))
+                           run=tso.Run(progress=Progress("s", stream=stream, tty=False)))
     assert "compiling" not in stream.getvalue() and len(cold) == 2
     assert compiling._HOW["planar/plain/sections/order4/cash-karp"] == "loaded"
 
 
 def test_the_estimate_is_the_last_measurement(vh, cold, monkeypatch):
-    tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10, progress=False)
+    tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10, run=tso.Run(progress=False))
     records = compiling.read_records()
     records["planar/plain/sections/order4/cash-karp"].update(seconds=37.0, fingerprint="old")
     compiling._write_records(records)                   # kernels changed since: a compile
     monkeypatch.setattr(compiling, "_SEEN", set())
     stream = io.StringIO()
     tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10,
-                           progress=Progress("s", stream=stream, tty=False))
+                           run=tso.Run(progress=Progress("s", stream=stream, tty=False)))
     assert "(first use only, about 37 s)" in stream.getvalue()
 
 
@@ -309,7 +313,7 @@ def test_a_callable_gets_the_announcements_when_it_wants_them(vh, cold):
         def compiled(self, seconds):
             seen.append(("compiled", seconds))
 
-    tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10, progress=Callback())
+    tso.surface_of_section(vh, 0.0, STARTS, orbits=2, rtol=1e-10, run=tso.Run(progress=Callback()))
     assert isinstance(seen[0], str) and seen[0].startswith("compiling kernels for the planar")
     assert seen[1][0] == "compiled" and seen[1][1] >= 1.5 and seen[-1] == 1.0
 

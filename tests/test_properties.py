@@ -10,11 +10,12 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import ti_spinorbit as tso
-from ti_spinorbit import _validate, analytic
-from ti_spinorbit.classify import wrap_half_turn
-from ti_spinorbit.section import TimeSeriesResult
-from ti_spinorbit.observables import derive
-from ti_spinorbit.progress import eta_seconds, format_duration
+from ti_spinorbit import _validate
+from ti_spinorbit.model import analytic
+from ti_spinorbit.studies.classify import wrap_half_turn
+from ti_spinorbit.studies.section import TimeSeriesResult
+from ti_spinorbit.model.observables import derive
+from ti_spinorbit.engine.progress import eta_seconds, format_duration
 
 FAST = settings(max_examples=50, deadline=None)
 
@@ -163,7 +164,7 @@ def test_scaled_and_si_states_round_trip(system, seed):
 @FAST
 @given(systems())
 def test_scaled_body_rows_undo_to_si(system):
-    from ti_spinorbit.bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
+    from ti_spinorbit.system.bodies import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
 
     M, a = system.total_mass, system.a
     scale = np.array([M] + [M * a**2] * len(EXPONENTS_2) + [M * a**3] * len(EXPONENTS_3)

@@ -37,7 +37,8 @@ def test_import_prints_nothing():
 
 @pytest.mark.parametrize("code", [
     "import ti_spinorbit",
-    "import ti_spinorbit as tso; from ti_spinorbit import io, cli, plotting, classify, analytic",
+    "import ti_spinorbit as tso; from ti_spinorbit import cli; from ti_spinorbit.output import io, "
+    "plotting; from ti_spinorbit.studies import classify; from ti_spinorbit.model import analytic",
     # describing a system and printing it is not a computation either
     "import ti_spinorbit as tso; s = tso.catalog.system('1991 VH'); repr(s); s._repr_html_(); "
     "s.omega0, s.orbital_period",

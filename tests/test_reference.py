@@ -1,4 +1,4 @@
-"""Physics tests of the NumPy reference (ti_spinorbit.reference) against exact oracles.
+"""Physics tests of the NumPy reference (ti_spinorbit.model.reference) against exact oracles.
 
 Sources of the expected values: docs/physics.md §11 (exact ellipsoid potential,
 sphere–ellipsoid closed form, quadrature, point-cloud pairwise sums, truncation-error table,
@@ -11,8 +11,8 @@ import sys
 import numpy as np
 import pytest
 
-from ti_spinorbit import reference as ref
-from ti_spinorbit.bodies import Body, Ellipsoid, Sphere
+from ti_spinorbit.model import reference as ref
+from ti_spinorbit.system.bodies import Body, Ellipsoid, Sphere
 
 sys.path.insert(0, os.path.dirname(__file__))
 import oracles  # noqa: E402  (test helper next to this file)

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import accuracy, cli
+from ti_spinorbit import cli
+from ti_spinorbit.engine import accuracy
 from ti_spinorbit.cli import common
 from ti_spinorbit.kernels.advance import (COLLISION, DONE, ESCAPE, INACCURATE, NONFINITE,
                                            STATUS_NAMES, STEP_UNDERFLOW)
@@ -69,7 +70,7 @@ def test_verdict_does_not_modify_its_input():
 
 def test_status_table_names_the_new_status():
     assert STATUS_NAMES[INACCURATE] == "inaccurate"
-    assert tso.io.status_codes()[INACCURATE] == "inaccurate"
+    assert tso.output.io.status_codes()[INACCURATE] == "inaccurate"
     assert accuracy.counts([DONE, INACCURATE, INACCURATE]) == {"done": 1, "inaccurate": 2}
 
 
@@ -131,8 +132,8 @@ def test_time_series_drift_is_the_largest_over_its_samples():
 
 
 def test_a_nan_in_any_sample_makes_the_member_non_finite():
-    from ti_spinorbit.ensemble import RunOutput
-    from ti_spinorbit.section import _sampled_drifts
+    from ti_spinorbit.engine.ensemble import RunOutput
+    from ti_spinorbit.studies.section import _sampled_drifts
 
     diag = np.zeros((2, 14))
     diag[:, 0] = -1.0
@@ -191,7 +192,7 @@ def test_chaos_map_verdict_survives_save_and_load(loose_map, tmp_path):
     assert back.n_inaccurate == 4 and back.max_drift == loose_map.max_drift
     np.testing.assert_array_equal(back.status, loose_map.status)
     np.testing.assert_array_equal(back.energy_drift, loose_map.energy_drift)
-    meta = tso.io.read_metadata(tmp_path / "m.npz")
+    meta = tso.output.io.read_metadata(tmp_path / "m.npz")
     assert meta["units"]["energy_drift"] == "1 (relative)"
     assert meta["status_counts"]["inaccurate"] == 4
 
@@ -214,7 +215,7 @@ def test_overlap_decisions_leave_inaccurate_trajectories_out():
 
 
 def test_libration_amplitude_is_nan_for_an_inaccurate_member():
-    from ti_spinorbit.libration import libration_amplitude
+    from ti_spinorbit.studies.libration import libration_amplitude
 
     # dense samples cap the step, so even rtol 1e-4 drifts only ~4e-6 here: ask for less
     bad = libration_amplitude(VH, 0.6, orbits=3, samples_per_orbit=32, rtol=1e-4,
@@ -329,7 +330,7 @@ def test_io_save_keeps_an_upper_case_extension(tight, tmp_path):
 
 
 def test_cli_plotting_failure_keeps_the_data(tmp_path, monkeypatch, capsys):
-    from ti_spinorbit import plotting
+    from ti_spinorbit.output import plotting
 
     def broken(ax, path):
         raise RuntimeError("disk full")

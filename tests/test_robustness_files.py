@@ -25,11 +25,11 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import checkpoint as C
-from ti_spinorbit import io
-from ti_spinorbit.io import ArchiveError
+from ti_spinorbit.engine import checkpoint as C
+from ti_spinorbit.output import io
+from ti_spinorbit.output.io import ArchiveError
 
-from conftest import run_cli
+from conftest import run_cli, run_options
 
 STARTS = [0.83, 1.63]
 ARGS = dict(orbits=20, rtol=1e-10, window_orbits=4)
@@ -43,7 +43,7 @@ def windows(ckpt):
 
 
 def run(vh, ckpt=None, starts=STARTS, **kw):
-    return tso.surface_of_section(vh, 0.0, starts, checkpoint=ckpt, **{**ARGS, **kw})
+    return tso.surface_of_section(vh, 0.0, starts, **run_options(**{**ARGS, **kw}, checkpoint=ckpt))
 
 
 def assert_same(a, b):
@@ -114,7 +114,7 @@ def test_held_lock_refuses_a_second_writer_at_once_and_names_the_holder(vh, ckpt
 
 HOLD = """
 import sys
-from ti_spinorbit import checkpoint as C
+from ti_spinorbit.engine import checkpoint as C
 with C.claim(sys.argv[1], resume=True):
     print("held", flush=True)
     sys.stdin.read()
@@ -172,8 +172,11 @@ def progress(fraction):
     if fraction < 1:
         print("held", flush=True)
         sys.stdin.readline()
-tso.surface_of_section(tso.catalog.system("1991 VH"), 0.0, {starts}, checkpoint=sys.argv[1],
-                       progress=progress, **{args})
+args = {args}
+window_orbits = args.pop("window_orbits")
+tso.surface_of_section(tso.catalog.system("1991 VH"), 0.0, {starts}, **args,
+                       run=tso.Run(checkpoint=sys.argv[1], progress=progress,
+                                   window_orbits=window_orbits))
 """
 
 
@@ -190,7 +193,7 @@ def test_a_running_integration_holds_the_lock_between_windows(vh, tmp_path, whol
         assert owner["pid"] == p.pid and owner["command"].startswith("-c")
         for resume in (True, False):
             with pytest.raises(C.CheckpointLocked, match=rf"locked by another run: pid {p.pid} "):
-                run(vh, ckpt, resume=resume, overwrite_checkpoint=True)
+                run(vh, ckpt, resume=resume, overwrite=True)
         p.stdin.write("\n" * MAX_WINDOWS)
         p.stdin.close()
         assert p.wait(timeout=300) == 0
@@ -245,13 +248,13 @@ def test_soft_lock_of_a_dead_process_does_not_block(vh, ckpt, whole, monkeypatch
 def entry_points(vh, ckpt, **kw):
     return {
         "section": lambda: run(vh, ckpt, **kw),
-        "time_series": lambda: tso.time_series(vh, 0.0, STARTS, checkpoint=ckpt,
-                                               samples_per_orbit=4, **ARGS, **kw),
-        "chaos_map": lambda: tso.chaos_map(vh, [0.0, 90.0], [1.0], orbits=8, checkpoint=ckpt,
-                                           **kw),
+        "time_series": lambda: tso.time_series(vh, 0.0, STARTS, samples_per_orbit=4,
+                                               **run_options(**ARGS, **kw, checkpoint=ckpt)),
+        "chaos_map": lambda: tso.chaos_map(vh, [0.0, 90.0], [1.0], orbits=8,
+                                           **run_options(**kw, checkpoint=ckpt)),
         "parameter_map": lambda: tso.parameter_map("1991 VH", [1.2], [0.05], orbits=8,
                                                    theta_p=[0.0], thetadot_p=[1.0],
-                                                   checkpoint=ckpt, **kw),
+                                                   **run_options(**kw, checkpoint=ckpt)),
     }
 
 
@@ -259,8 +262,9 @@ def entry_points(vh, ckpt, **kw):
 def test_checkpoint_of_another_run_is_not_overwritten(vh, ckpt, entry):
     before = snapshot(ckpt)
     with pytest.raises(C.CheckpointExists,
-                       match=r"already holds a checkpoint of an earlier run; pass resume=True "
-                             r"to continue it or overwrite_checkpoint=True to replace it"):
+                       match=r"already holds a checkpoint of an earlier run; pass "
+                             r"Run\(resume=True\) to continue it or Run\(overwrite=True\) "
+                             r"to replace it"):
         entry_points(vh, ckpt)[entry]()
     assert snapshot(ckpt) == before
     assert isinstance(C.CheckpointExists("x"), ValueError)
@@ -268,7 +272,7 @@ def test_checkpoint_of_another_run_is_not_overwritten(vh, ckpt, entry):
 
 @pytest.mark.parametrize("entry", ["section", "chaos_map"])
 def test_overwrite_checkpoint_replaces_it(vh, ckpt, entry):
-    result = entry_points(vh, ckpt, overwrite_checkpoint=True)[entry]()
+    result = entry_points(vh, ckpt, overwrite=True)[entry]()
     again = entry_points(vh, ckpt, resume=True)[entry]()     # resumes the new run, finished
     if entry == "section":
         assert_same(result, again)
@@ -665,7 +669,7 @@ def test_format_99_is_still_called_newer_and_valid_files_load(archive, tmp_path)
     with pytest.raises(ArchiveError, match="a newer package wrote it"):
         tso.load(with_meta(good, tmp_path / "f.npz", format_version=99))
     assert_same(result, tso.load(good))
-    assert io.ArchiveError is tso.io.ArchiveError and "ArchiveError" in io.__all__
+    assert io.ArchiveError is tso.output.io.ArchiveError and "ArchiveError" in io.__all__
 
 
 def test_missing_path_is_still_file_not_found(tmp_path):

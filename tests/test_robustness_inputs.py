@@ -17,7 +17,7 @@ import pytest
 
 import ti_spinorbit as tso
 from ti_spinorbit import _validate
-from ti_spinorbit.overlap import overlap_vs_eccentricity
+from ti_spinorbit.studies.overlap import overlap_vs_eccentricity
 
 from conftest import run_cli
 
@@ -140,7 +140,8 @@ TYPES = [
      r"^orbits must be a number, not a bool"),
     ("section-rtol-list", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, rtol=[1e-10]),
      TypeError, r"^rtol must be a single number, not a list"),
-    ("section-atol-text", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, atol="1e-12"),
+    ("section-atol-text", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1,
+                                                            integrator=tso.Integrator(atol="1e-12")),
      TypeError, r"^atol must be a number \(got '1e-12'\)"),
     ("section-theta-complex", lambda vh: tso.surface_of_section(vh, 1j, 1.0, 1), TypeError,
      r"^theta_p must be a real number, not complex \(got 1j\)"),
@@ -153,14 +154,16 @@ TYPES = [
      r"^theta_p must be a number \(got None\)"),
     ("section-thetadot-text", lambda vh: tso.surface_of_section(vh, 0, "fast", 1), TypeError,
      r"^thetadot_p must be a number \(got 'fast'\)"),
-    ("section-order-bool", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, order=True),
+    ("section-order-bool", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1,
+                                                             integrator=tso.Integrator(order=True)),
      TypeError, r"^order must be one of the integers 0, 2, 3, 4 \(got True\)"),
     ("section-progress-not-callable",
-     lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, progress=5), TypeError,
+     lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, run=tso.Run(progress=5)), TypeError,
      r"^progress must be True, False, None or a callable progress\(fraction\) \(got 5\)"),
     ("section-system-number", lambda vh: tso.surface_of_section(5, 0, 1.0, 1), TypeError,
      r"^system must be a BinarySystem, a catalogue name or a non-empty list of them \(got 5\)"),
-    ("section-window-text", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1, window_orbits="16"),
+    ("section-window-text", lambda vh: tso.surface_of_section(vh, 0, 1.0, 1,
+                                                              run=tso.Run(window_orbits="16")),
      TypeError, r"^window_orbits must be a number \(got '16'\)"),
     ("time-series-orbits-none", lambda vh: tso.time_series(vh, 0, 1.0, None), TypeError,
      r"^orbits must be a number \(got None\)"),
@@ -197,8 +200,8 @@ TYPES = [
      r"^separatrix_starts must be an integer in \[2, 100000\] \(got 2\.5\)"),
     ("overlap-orbits-list", lambda vh: _ov(vh, orbits=[5]), TypeError,
      r"^orbits must be a single number, not a list"),
-    ("overlap-rtol-none", lambda vh: _ov(vh, rtol=None), TypeError,
-     r"^rtol must be a number \(got None\)"),
+    ("overlap-rtol-text", lambda vh: _ov(vh, rtol="1e-10"), TypeError,   # None: the default
+     r"^rtol must be a number \(got '1e-10'\)"),
     ("overlap-eccentricity-list", lambda vh: _ov(vh, eccentricity=[0.1]), TypeError,
      r"^eccentricity must be a single number, not a list"),
     ("overlap-elongations-complex", lambda vh: _ov(vh, elongations=[1.02j]), TypeError,
@@ -215,7 +218,8 @@ TYPES = [
      r"^orbits must be a single number, not a list"),
     ("libration-xtol-text", lambda vh: tso.relaxed_libration(vh, orbits=5, xtol="1e-6"),
      TypeError, r"^xtol must be a number \(got '1e-6'\)"),
-    ("libration-progress", lambda vh: tso.relaxed_libration(vh, orbits=5, progress="bar"),
+    ("libration-progress", lambda vh: tso.relaxed_libration(vh, orbits=5,
+                                                            run=tso.Run(progress="bar")),
      TypeError, r"^progress must be True, False, None or a callable progress\(fraction\) \(got 'bar'\)"),
     ("libration-amplitude-orbits-text",
      lambda vh: tso.libration_amplitude(vh, 1.0, orbits="5"), TypeError,

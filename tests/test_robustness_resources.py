@@ -13,8 +13,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit.members import Members
-from ti_spinorbit import _validate, cli, ensemble, overlap, resources, runtime
+from ti_spinorbit.engine.members import Members
+from ti_spinorbit import _validate, cli, runtime
+from ti_spinorbit.engine import ensemble, resources
+from ti_spinorbit.studies import overlap
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXPERIMENT = os.path.join(ROOT, "experiments", "memory_estimate.py")
@@ -96,8 +98,10 @@ def test_perturbed_runs_count_their_accumulator_columns(vh, monkeypatch, model, 
 
     monkeypatch.setattr(resources, "check_memory", spy)
     tide = tso.Tides(k2=1e-5, time_lag=600.0)
-    tso.surface_of_section(vh, 0.0, [1.0], orbits=0.1, model=model, perturbations=[tide])
-    tso.chaos_map(vh, [0.0], [1.0], orbits=0.1, model=model, perturbations=[tide])
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=0.1, perturbations=[tide],
+                           integrator=tso.Integrator(model=model))
+    tso.chaos_map(vh, [0.0], [1.0], orbits=0.1, perturbations=[tide],
+                  integrator=tso.Integrator(model=model))
     assert len(widths) >= 2 and set(widths) == {width}   # the map checks its nested runs too
 
 
@@ -207,11 +211,11 @@ def test_forced_short_windows_are_bit_identical(vh, monkeypatch, kind):
         calls = []
         if kind == "time_series":
             r = tso.time_series(vh, 0.0, [0.83, 1.63], 12, samples_per_orbit=16,
-                                progress=calls.append)
+                                run=tso.Run(progress=calls.append))
         else:
             r = tso.surface_of_section(vh, 0.0, [0.83, 1.63], 12, rtol=1e-10,
                                        indicators=kind.endswith("indicators"),
-                                       progress=calls.append)
+                                       run=tso.Run(progress=calls.append))
         return r, calls
 
     default, default_calls = run()
@@ -226,7 +230,7 @@ def test_short_windows_checkpoint_resume_with_default_windows(vh, monkeypatch, t
     an uninterrupted default run (window ends are soft; window_orbits, which the checkpoint
     records, is unchanged)."""
     ckpt = tmp_path / "run.ckpt"
-    args = dict(orbits=10, rtol=1e-10, window_orbits=4)
+    args = dict(orbits=10, rtol=1e-10)
     calls = []
 
     def stop_after_some(fraction):
@@ -236,12 +240,14 @@ def test_short_windows_checkpoint_resume_with_default_windows(vh, monkeypatch, t
 
     monkeypatch.setattr(ensemble, "PROGRESS_SECONDS", 0.0)
     with pytest.raises(KeyboardInterrupt):
-        tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=ckpt, progress=stop_after_some,
-                               **args)
+        tso.surface_of_section(vh, 0.0, [0.83, 1.63], **args,
+                               run=tso.Run(checkpoint=ckpt, progress=stop_after_some,
+                                           window_orbits=4))
     assert 0 < calls[-1] < 1
     monkeypatch.setattr(ensemble, "PROGRESS_SECONDS", 1.0)
-    resumed = tso.surface_of_section(vh, 0.0, [0.83, 1.63], checkpoint=ckpt, resume=True, **args)
-    whole = tso.surface_of_section(vh, 0.0, [0.83, 1.63], **args)
+    resumed = tso.surface_of_section(vh, 0.0, [0.83, 1.63], **args,
+                                     run=tso.Run(checkpoint=ckpt, resume=True, window_orbits=4))
+    whole = tso.surface_of_section(vh, 0.0, [0.83, 1.63], **args, run=tso.Run(window_orbits=4))
     _fields_equal(resumed, whole)
 
 

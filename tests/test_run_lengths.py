@@ -1,9 +1,9 @@
-"""The shared loop of the length-convergence checks (ti_spinorbit.convergence.run_lengths):
+"""The shared loop of the length-convergence checks (ti_spinorbit.engine.convergence.run_lengths):
 stages in order with their share of the progress, stopped when settled."""
 
 import pytest
 
-from ti_spinorbit.convergence import run_lengths
+from ti_spinorbit.engine.convergence import run_lengths
 
 
 def test_every_length_runs_in_order_with_its_share_of_the_progress():

@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import checkpoint as C
+from ti_spinorbit.engine import checkpoint as C
 
-from conftest import run_cli
+from conftest import run_cli, run_options
 
 THETA, RATES = [0.0, 90.0], [0.8, 1.2, 1.6]
 MAP = dict(orbits=8, rtol=1e-8)
@@ -75,7 +75,7 @@ def assert_same(a, b):
 
 
 def chaos(vh, **kw):
-    return tso.chaos_map(vh, THETA, RATES, **MAP, **kw)
+    return tso.chaos_map(vh, THETA, RATES, **run_options(**MAP, **kw))
 
 
 @pytest.fixture(scope="module")
@@ -142,31 +142,34 @@ def test_map_interrupted_at_every_window_then_resumed_each_time(vh, whole, windo
 def test_parameter_map_interrupted_in_its_evidence_resumes_bit_identical(tmp_path, saves):
     kw = dict(elongations=[1.2], eccentricities=[0.05], orbits=6, thetadot_p=[0.9, 1.5],
               theta_p=[0.0], rtol=1e-8)
-    whole = tso.parameter_map("1991 VH", progress=False, **kw)
+    whole = tso.parameter_map("1991 VH", **kw, run=tso.Run(progress=False))
     ckpt = tmp_path / "ck"
     with pytest.raises(KeyboardInterrupt):
-        tso.parameter_map("1991 VH", checkpoint=ckpt, progress=Interrupt(2), **kw)
+        tso.parameter_map("1991 VH", **kw, run=tso.Run(checkpoint=ckpt, progress=Interrupt(2)))
     assert saves[-1] in ("launch-000", "launch-001")
-    resumed = tso.parameter_map("1991 VH", checkpoint=ckpt, resume=True, progress=False, **kw)
+    resumed = tso.parameter_map("1991 VH", **kw,
+                                run=tso.Run(checkpoint=ckpt, resume=True, progress=False))
     assert_same(resumed, whole)
 
 
 def test_overlap_doubling_interrupted_in_a_longer_length_resumes(tmp_path, saves):
     kw = dict(elongations=[1.05, 1.3], orbits=4, max_orbits=8, rtol=1e-8, centre_starts=3,
               separatrix_starts=3)
-    whole = tso.overlap_threshold("1991 VH", progress=False, **kw)
+    whole = tso.overlap_threshold("1991 VH", **kw, run=tso.Run(progress=False))
     ckpt = tmp_path / "ck"
     full = []
-    tso.overlap_threshold("1991 VH", checkpoint=tmp_path / "count", progress=False, **kw)
+    tso.overlap_threshold("1991 VH", **kw,
+                          run=tso.Run(checkpoint=tmp_path / "count", progress=False))
     full = sorted(p.name for p in (tmp_path / "count").iterdir() if p.is_dir())
     assert len(full) >= 2, full          # the doubling ran a second length
     first = len(list((tmp_path / "count" / "launch-000").glob("records-*.npz")))
     with pytest.raises(KeyboardInterrupt):
-        tso.overlap_threshold("1991 VH", checkpoint=ckpt, progress=Interrupt(first + 1), **kw)
+        tso.overlap_threshold("1991 VH", **kw,
+                              run=tso.Run(checkpoint=ckpt, progress=Interrupt(first + 1)))
     assert saves[-1] == "launch-001"
     saves.clear()
-    resumed = tso.overlap_threshold("1991 VH", checkpoint=ckpt, resume=True, progress=False,
-                                    **kw)
+    resumed = tso.overlap_threshold("1991 VH", **kw,
+                                    run=tso.Run(checkpoint=ckpt, resume=True, progress=False))
     assert "launch-000" not in saves
     assert_same(resumed, whole)
     np.testing.assert_array_equal(resumed.overlaps_by_length, whole.overlaps_by_length)
@@ -195,7 +198,7 @@ def test_overwrite_replaces_every_stage_and_remove_deletes_them(vh, whole, tmp_p
         chaos(vh, checkpoint=ckpt, progress=Interrupt(1))
     (ckpt / "launch-007").mkdir()      # a stale launch of some longer computation
     assert C.holds_checkpoint(ckpt)
-    fresh = chaos(vh, checkpoint=ckpt, overwrite_checkpoint=True, progress=False)
+    fresh = chaos(vh, checkpoint=ckpt, overwrite=True, progress=False)
     assert_same(fresh, whole)
     assert not (ckpt / "launch-007").exists()
     C.remove(ckpt)
@@ -205,22 +208,22 @@ def test_overwrite_replaces_every_stage_and_remove_deletes_them(vh, whole, tmp_p
 def test_resume_refused_after_a_perturbation_changed_names_it(vh, tmp_path):
     tide = tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6)
     ckpt = tmp_path / "ck"
-    tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=ckpt,
-                           perturbations=[tide], progress=False)
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, perturbations=[tide],
+                           run=tso.Run(checkpoint=ckpt, progress=False))
     stronger = dataclasses.replace(tide, strength=2e6)
     with pytest.raises(C.CheckpointError, match=r"other inputs \(perturbations \(tides, YORP, "
                                                 r"BYORP or their parameters\) differ\)"):
-        tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=ckpt,
-                               resume=True, perturbations=[stronger], progress=False)
+        tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, perturbations=[stronger],
+                               run=tso.Run(checkpoint=ckpt, resume=True, progress=False))
     with pytest.raises(C.CheckpointError, match=r"other inputs \(initial states differ\)"):
-        tso.surface_of_section(vh, 0.0, [1.1], orbits=2, rtol=1e-8, checkpoint=ckpt,
-                               resume=True, perturbations=[tide], progress=False)
+        tso.surface_of_section(vh, 0.0, [1.1], orbits=2, rtol=1e-8, perturbations=[tide],
+                               run=tso.Run(checkpoint=ckpt, resume=True, progress=False))
 
 
 def test_map_inputs_that_are_refused_before_any_work(vh, tmp_path):
     with pytest.raises(ValueError, match="fraction_orbits must hold distinct lengths"):
         chaos(vh, fraction_orbits=[5, 5])
-    with pytest.raises(TypeError, match="chaos_map takes a grid of starts"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'initial_states'"):
         chaos(vh, initial_states=[vh.tilted_start(0.0, 1.0, roll=1.0, pitch=0.0)])
     with pytest.raises(TypeError, match="checkpoint must be a directory path"):
         chaos(vh, checkpoint=123)
@@ -264,11 +267,11 @@ def test_cli_map_killed_in_its_evidence_resumes_to_the_same_data(tmp_path):
 
 def test_a_single_run_and_a_staged_checkpoint_are_not_confused(vh, tmp_path):
     single, staged = tmp_path / "single", tmp_path / "staged"
-    tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=single,
-                           progress=False)
+    tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8,
+                           run=tso.Run(checkpoint=single, progress=False))
     with pytest.raises(C.CheckpointError, match="holds a single run's checkpoint"):
         chaos(vh, checkpoint=single, resume=True, progress=False)
     chaos(vh, checkpoint=staged, progress=False)
     with pytest.raises(C.CheckpointError, match=r"holds the launches \(launch-kkk\)"):
-        tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, checkpoint=staged,
-                               resume=True, progress=False)
+        tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8,
+                               run=tso.Run(checkpoint=staged, resume=True, progress=False))

@@ -19,10 +19,11 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import analytic, cli
+from ti_spinorbit import cli
+from ti_spinorbit.model import analytic
 from ti_spinorbit.cli import options
-from ti_spinorbit import perturbations as tsp
-from ti_spinorbit.bodies import Sphere
+from ti_spinorbit.model import perturbations as tsp
+from ti_spinorbit.system.bodies import Sphere
 
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "experiments")
 
@@ -107,7 +108,8 @@ def test_integrated_work_over_one_orbit(convention, thetadot, orbits_of_energy):
     system = spheres()
     yorp = tso.YORP(coefficient=1e-3, convention=convention, **HELIO)
     ts = tso.time_series(system, 0.0, [thetadot], orbits=1, samples_per_orbit=8,
-                         perturbations=[yorp], model="planar", rtol=1e-12, states=True)
+                         perturbations=[yorp], rtol=1e-12, states=True,
+                         integrator=tso.Integrator(model="planar"))
     assert ts.status_names == ["done"]
     P, T, C = system.orbital_period, yorp.torque(system), system.secondary.moments[2]
     assert ts.t[0, -1] == pytest.approx(P, rel=1e-12)
@@ -129,7 +131,8 @@ def test_the_convention_round_trips_through_descriptions_and_files(tmp_path):
     # through a saved result
     system = spheres()
     ts = tso.time_series(system, 0.0, [2.0], orbits=0.25, samples_per_orbit=8,
-                         perturbations=[items[0]], model="planar", rtol=1e-10)
+                         perturbations=[items[0]], rtol=1e-10,
+                         integrator=tso.Integrator(model="planar"))
     path = tmp_path / "yorp.npz"
     tso.save(ts, str(path))
     assert tso.load(str(path)).perturbations == (items[0],)
@@ -158,7 +161,7 @@ def test_cli_yorp_convention_flag(tmp_path, capsys):
 # ---- study 9: the paper's Fig. 11 starts are inertial ------------------------------------------
 
 def test_study09_starts_are_inertial_and_give_the_papers_four_classes():
-    from ti_spinorbit.classify import classify_section
+    from ti_spinorbit.studies.classify import classify_section
 
     study = _experiment("study09_spin_rate")
     vh = tso.catalog.system("1991 VH")

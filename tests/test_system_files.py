@@ -14,8 +14,10 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit import _validate, catalog, cli, io
-from ti_spinorbit.systems import DERIVED_RTOL, G, read_system_file
+from ti_spinorbit import _validate, cli
+from ti_spinorbit.system import catalog
+from ti_spinorbit.output import io
+from ti_spinorbit.system.systems import DERIVED_RTOL, G, read_system_file
 
 DERIVED = ("mean_motion_rad_s", "mass_ratio", "omega0", "orbital_period_h")
 

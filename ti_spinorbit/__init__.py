@@ -20,28 +20,33 @@ _checkout = _Path(__file__).resolve().parent.parent
 if not (_Path(__file__).parent / "kernels").is_dir() and (_checkout / "kernels" / "__init__.py").is_file():
     __path__.append(str(_checkout))        # noqa: F821 (the package's own module __path__)
 
-from .bodies import Body, Ellipsoid, Sphere
-from .potential import mutual_potential
+from .system.bodies import Body, Ellipsoid, Sphere
+from .engine.evaluation import mutual_potential
 from .runtime import init
-from .section import SectionResult, TimeSeriesResult, surface_of_section, time_series
-from .systems import G, BinarySystem, ImplausibleInputWarning, NearCircularWarning
-from . import analytic, catalog
-from .chaosmap import chaos_map, parameter_map
-from .classify import classify_section
-from .libration import libration_amplitude, relaxed_libration
-from .overlap import overlap_threshold
-from .io import load, save
-from .xarray_io import to_xarray
-from .results import Result, Status
-from .initial import InitialState
-from .perturbations import BYORP, YORP, Tides
-from .warmup import warmup
+from .engine.options import Integrator, Run
+from .studies.section import SectionResult, TimeSeriesResult, surface_of_section, time_series
+from .system.systems import G, BinarySystem, ImplausibleInputWarning, NearCircularWarning
+from .model import analytic
+from .system import catalog
+from .studies.chaosmap import chaos_map, parameter_map
+from .studies.classify import classify_section
+from .studies.libration import libration_amplitude, relaxed_libration
+from .studies.overlap import overlap_threshold
+from .output.io import ArchiveError, load, read_metadata, save
+from .output.xarray_io import to_xarray
+from .output import plotting as _plotting  # noqa: F401 (fills results.FIGURES: every .plot())
+from .engine.results import Result, Status
+from .system.initial import InitialState
+from .model.perturbations import BYORP, YORP, Tides
+from .studies.warmup import warmup
 from ._version import __version__
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
+           "Integrator", "Run",
            "ImplausibleInputWarning", "NearCircularWarning", "InitialState",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
-           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "to_xarray", "Result",
+           "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "read_metadata",
+           "ArchiveError", "to_xarray", "Result",
            "Status", "warmup", "Tides", "YORP", "BYORP",
            "__version__"]

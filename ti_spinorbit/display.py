@@ -11,7 +11,6 @@ import math
 
 import numpy as np
 
-from .accuracy import usable
 
 #: Longest user-supplied name shown (longer ones are cut with "…").
 MAX_NAME = 40
@@ -187,7 +186,11 @@ def _time_series(r):
 
 
 def _fraction(r):
-    counted = int(usable(r.status, getattr(r, "include_inaccurate", False)).sum())
+    # the members a map counts: "done", and "inaccurate" where it counts them (the status
+    # names of the result's own table, so this base module needs no engine)
+    counts = r.status_counts
+    counted = counts.get("done", 0) + (counts.get("inaccurate", 0)
+                                       if getattr(r, "include_inaccurate", False) else 0)
     row = [("chaotic fraction", f"{number(r.chaotic_fraction, '.3g')} of {counted} counted")]
     if getattr(r, "megno_chaotic", None) is not None:
         row.append(("threshold ⟨Y⟩ >", number(r.megno_chaotic, "g")))

@@ -1,7 +1,7 @@
 """Writing files safely: atomic replaces, claimed output names, names that fit the folder.
 
-Every result file (:func:`ti_spinorbit.io.save`), figure
-(:func:`ti_spinorbit.plotting.save_figure`) and report of the command line is written through
+Every result file (:func:`ti_spinorbit.output.io.save`), figure
+(:func:`ti_spinorbit.output.plotting.save_figure`) and report of the command line is written through
 :func:`atomic_write`, and every run of the command line owns its output names through
 :func:`claim`. The decisions:
 

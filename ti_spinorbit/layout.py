@@ -12,12 +12,12 @@ layout is written once and nothing has to be kept in step by hand.
 
 (length a, time 1/n, mass m1 + m2; w = Γ/C), and a parameter row of the two bodies' rows
 (ROW_LENGTH each: the mass, then the inertia integrals T^{lmn} in the orders EXPONENTS_2,
-EXPONENTS_3, EXPONENTS_4, :meth:`ti_spinorbit.bodies.Body.as_row`) followed by the derived
+EXPONENTS_3, EXPONENTS_4, :meth:`ti_spinorbit.system.bodies.Body.as_row`) followed by the derived
 constants P_MRED ... P_ESCAPE.
 
 **Planar model** (``kernels/planar_eom.py``; docs/physics.md §5): the 10-number state
 [r, v_r, ℓ, λ, cos ψ_A, sin ψ_A, w1, cos ψ_B, sin ψ_B, w2] and a 37-column row of Fourier
-coefficients of the mutual potential (``ti_spinorbit.planar.parameter_rows``).
+coefficients of the mutual potential (``ti_spinorbit.model.planar.parameter_rows``).
 
 **Perturbations** (``kernels/perturb.py``; docs/physics.md §13): a block of NPERT columns after
 a model's row, and NACC accumulators (work W, external angular momentum L_ext) after its state.
@@ -26,7 +26,7 @@ a model's row, and NACC accumulators (work W, external angular momentum L_ext) a
 planar records are converted to it on the host.
 
 **Statuses**: the codes in every ``status`` array, archive and checkpoint
-(:class:`ti_spinorbit.results.Status` names them). Codes are never renumbered: files hold
+(:class:`ti_spinorbit.engine.results.Status` names them). Codes are never renumbered: files hold
 them.
 """
 
@@ -91,7 +91,7 @@ class perturbation:
 #: Columns of a 3-D event or sample record: the scaled time, then the 30-number state.
 RECORD_WIDTH = 1 + spatial.NSTATE
 
-#: Status codes (``ti_spinorbit.results.Status``): the kernels set RUNNING ... NONFINITE and
+#: Status codes (``ti_spinorbit.engine.results.Status``): the kernels set RUNNING ... NONFINITE and
 #: STEP_BUDGET; the host's accuracy check sets INACCURATE.
 RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE, INACCURATE, STEP_BUDGET = range(8)
 STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite",

@@ -1,6 +1,6 @@
 """Reading NumPy ``.npz`` archives that may be damaged or hostile, safely.
 
-Used by :mod:`ti_spinorbit.io` (saved results) and :mod:`ti_spinorbit.checkpoint` (records
+Used by :mod:`ti_spinorbit.output.io` (saved results) and :mod:`ti_spinorbit.engine.checkpoint` (records
 files). Entries are read one at a time and only when asked for; before anything is
 allocated, every entry's size in the zip directory is checked against its ``.npy`` header and
 against the largest ratio deflate can reach, so a small file cannot make a reader allocate

@@ -213,7 +213,7 @@ def current_arch():
 
 def disk_cache():
     """True when compiled kernels are kept in the offline cache on disk (so a variant compiled
-    by an earlier process is only loaded; ``ti_spinorbit.compiling``)."""
+    by an earlier process is only loaded; ``ti_spinorbit.engine.compiling``)."""
     return bool(_STATE.get("disk_cache"))
 
 

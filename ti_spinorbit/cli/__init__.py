@@ -15,7 +15,7 @@ figures    run the experiment scripts that reproduce the paper's studies (needs 
 
 Conventions: every flag is checked before any work starts; a bad value, like any other error
 in the inputs, prints ONE line naming the flag, the value and the allowed range, and exits with
-status 2 (no traceback). Long runs draw a progress bar on stderr (:mod:`ti_spinorbit.progress`:
+status 2 (no traceback). Long runs draw a progress bar on stderr (:mod:`ti_spinorbit.engine.progress`:
 a tqdm bar on a terminal, a line per 10 % elsewhere; ``--no-progress`` hides it), and the first
 use of a kernel variant says "compiling kernels ... (first use only, about N s)"; compile time
 is left out of elapsed times, ETAs and printed rates. ``--quiet`` prints nothing but errors.
@@ -25,13 +25,13 @@ File names: defaults carry every physics flag that differs from its default
 overwrites an existing output: it is refused before any work, naming the file, unless
 ``--overwrite``. The checkpoint directory of a run is removed once its outputs are written,
 unless ``--keep-checkpoint``. Data files are self-describing ``.npz``
-(:func:`ti_spinorbit.io.save`); figures are PNG (or PDF/SVG by the extension of ``--out``).
+(:func:`ti_spinorbit.output.io.save`); figures are PNG (or PDF/SVG by the extension of ``--out``).
 
 Outputs: every output path (and the Matplotlib backend) is checked before any work; the data
 file is written before the figure, so a plotting failure never loses a run's numbers.
 
 Accuracy: every member's energy and angular-momentum drift is held against a limit
-(``--max-drift``, default scaled with the tolerance and run length; ti_spinorbit.accuracy).
+(``--max-drift``, default scaled with the tolerance and run length; ti_spinorbit.engine.accuracy).
 Members above it are "inaccurate": kept in the data file, counted on stderr, and the command
 exits with status 3 (EXIT_INACCURATE) unless ``--allow-inaccurate``.
 
@@ -50,15 +50,16 @@ assembled from the subcommands, and :func:`main`."""
 import argparse
 import shlex
 import sys
+import warnings
 
-from . import (benchmark, energy, figures, libration, map, overlap, section, systems,
-               warmup)
+from ..system.systems import ImplausibleInputWarning
+from . import benchmark, common, energy, figures, libration, map, overlap, section, systems
+from . import warmup
 from .common import one_line, release_outputs
 from .options import DEBUG_HELP, CommandLineError, Parser
 # the names other modules and the tests import from ti_spinorbit.cli
-from .common import (EXIT_CHECK_FAILED, EXIT_ERROR, EXIT_INACCURATE,  # noqa: F401
-                     EXIT_INTERRUPTED, EXIT_OK, FIGURE_EXTENSIONS, NAME_TAGS, FigureError,
-                     default_stem)
+from .common import (EXIT_CHECK_FAILED, EXIT_ERROR, EXIT_INACCURATE, EXIT_INTERRUPTED, EXIT_OK,
+                     FIGURE_EXTENSIONS, NAME_TAGS, FigureError, default_stem)
 from .energy import energy_check  # noqa: F401
 from .libration import psi_phase  # noqa: F401
 from .options import MAX_SPIN, perturbation_summary  # noqa: F401
@@ -89,6 +90,9 @@ def _parser():
     return p
 
 
+common.PARSER[0] = _parser      # default_stem reads the flags' defaults through it
+
+
 def check_args(args):
     """Check a parsed command line beyond what argparse checked (every numeric flag's range:
     :class:`~.options.Bounded`): the relations between values, the system, the
@@ -101,9 +105,7 @@ def _checked_run(args):
     """check_args then the handler, with this package's input warnings (ImplausibleInputWarning:
     tiny bodies, a section at e ~ 0) printed once each as one line on stderr (none with
     --quiet); other warnings as Python shows them."""
-    import warnings
 
-    from ..systems import ImplausibleInputWarning
 
     shown = warnings.showwarning
 

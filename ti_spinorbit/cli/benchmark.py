@@ -1,9 +1,13 @@
 """``ti-spinorbit benchmark``: ensemble throughput in member-orbits/s (JSON)."""
 
 import os
+import platform
+import time
 
-from .common import (build_system, check_output, check_system_flags, claim_outputs,
-                     init_taichi, refuse_existing, say)
+from .. import Integrator, Run, runtime, surface_of_section
+from ..output.io import provenance
+from .common import (build_system, check_output, check_system_flags, claim_outputs, init_taichi,
+                     refuse_existing, say)
 from .options import Bounded, add_command, run_options
 
 NAME = "benchmark"
@@ -37,24 +41,19 @@ def check(args):
 
 
 def run(args):
-    import platform
-    import time
-
     import numpy as np
 
-    from .. import runtime, surface_of_section
-    from ..io import provenance
 
     system = build_system(args)
     out = args.out or "benchmark.json"
     thetadot = np.linspace(*BENCH_THETADOT_RANGE, args.members)
     init_taichi(args)
     started = time.perf_counter()
-    surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, rtol=args.rtol,
-                       model=args.model, method=args.method, progress=False)   # compile / load
+    options = dict(rtol=args.rtol, method=args.method, integrator=Integrator(model=args.model),
+                   run=Run(progress=False))
+    surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, **options)   # compile / load
     warmup = time.perf_counter() - started
-    runs = [surface_of_section(system, 0.0, thetadot, orbits=args.orbits, rtol=args.rtol,
-                               model=args.model, method=args.method, progress=False)
+    runs = [surface_of_section(system, 0.0, thetadot, orbits=args.orbits, **options)
             for _ in range(args.repeat)]
     best = min(runs, key=lambda r: r.seconds)
     rate = args.members * args.orbits / best.seconds

@@ -3,8 +3,25 @@ output checks and paths (claimed for the run, never overwritten unless --overwri
 Matplotlib backend, Taichi start-up, the system a command runs on (catalogued or a --system
 file), default file names, progress, checkpoints, writing results and the accuracy verdict."""
 
+import contextlib
+import dataclasses
+import io
 import os
+import re
 import sys
+import tempfile
+
+from .. import init
+from ..engine.checkpoint import check_target, holds_checkpoint, remove
+from ..engine.options import Integrator, Run
+from ..engine import progress as _progress
+from ..engine.results import STATUS_NAMES, Status
+from ..files import check_name, claim, safe_part, target
+from ..model.coordinates import APSIDAL_MIN_ECCENTRICITY
+from ..output.io import read_metadata, save
+from ..output.plotting import _pyplot, save_figure
+from ..system import catalog
+from ..system.systems import read_system_file
 
 #: Exit statuses (README "Statuses, exit codes and accuracy").
 EXIT_OK, EXIT_CHECK_FAILED, EXIT_ERROR, EXIT_INACCURATE, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
@@ -39,9 +56,7 @@ def check_output(flag, path, extensions):
     before a long run, not after it. Probes by opening (an existing file for appending, which
     changes nothing, and always a temporary file beside it, where the atomic write will put
     its bytes), because permission bits do not tell for root or read-only mounts."""
-    import tempfile
 
-    from ..files import check_name, target
 
     if path is None:
         return
@@ -84,7 +99,6 @@ def check_plotting():
     """Matplotlib must load with the environment's backend before a run whose figure would
     otherwise fail at the end (an invalid MPLBACKEND raises at import)."""
     try:
-        from ..plotting import _pyplot
 
         choose_backend()
         _pyplot()
@@ -108,10 +122,7 @@ def check_figure_outputs(args):
 
 def init_taichi(args):
     """Start Taichi on --arch; with --quiet, Taichi's own "Starting on arch" line is hidden."""
-    import contextlib
-    import io
 
-    from .. import init
 
     if not args.quiet:
         return init(arch=args.arch)
@@ -137,7 +148,6 @@ def file_system(args):
     keys and derived entries that disagree with the inputs are refused). --elongation and
     --density are refused: they rebuild a catalogued secondary by the catalogue's
     prescription (docs/physics.md §7), which a file of your own system does not follow."""
-    import dataclasses
 
     path = args.system
     for dest, flag in (("elongation", "--elongation"), ("density", "--density")):
@@ -164,7 +174,6 @@ def file_system(args):
 def load_system_file(path, flag):
     """BinarySystem.from_file for the command line: every error one line naming ``flag``
     (--system, --show) and the file."""
-    from ..systems import read_system_file
 
     try:
         return read_system_file(path, flag)
@@ -176,7 +185,6 @@ def load_system_file(path, flag):
 def catalogue_name(system):
     """The catalogue key of a system loaded from a file when its name is one, else None
     (its defaults, e.g. the section starts, then follow the catalogue)."""
-    from .. import catalog
 
     try:
         return catalog._resolve(system.name)
@@ -186,7 +194,6 @@ def catalogue_name(system):
 
 def build_system(args):
     """The BinarySystem of --system (a catalogue name or a .json file) and the shape flags."""
-    from .. import catalog
 
     if is_system_file(args.system):
         return file_system(args)
@@ -201,9 +208,7 @@ def check_system_flags(args):
     --elongation making b < c, an --eccentricity making the bodies touch at pericentre)
     fails before any work, naming the flag rather than the library's argument. Returns the
     system (None for 'systems' without --show, or --show with a file)."""
-    import re
 
-    from .. import catalog
 
     name = args.show if args.command == "systems" else getattr(args, "system", None)
     if name is None:
@@ -247,7 +252,6 @@ def check_system_flags(args):
 
 def check_derived(args, system):
     """Checks of the built system that the catalogue and a --system file share."""
-    from ..coordinates import APSIDAL_MIN_ECCENTRICITY
 
     if getattr(args, "coordinates", None) == "apsidal" and system.e < APSIDAL_MIN_ECCENTRICITY:
         raise ValueError(f"--coordinates apsidal needs an eccentricity >= "
@@ -282,16 +286,17 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("yorp_radius", "Ryorp"), ("byorp_radius", "Rbyorp"))
 
 
+#: The whole command line's parser factory, [ti_spinorbit.cli._parser], set by the cli package
+#: when it is imported: the package assembles the subcommands, which sit above this module.
+PARSER = [None]
+
+
 def default_stem(args, prefix, system_name):
     """Default output name without extension: ``<prefix>_<system>`` and one ``_<tag><value>``
     per physics flag that differs from its default (:data:`NAME_TAGS`), so that runs with
     other parameters never share a file: ``sos_1991VH_ab1.06_o1000``."""
-    import re
 
-    from ..files import safe_part
-    from . import _parser
-
-    defaults = vars(_parser().parse_args([args.command]))
+    defaults = vars(PARSER[0]().parse_args([args.command]))
     # a system's name (a system file's included) is made safe for a file name: no folder
     # separators, control characters or newlines ("sub/evil" -> "sub-evil")
     parts = [prefix, safe_part(system_name)]
@@ -337,7 +342,6 @@ def claim_outputs(args, outputs):
     one, held until the command ends): a second run with the same names, started while this
     one goes, is refused at once in one line (exit status 2) instead of silently replacing
     this run's files."""
-    from ..files import claim
 
     _CLAIMS.append(claim(outputs, command=getattr(args, "command_line", None)))
 
@@ -354,8 +358,6 @@ def _finishes_a_run(args, out, data, checkpoint):
     figure does not, the checkpoint is still there and the data file records this very
     command line. The run then resumes from its checkpoint (nothing is integrated again),
     and rewrites the data file (the same numbers) and the figure, instead of being refused."""
-    from ..checkpoint import holds_checkpoint
-    from ..io import read_metadata
 
     if not getattr(args, "resume", False) or checkpoint is None or os.path.exists(out) \
             or not os.path.isfile(data) or not os.path.isdir(checkpoint) \
@@ -374,7 +376,6 @@ def output_paths(args, prefix, system_name):
     claimed for this run (:func:`claim_outputs`) and then not already there (unless
     --overwrite, or this --resume finishes the same command's run: :func:`_finishes_a_run`),
     and the checkpoint directory checked, before any work."""
-    from ..files import check_name
 
     out = args.out or default_stem(args, prefix, system_name) + ".png"
     data = args.data or os.path.splitext(out)[0] + ".npz"
@@ -391,7 +392,6 @@ def output_paths(args, prefix, system_name):
     if not _finishes_a_run(args, out, data, checkpoint):
         refuse_existing(args, data, data_flag)
     if checkpoint is not None:   # a checkpoint that would be refused: before any work
-        from ..checkpoint import check_target
 
         check_target(checkpoint, args.resume, args.overwrite_checkpoint, cli=True)
     return out, data
@@ -407,11 +407,14 @@ def checkpoint_path(args, data):
     return None
 
 
-def run_keywords(args, data):
-    """model, checkpoint and resume keywords from the flags (the directory was checked by
-    :func:`output_paths` before any work)."""
-    return {"model": args.model, "method": args.method, "checkpoint": checkpoint_path(args, data),
-            "resume": args.resume, "overwrite_checkpoint": args.overwrite_checkpoint}
+def entry_options(args, data, bar):
+    """An entry point's ``method``, ``integrator`` (the model) and ``run`` (progress bar,
+    checkpoint and resume) from the flags; the directory was checked by :func:`output_paths`
+    before any work."""
+
+    return {"method": args.method, "integrator": Integrator(model=args.model),
+            "run": Run(progress=bar, checkpoint=checkpoint_path(args, data), resume=args.resume,
+                       overwrite=args.overwrite_checkpoint)}
 
 
 def finish_checkpoint(args, data):
@@ -423,7 +426,6 @@ def finish_checkpoint(args, data):
         return None
     if getattr(args, "keep_checkpoint", False):
         return f"kept checkpoint {path} (--keep-checkpoint)"
-    from ..checkpoint import remove
 
     try:
         remove(path)
@@ -437,26 +439,16 @@ def finish_checkpoint(args, data):
 def progress_bar(args):
     """The command's reporter: a bar (terminal) or a line per 10 % (log) on stderr, compile
     announcements; nothing with --quiet, no bar with --no-progress."""
-    from ..progress import DELAY_S, Progress
-
-    return Progress(args.command, enabled=not args.quiet, delay=DELAY_S,
-                    bar=not getattr(args, "no_progress", False))
-
-
-def with_progress(func, bar):
-    """``{"progress": bar}`` where ``func`` takes a progress callback, else nothing."""
-    import inspect
-
-    return {"progress": bar} if "progress" in inspect.signature(func).parameters else {}
+    return _progress.Progress(args.command, enabled=not args.quiet, delay=_progress.DELAY_S,
+                              bar=not getattr(args, "no_progress", False))
 
 
 # ---- writing results --------------------------------------------------------------------
 
 def _save(result, path, extra):
-    """Write a result with :func:`ti_spinorbit.io.save` (self-describing, loadable with
+    """Write a result with :func:`ti_spinorbit.output.io.save` (self-describing, loadable with
     ``io.load``; atomic: a killed write leaves no partial file), the command's own numbers in
     the metadata under ``extra``."""
-    from ..io import save
 
     return save(result, path, extra=extra)
 
@@ -470,7 +462,6 @@ def write_outputs(result, data, extra, figure, out):
     atomically (:mod:`ti_spinorbit.files`): a plotting failure never loses the numbers of a
     run, and a run killed between the two is finished by the same ``--resume`` command
     (:func:`_finishes_a_run`). Returns the paths written."""
-    from ..plotting import save_figure
 
     data = _save(result, data, extra)
     try:
@@ -494,7 +485,6 @@ def accuracy_status(args, status, energy_drift, max_drift, what="members", stop_
     ``stop_status`` (the kernels' codes) names what inaccurate members stopped for."""
     import numpy as np
 
-    from ..results import STATUS_NAMES, Status
 
     INACCURATE, NONFINITE, BUDGET = Status.INACCURATE, Status.NONFINITE, Status.STEP_BUDGET
     status = np.asarray(status)

@@ -1,13 +1,15 @@
 """``ti-spinorbit energy``: energy and angular-momentum conservation check (PNG + .npz; exit
 status 1 above --max-drift)."""
 
+import math as m
 import sys
 
+from .. import time_series
+from ..system import catalog
 from .common import (EXIT_CHECK_FAILED, EXIT_OK, build_system, catalogue_name,
-                     check_figure_outputs, check_system_flags, finish_checkpoint, init_taichi,
-                     output_paths, progress_bar, run_keywords, say, with_progress,
-                     write_outputs)
-from .options import (ANGLE, MAX_DRIFT, SPIN, Bounded, add_command, announce_perturbations,
+                     check_figure_outputs, check_system_flags, entry_options, finish_checkpoint,
+                     init_taichi, output_paths, progress_bar, say, write_outputs)
+from .options import (ANGLE, Bounded, MAX_DRIFT, SPIN, add_command, announce_perturbations,
                       check_perturbation_flags, perturbation_flags, run_options, system_flags)
 
 NAME = "energy"
@@ -50,7 +52,7 @@ def check(args):
 
 def energy_check(ts, member=0):
     """Conservation numbers of one member of a TimeSeriesResult and the per-sample arrays:
-    :meth:`~ti_spinorbit.section.TimeSeriesResult.conservation` (kept here for callers)."""
+    :meth:`~ti_spinorbit.studies.section.TimeSeriesResult.conservation` (kept here for callers)."""
     return ts.conservation(member)
 
 
@@ -71,10 +73,6 @@ def _work_line(ts, member=0):
 
 
 def run(args):
-    import math as m
-
-    from .. import catalog, time_series
-
     system = build_system(args)
     out, data = output_paths(args, "energy", system.name)
     thetadot = args.thetadot
@@ -92,7 +90,7 @@ def run(args):
     with progress_bar(args) as bar:
         ts = time_series(system, args.theta_p, thetadot, args.orbits, samples_per_orbit=samples,
                          rtol=args.rtol, max_drift=args.max_drift, perturbations=perturbations,
-                         **with_progress(time_series, bar), **run_keywords(args, data))
+                         **entry_options(args, data, bar))
     numbers, series = energy_check(ts)
     status = ts.status_names[0]
     out, data = write_outputs(ts, data, {"command": args.command_line, "energy_check": numbers,

@@ -1,9 +1,13 @@
 """``ti-spinorbit figures``: run the experiment scripts that reproduce the paper's studies
 (needs a source checkout: the scripts live in experiments/)."""
 
+import glob
 import os
+import subprocess
 import sys
+import time
 
+from ..runtime import _KNOWN_ARCHS
 from .common import say
 from .options import Bounded, add_command
 
@@ -13,8 +17,6 @@ EXAMPLES = """\
 
 
 def add_parser(subparsers):
-    from ..runtime import _KNOWN_ARCHS
-
     s = add_command(subparsers, NAME, "reproduce the paper's studies (experiments/study*.py)",
                     EXAMPLES, description=None)
     s.add_argument("--quick", action="store_true", help="small runs (minutes in all)")
@@ -48,10 +50,6 @@ def _experiments_dir(given):
 
 
 def run(args):
-    import glob
-    import subprocess
-    import time
-
     folder = _experiments_dir(args.experiments)
     scripts = sorted(glob.glob(os.path.join(folder, "study[0-9][0-9]_*.py")))
     if args.only:

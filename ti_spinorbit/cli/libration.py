@@ -3,11 +3,16 @@ centre (PNG + .npz)."""
 
 import math
 import sys
+import warnings
 
+from ..engine.options import Run
+from ..engine.results import Status
+from ..output.plotting import plot_libration_search
+from ..studies.libration import relaxed_libration
 from .common import (EXIT_INACCURATE, accuracy_status, build_system, check_figure_outputs,
                      check_system_flags, init_taichi, output_paths, progress_bar, say,
-                     with_progress, write_outputs)
-from .options import (MAX_SPIN, ORBITS, SPIN, Bounded, accuracy_flags, add_command,
+                     write_outputs)
+from .options import (Bounded, MAX_SPIN, ORBITS, SPIN, accuracy_flags, add_command,
                       announce_perturbations, check_max_orbits, check_perturbation_flags,
                       coordinates_flag, perturbation_flags, run_options, system_flags)
 
@@ -56,22 +61,16 @@ def check(args):
 
 
 def _plot_libration(result):
-    from ..plotting import plot_libration_search
     return plot_libration_search(result)
 
 
 def _status_code(name):
-    from ..results import Status
-
     return int(Status.from_label(name))
 
 
 def run(args):
-    import warnings
-
     import numpy as np
 
-    from ..libration import relaxed_libration
 
     system = build_system(args)
     out, data = output_paths(args, "libration", system.name)
@@ -84,7 +83,7 @@ def run(args):
     init_taichi(args)
     with progress_bar(args) as bar, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RuntimeWarning)
-        result = relaxed_libration(system, **kwargs, **with_progress(relaxed_libration, bar))
+        result = relaxed_libration(system, **kwargs, run=Run(progress=bar))
     for w in caught:
         if not args.quiet:
             print(f"ti-spinorbit libration: warning: {w.message}", file=sys.stderr)

@@ -1,11 +1,12 @@
 """``ti-spinorbit map``: chaos map (MEGNO, Lyapunov, classes) over a (θ_p, θ̇_p/n) grid."""
 
+from ..studies.chaosmap import chaos_map
 from .common import (accuracy_status, build_system, check_figure_outputs, check_system_flags,
-                     finish_checkpoint, init_taichi, output_paths, progress_bar, run_keywords,
+                     entry_options, finish_checkpoint, init_taichi, output_paths, progress_bar,
                      say, write_outputs)
-from .options import (SPIN, Bounded, accuracy_flags, add_command, announce_perturbations,
-                      check_perturbation_flags, coordinates_flag, perturbation_flags,
-                      run_options, system_flags)
+from .options import (Bounded, SPIN, accuracy_flags, add_command, announce_perturbations,
+                      check_perturbation_flags, coordinates_flag, perturbation_flags, run_options,
+                      system_flags)
 
 NAME = "map"
 EXAMPLES = """\
@@ -47,7 +48,6 @@ def check(args):
 def run(args):
     import numpy as np
 
-    from ..chaosmap import chaos_map
 
     system = build_system(args)
     nt, nd = args.grid
@@ -58,10 +58,10 @@ def run(args):
     theta = (np.arange(nt) + 0.5) * 180.0 / nt
     with progress_bar(args) as bar:
         cmap = chaos_map(system, theta, np.linspace(lo, hi, nd), orbits=args.orbits,
-                         rtol=args.rtol, progress=bar, max_drift=args.max_drift,
+                         rtol=args.rtol, max_drift=args.max_drift,
                          include_inaccurate=args.allow_inaccurate, coordinates=args.coordinates,
                          indicator_space=args.indicator_space, perturbations=perturbations,
-                         **run_keywords(args, data))
+                         **entry_options(args, data, bar))
     out, data = write_outputs(cmap, data, {"command": args.command_line}, cmap.plot, out)
     counted = "all finished members" if args.allow_inaccurate else \
         f"{cmap.n_inaccurate} inaccurate left out"

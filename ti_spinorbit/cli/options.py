@@ -11,9 +11,13 @@ import math
 import re
 
 from .._validate import MAX_DENSITY, MAX_SPIN, MIN_DENSITY  # bounds shared with the library
-from ..section import MAX_ORBITS  # orbits limit shared with the library
-from .. import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
-from .. import models as _models  # the model requests (one registry)
+from ..engine.compiling import METHODS
+from ..model import models as _models  # the model requests (one registry)
+from ..model import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
+from ..model.perturbations import BYORP, YORP, Tides
+from ..runtime import _KNOWN_ARCHS
+from ..studies.section import MAX_ORBITS  # orbits limit shared with the library
+from ..system import catalog
 from .common import EXIT_INACCURATE, build_system, fmt, one_line, say
 
 #: Accepted --rtol range (the integrator's own limits, ensemble.check_tolerances).
@@ -92,7 +96,7 @@ ECCENTRICITY = Bounded(float, 0.0, 1.0, high_open=True)
 ANGLE = Bounded(float, -360.0, 360.0)                  # deg: --theta-p, --tilt, --inclination
 SPIN = Bounded(float, -MAX_SPIN, MAX_SPIN)             # units of n: --thetadot, --spin-xy, ...
 MAX_DRIFT = Bounded(float, 0.0, 1.0, low_open=True)
-# tides, YORP, BYORP (the bounds of ti_spinorbit.perturbations)
+# tides, YORP, BYORP (the bounds of ti_spinorbit.model.perturbations)
 K2 = Bounded(float, *_pert.K2_RANGE)
 TIME_LAG = Bounded(float, *_pert.TIME_LAG_RANGE)
 Q = Bounded(float, *_pert.Q_RANGE)
@@ -136,8 +140,6 @@ def add_command(subparsers, name, help, examples, description=_SAME):
 def run_options(s, out_help, data=True, orbits=300.0, rtol=1e-10, model=True, resume=False):
     """--orbits, --rtol, --method, --arch, the outputs, --quiet, --no-progress, --overwrite,
     --model (``model``) and the checkpoint group (``resume``) of a command that integrates."""
-    from ..compiling import METHODS
-    from ..runtime import _KNOWN_ARCHS
 
     if orbits is not None:
         s.add_argument("--orbits", type=ORBITS, default=orbits,
@@ -280,7 +282,6 @@ def perturbation_flags(s):
 
 def perturbations(args):
     """The Tides / YORP / BYORP objects the flags ask for (a list, empty without them)."""
-    from ..perturbations import BYORP, YORP, Tides
 
     if not hasattr(args, "tide"):
         return []
@@ -333,7 +334,6 @@ def check_perturbation_flags(args):
             raise ValueError("--strength needs --tide, --yorp or --byorp (it scales them)")
         return
     if args.command == "overlap":
-        from .. import catalog
         system = catalog.system(args.system, eccentricity=args.eccentricity)
     else:
         system = build_system(args)

@@ -1,8 +1,11 @@
 """``ti-spinorbit overlap``: 1:1 / 3:2 resonance-overlap scan over the elongation a/b."""
 
+from ..engine.options import Integrator, Run
+from ..studies.overlap import overlap_threshold
+from ..system import catalog
 from .common import (accuracy_status, check_figure_outputs, check_system_flags, init_taichi,
                      output_paths, progress_bar, say, write_outputs)
-from .options import (MAX_ELONGATION, ORBITS, Bounded, accuracy_flags, add_command,
+from .options import (Bounded, MAX_ELONGATION, ORBITS, accuracy_flags, add_command,
                       announce_perturbations, check_max_orbits, check_perturbation_flags,
                       coordinates_flag, perturbation_flags, run_options, system_flags)
 
@@ -60,9 +63,6 @@ def check(args):
 
 
 def run(args):
-    from .. import catalog
-    from ..overlap import overlap_threshold
-
     system = catalog.system(args.system, eccentricity=args.eccentricity)   # checks name and e
     out, data = output_paths(args, "overlap", system.name)
     init_taichi(args)
@@ -70,8 +70,9 @@ def run(args):
     q = _scan(*args.elongations)
     with progress_bar(args) as bar:
         scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
-                                 orbits=args.orbits, rtol=args.rtol, progress=bar,
-                                 model=args.model, method=args.method, max_drift=args.max_drift,
+                                 orbits=args.orbits, rtol=args.rtol, method=args.method,
+                                 integrator=Integrator(model=args.model),
+                                 run=Run(progress=bar), max_drift=args.max_drift,
                                  include_inaccurate=args.allow_inaccurate,
                                  max_orbits=args.max_orbits, coordinates=args.coordinates,
                                  perturbations=perturbations)

@@ -1,11 +1,15 @@
 """``ti-spinorbit section``: surface of section of a system (PNG + .npz)."""
 
+from .. import surface_of_section
+from ..engine.results import STATUS_NAMES, Status
+from ..output.plotting import plot_section
+from ..system import catalog
 from .common import (accuracy_status, build_system, catalogue_name, check_figure_outputs,
-                     check_system_flags, finish_checkpoint, init_taichi, output_paths,
-                     progress_bar, run_keywords, say, write_outputs)
+                     check_system_flags, entry_options, finish_checkpoint, init_taichi,
+                     output_paths, progress_bar, say, write_outputs)
 from .options import (ANGLE, SPIN, accuracy_flags, add_command, announce_perturbations,
-                      check_perturbation_flags, coordinates_flag, perturbation_flags,
-                      run_options, system_flags, tilt_flags)
+                      check_perturbation_flags, coordinates_flag, perturbation_flags, run_options,
+                      system_flags, tilt_flags)
 
 NAME = "section"
 EXAMPLES = """\
@@ -38,7 +42,6 @@ def check(args):
 def _status_text(result, k):
     """Member k's status, with what it stopped for when the verdict overrode it
     ("inaccurate (escape)")."""
-    from ..results import STATUS_NAMES, Status
 
     name = result.status_names[k]
     stop = getattr(result, "stop_status", None)
@@ -50,8 +53,6 @@ def _status_text(result, k):
 def run(args):
     import numpy as np
 
-    from .. import catalog, surface_of_section
-    from ..plotting import plot_section
 
     system = build_system(args)
     known = catalogue_name(system)
@@ -74,9 +75,9 @@ def run(args):
         starts_kw = {"theta_p": args.theta_p, "thetadot_p": np.array(starts)}
     with progress_bar(args) as bar:
         result = surface_of_section(system, orbits=args.orbits, **starts_kw,
-                                    rtol=args.rtol, progress=bar, max_drift=args.max_drift,
+                                    rtol=args.rtol, max_drift=args.max_drift,
                                     coordinates=args.coordinates, perturbations=perturbations,
-                                    **run_keywords(args, data))
+                                    **entry_options(args, data, bar))
     out, data = write_outputs(result, data, {"command": args.command_line},
                               lambda: plot_section(result), out)
     say(args, f"{system.name}: mass ratio {system.mass_ratio:.2f}, omega0 {system.omega0:.4f}, "

@@ -1,5 +1,7 @@
 """``ti-spinorbit systems``: list the catalogued systems, or show one (a name or a file)."""
 
+from ..files import write_json   # atomic: a killed write leaves no partial file
+from ..system import catalog
 from .common import check_output, check_system_flags, is_system_file, load_system_file, say
 from .options import add_command
 
@@ -37,14 +39,10 @@ def _body_size(body):
 
 
 def run(args):
-    from .. import catalog
-
     if args.show:
         system = load_system_file(args.show, "--show") if is_system_file(args.show) \
             else catalog.system(args.show)
         if args.out:
-            from ..files import write_json     # atomic: a killed write leaves no partial file
-
             write_json(args.out, system.describe(), indent=1)
         if not args.quiet:
             for k, v in system.describe().items():
@@ -52,7 +50,6 @@ def run(args):
         return 0
     systems = [catalog.system(name) for name in catalog.names()]
     if args.out:
-        from ..files import write_json
 
         write_json(args.out, [s.describe() for s in systems], indent=1)
     say(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} "

@@ -1,6 +1,12 @@
 """``ti-spinorbit warmup``: compile the kernel variants ahead of time (later runs start
 without waiting)."""
 
+import time
+
+from .. import runtime
+from ..engine.compiling import METHODS
+from ..runtime import _KNOWN_ARCHS
+from ..studies.warmup import warmup
 from .common import init_taichi, say
 from .options import add_command
 
@@ -12,8 +18,6 @@ EXAMPLES = """\
 
 
 def add_parser(subparsers):
-    from ..runtime import _KNOWN_ARCHS
-
     s = add_command(subparsers, NAME, "compile kernel variants ahead of time, so later runs "
                     "start at once", EXAMPLES)
     s.add_argument("--models", nargs="+", choices=("planar", "3d"), default=["planar", "3d"],
@@ -36,19 +40,12 @@ def add_parser(subparsers):
 
 
 def check(args):
-    from ..compiling import METHODS
-
     bad = [m for m in args.methods if m not in METHODS]
     if bad:
         raise ValueError(f"--methods must be among {', '.join(METHODS)} (got {bad[0]!r})")
 
 
 def run(args):
-    import time
-
-    from .. import runtime
-    from ..warmup import warmup
-
     init_taichi(args)
     started = time.perf_counter()
     done = warmup(models=args.models, indicators=[v == "on" for v in args.indicators],

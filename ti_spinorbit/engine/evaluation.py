@@ -1,0 +1,140 @@
+"""Host-side evaluations through the kernels, in one place: every launch of a Taichi kernel
+that is not an integration.
+
+* :func:`mutual_potential`: the truncated mutual potential, the force and both torques of
+  two bodies at given configurations (SI, the primary's frame), by the same Taichi code
+  path as the integrator (docs/physics.md §3);
+* :func:`true_acceleration` and :func:`apsidal_rates`: the relative acceleration seen from
+  the inertial frame and the rate ϖ̇ of the osculating line of apsides it gives, for the
+  apsidal coordinates of docs/physics.md §6.7;
+* :func:`diagnostics`: energies, angular momenta and orthonormality errors of recorded
+  states (``layout.DIAG_FIELDS``), for time series and the accuracy verdict.
+
+Results are built from these functions and the member table's rows; they never call an
+:class:`~ti_spinorbit.engine.ensemble.Ensemble` back. Each call initialises Taichi when it is
+not yet (``runtime.ensure_init``); the kernels are imported on first use, so importing this
+module stays quiet.
+"""
+
+import numpy as np
+
+from .. import layout, runtime
+from .._validate import require_finite, require_order
+from ..layout import ROW_LENGTH, spatial as _S
+from ..system.bodies import Body, odd_columns
+from ..system.systems import G
+from ..model.coordinates import apsidal_rate
+
+
+def has_odd(par) -> bool:
+    """Whether any member row holds an integral with an odd exponent (the kernels' odd
+    terms are then compiled in), as ``Ensemble`` decides it."""
+    par = np.asarray(par)
+    return bool(par.size and np.any(par[:, odd_columns(ROW_LENGTH)] != 0.0))
+
+
+def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
+    """Mutual potential energy, force on the secondary and torques, SI, primary frame.
+
+    Parameters
+    ----------
+    primary, secondary : Body
+    R : array (..., 3)
+        Secondary's centre of mass relative to the primary's, m, primary frame.
+    S : array (..., 3, 3)
+        Rotation taking secondary-frame vectors to the primary frame: orthonormal
+        (|S^T S − 1| <= 1e-9) and proper (det S = +1; a reflection is no rigid motion).
+    order : {0, 2, 3, 4}
+        Truncation order (docs/physics.md §3; Ashenberg 2007; Hou et al. 2017).
+
+    Returns
+    -------
+    (V, F, torque_primary, torque_secondary)
+        V in J; F = −∂V/∂R the force on the secondary, N; torques about each body's centre of
+        mass, N m (δV = −torque·δθ for an infinitesimal rotation of that body alone).
+    """
+    from ..kernels import advance as K      # Taichi: imported on first use
+
+    for label, body in (("primary", primary), ("secondary", secondary)):
+        if not isinstance(body, Body):
+            raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body) "
+                            f"(got {type(body).__name__})")
+    order = require_order(order)
+    # checked before the conversion, so text is a TypeError naming R or S
+    R = np.asarray(require_finite("R", R), dtype=np.float64)
+    S = np.asarray(require_finite("S", S), dtype=np.float64)
+    if R.shape[-1:] != (3,) or S.shape[-2:] != (3, 3) or R.shape[:-1] != S.shape[:-2]:
+        raise ValueError(f"R must be (..., 3) and S (..., 3, 3) with matching batch shapes "
+                         f"(got {R.shape} and {S.shape})")
+    if not np.allclose(np.einsum("...ji,...jk->...ik", S, S), np.eye(3), atol=1e-9):
+        raise ValueError("S must be a rotation matrix (S^T S = 1)")
+    det = np.linalg.det(S) if S.size else np.ones(0)
+    if np.any(det < 0):
+        raise ValueError(f"S must be a proper rotation matrix, det S = +1 (got det S = "
+                         f"{float(np.min(det)):.6g}: a reflection)")
+    # the expansion converges only outside the bodies' bounding spheres (R = 0 gave NaN)
+    contact = primary.bounding_radius + secondary.bounding_radius
+    closest = float(np.min(np.linalg.norm(R, axis=-1))) if R.size else np.inf
+    if closest <= contact:
+        raise ValueError(f"bodies overlap: |R| = {closest:.6g} m must exceed the sum of "
+                         f"bounding radii ({contact:.6g} m)")
+    batch = R.shape[:-1]
+    Rf = np.ascontiguousarray(R.reshape(-1, 3))
+    Sf = np.ascontiguousarray(S.reshape(-1, 3, 3))
+    par = np.zeros((len(Rf), _S.NPAR))
+    par[:, _S.BODY_A:_S.BODY_A + ROW_LENGTH] = primary.as_row()
+    par[:, _S.BODY_B:_S.BODY_B + ROW_LENGTH] = secondary.as_row()
+    runtime.ensure_init()
+    out = np.zeros((len(Rf), 10))
+    K.evaluate_mutual(par, Rf, Sf, out, G, int(order), has_odd(par))
+    V = out[:, 0].reshape(batch)
+    F = -out[:, 1:4].reshape(batch + (3,))
+    return V, F, out[:, 4:7].reshape(batch + (3,)), out[:, 7:10].reshape(batch + (3,))
+
+
+def true_acceleration(par, states, order=4):
+    """Relative acceleration d²R/dt² seen from the inertial frame, in primary-frame
+    components, scaled units (G = 1, a = 1, n = 1), for 3-D states (M, 30) with parameter
+    rows par (M, NPAR). It is −(∂U/∂R)/m: the kernels' dV/dt = V × Ω1 − (∂U/∂R)/m with the
+    frame term V × Ω1 removed (docs/physics.md §4.3)."""
+    from ..kernels import advance as K      # Taichi: imported on first use
+
+    runtime.ensure_init()
+    par = np.ascontiguousarray(par, dtype=np.float64)
+    y = np.ascontiguousarray(np.atleast_2d(states), dtype=np.float64)
+    if len(y) == 0:
+        return np.zeros((0, 3))
+    f = np.zeros_like(y)
+    K.SPATIAL.evaluate_rhs(par, y, f, int(order), has_odd(par))
+    V = y[:, _S.Y_V:_S.Y_V + 3]
+    om1 = par[:, _S.P_IA:_S.P_IA + 3] * y[:, _S.Y_W1:_S.Y_W1 + 3]
+    return f[:, _S.Y_V:_S.Y_V + 3] + np.cross(om1, V)
+
+
+def apsidal_rates(par, states, order=4):
+    """ϖ̇ (units of n) of scaled 3-D states (M, 30) with parameter rows par (M, NPAR): the
+    exact rate of the osculating line of apsides under the true acceleration
+    (:func:`ti_spinorbit.model.coordinates.apsidal_rate`)."""
+    states = np.atleast_2d(states)
+    acc = true_acceleration(par, states, order)
+    return apsidal_rate(states[:, _S.Y_R:_S.Y_R + 3], states[:, _S.Y_V:_S.Y_V + 3], acc)
+
+
+def diagnostics(par, states, member, order=4, odd=None):
+    """``layout.DIAG_FIELDS`` (three energies, three angular-momentum vectors, two
+    orthonormality errors; scaled units) of 3-D states (M, 30) of the members ``member``
+    (M,) whose rows are ``par`` (N, NPAR); ``odd`` as ``Ensemble`` decides it (default: from
+    the rows)."""
+    from ..kernels import advance as K      # Taichi: imported on first use
+
+    par = np.ascontiguousarray(par, dtype=np.float64)
+    y = np.ascontiguousarray(states, dtype=np.float64).reshape(-1, _S.NSTATE)
+    member = np.ascontiguousarray(member, dtype=np.int32)
+    out = np.zeros((len(y), len(layout.DIAG_FIELDS)))
+    if len(y):
+        runtime.ensure_init()
+        K.diagnostics(par, y, member, out, int(order), has_odd(par) if odd is None else odd)
+    return out
+
+
+__all__ = ["mutual_potential", "true_acceleration", "apsidal_rates", "diagnostics", "has_odd"]

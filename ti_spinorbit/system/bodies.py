@@ -1,0 +1,263 @@
+"""Rigid bodies described by their mass and inertia integrals of orders 2 to 4.
+
+A body lives in its own principal-axis frame with the origin at its centre of mass
+(docs/physics.md §2). What the mutual potential needs of it is
+
+    T^{lmn} = ∫_B x^l y^m z^n dm      (kg m^{l+m+n}),   l + m + n = 2, 3, 4,
+
+computed once here, never per step. Order 1 vanishes (centre of mass) and order 2 must be
+diagonal (principal axes); orders 3 and 4 may be anything, so a lumpy body with odd
+integrals plugs into the same kernels as an ellipsoid.
+
+Sources: uniform ellipsoid integrals, Tricarico 2008 eq. 19 / Hou et al. 2017 eq. 26
+(docs/physics.md §2.2):
+    T^{lmn} = 3 M a^l b^m c^n (l-1)!!(m-1)!!(n-1)!! / (l+m+n+3)!!   (all indices even), else 0.
+"""
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, Tuple
+
+import numpy as np
+
+from .._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LENGTH, MIN_MASS,
+                         MIN_MOMENT_RATIO, require_finite, require_positive_scalar, require_real,
+                         show, _as_floats)
+from .. import display as _display
+# the monomial orders of a body's row (Body.as_row), shared with the kernels
+from ..layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
+
+
+def row_columns(select):
+    """Offsets in :meth:`Body.as_row` of the integrals whose exponents (l, m, n) satisfy
+    ``select`` (the mass at offset 0 is never included)."""
+    cols, off = [], 1
+    for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
+        cols += [off + k for k, e in enumerate(group) if select(e)]
+        off += len(group)
+    return cols
+
+
+def odd_columns(row_length=ROW_LENGTH):
+    """Parameter-row columns of the integrals with an odd exponent, for both body rows (the
+    primary's from 0, the secondary's from ``row_length``): any non-zero one makes a member
+    need the kernels' odd terms."""
+    cols = row_columns(lambda e: any(x % 2 for x in e))
+    return cols + [row_length + c for c in cols]
+
+
+def tensor_from_integrals(order, integral):
+    """Full symmetric rank-``order`` moment tensor whose entry i..k is ``integral(l, m, n)``,
+    (l, m, n) counting the indices equal to x, y and z."""
+    tensor = np.zeros((3,) * order)
+    for idx in np.ndindex(*tensor.shape):
+        tensor[idx] = integral(idx.count(0), idx.count(1), idx.count(2))
+    return tensor
+
+
+def _double_factorial(n: int) -> int:
+    return 1 if n <= 0 else n * _double_factorial(n - 2)
+
+
+def _multi_index(exponents):
+    """Indices (i, j, k, ...) into a symmetric tensor for a monomial x^l y^m z^n."""
+    l, m, n = exponents
+    return (0,) * l + (1,) * m + (2,) * n
+
+
+@dataclass(frozen=True, repr=False)
+class Body(_display.Readable):
+    """A rigid body given by its mass and inertia integrals in its principal-axis frame.
+
+    Parameters
+    ----------
+    mass : float
+        Mass in kg, in [1e-9, 1e35] (``MIN_MASS``, ``MAX_MASS`` of ``ti_spinorbit._validate``).
+    integrals : dict
+        ``{(l, m, n): T^{lmn}}`` for l + m + n in {2, 3, 4}, SI units (kg m^{l+m+n}).
+        Missing entries are zero. Second-order off-diagonal terms must vanish: the frame is
+        the principal-axis frame. The second moments T^200, T^020, T^002 must be >= 0. (A
+        body collapsed onto a line has a zero principal moment: its potential is fine, but
+        :class:`~ti_spinorbit.system.systems.BinarySystem` refuses it, since the spin equations
+        divide by the moments.)
+    bounding_radius : float
+        Radius (m) of a sphere about the centre of mass that contains the body; used for the
+        collision test and the overlap check at start. In [1e-3, 1e10] m (``MIN_LENGTH``,
+        ``MAX_LENGTH``) and no smaller than the integrals allow: a body inside a sphere of
+        radius ρ has (T^200 + T^020 + T^002) <= mass ρ² and |T^lmn| <= mass ρ^(l+m+n).
+    name : str
+        Free text used in plots and saved files.
+    """
+
+    mass: float
+    integrals: Dict[Tuple[int, int, int], float]
+    bounding_radius: float
+    name: str = "body"
+    _row: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        require_positive_scalar("mass", self.mass, MIN_MASS, MAX_MASS, "kg")
+        require_positive_scalar("bounding_radius", self.bounding_radius, MIN_LENGTH, MAX_LENGTH, "m")
+        if not isinstance(self.integrals, dict):
+            raise TypeError(f"integrals must be a dict {{(l, m, n): T^lmn}} (got "
+                            f"{type(self.integrals).__name__} {show(self.integrals)})")
+        if not isinstance(self.name, str):
+            raise TypeError(f"name must be a string (got {show(self.name)})")
+        for key, value in self.integrals.items():
+            if not isinstance(key, tuple) or len(key) != 3 or sum(key) not in (2, 3, 4) or min(key) < 0:
+                raise ValueError(
+                    f"integrals: key {key!r} is not (l, m, n) with l + m + n in 2..4")
+            require_real(f"integrals[{key}]", value)
+            require_finite(f"integrals[{key}]", value)
+        trace = sum(self.integrals.get(k, 0.0) for k in EXPONENTS_2)
+        if not trace > 0.0:
+            raise ValueError(f"integrals: second-order trace must be > 0 (got {trace!r})")
+        for k in ((1, 1, 0), (1, 0, 1), (0, 1, 1)):
+            if abs(self.integrals.get(k, 0.0)) > 1e-12 * trace:
+                raise ValueError(
+                    f"integrals[{k}] = {self.integrals[k]!r}: the body frame must be its "
+                    "principal-axis frame (off-diagonal second-order integrals must be 0); "
+                    "Body.from_point_masses rotates a mass distribution into it")
+        for k in EXPONENTS_2:
+            if self.integrals.get(k, 0.0) < 0:
+                raise ValueError(f"integrals[{k}] must be >= 0: a second moment ∫ x_i² dm "
+                                 f"(got {self.integrals[k]!r})")
+        # a body inside a sphere of radius ρ has ∫ r² dm <= M ρ² and |T^lmn| <= M ρ^(l+m+n)
+        mass = float(self.mass)
+        rms = math.sqrt(trace / mass)
+        smallest = max([rms] + [(abs(v) / mass) ** (1.0 / sum(k))
+                                for k, v in self.integrals.items() if v])
+        if float(self.bounding_radius) < smallest * (1.0 - 1e-12):
+            raise ValueError(
+                f"bounding_radius must be >= {smallest:.6g} m, the smallest sphere the integrals "
+                f"allow (RMS radius sqrt((T^200 + T^020 + T^002)/mass) = {rms:.6g} m, and "
+                f"|T^lmn| <= mass radius^(l+m+n)) (got {float(self.bounding_radius):.6g})")
+        row = [self.mass]
+        for group in (EXPONENTS_2, EXPONENTS_3, EXPONENTS_4):
+            row += [float(self.integrals.get(k, 0.0)) for k in group]
+        object.__setattr__(self, "_row", np.array(row, dtype=np.float64))
+
+    # ---- derived quantities -------------------------------------------------------------
+    def integral(self, l: int, m: int, n: int) -> float:
+        """T^{lmn} in SI units (kg m^{l+m+n}); 0 for entries not stored."""
+        if (l, m, n) == (0, 0, 0):
+            return self.mass
+        return float(self.integrals.get((l, m, n), 0.0))
+
+    @property
+    def moments(self) -> np.ndarray:
+        """Principal moments of inertia (A, B, C) about x, y, z, kg m^2."""
+        t200, t020, t002 = (self.integral(*k) for k in EXPONENTS_2)
+        return np.array([t020 + t002, t200 + t002, t200 + t020])
+
+    @property
+    def has_odd_integrals(self) -> bool:
+        """True when any integral with an odd index is non-zero (no mirror symmetry)."""
+        return any(v != 0.0 and any(i % 2 for i in k) for k, v in self.integrals.items())
+
+    def moment_tensor(self, order: int) -> np.ndarray:
+        """Full symmetric moment tensor M^(k)_{i..} = ∫ x_i ... dm in the body frame (SI),
+        k = 0..4."""
+        if order not in (0, 1, 2, 3, 4):
+            raise ValueError(f"order must be 0..4 (got {order!r})")
+        if order == 0:
+            return np.array(self.mass)
+        if order == 1:
+            return np.zeros(3)
+        return tensor_from_integrals(order, self.integral)
+
+    def as_row(self) -> np.ndarray:
+        """Mass and integrals in the fixed order the kernels read (copy, SI units)."""
+        return self._row.copy()
+
+    # ---- constructors for general bodies ------------------------------------------------
+    @classmethod
+    def from_point_masses(cls, points, masses, name="point cloud", bounding_radius=None):
+        """A body made of point masses (m, kg), shifted to its centre of mass and rotated into
+        its principal axes (x = smallest moment, i.e. the long axis).
+
+        Returns ``(body, rotation)``: ``rotation`` takes the input frame to the body frame."""
+        points = _as_floats("points", points)
+        masses = _as_floats("masses", masses)
+        if points.ndim != 2 or points.shape[1] != 3 or masses.shape != points.shape[:1]:
+            raise ValueError("points must have shape (n, 3) and masses shape (n,)")
+        require_finite("points", points)
+        if points.size and np.abs(points).max() > MAX_LENGTH:
+            raise ValueError(f"points must lie within {MAX_LENGTH:g} m of the origin (got a "
+                             f"coordinate of {np.abs(points).max():g} m)")
+        if np.any(masses <= 0) or not np.all(np.isfinite(masses)):
+            raise ValueError("masses must all be finite and > 0")
+        total = masses.sum()
+        p = points - (masses[:, None] * points).sum(0) / total
+        second = np.einsum("n,ni,nj->ij", masses, p, p)
+        inertia = np.trace(second) * np.eye(3) - second
+        w, vecs = np.linalg.eigh(inertia)  # ascending moments: x long axis
+        if np.linalg.det(vecs) < 0:
+            vecs[:, 2] *= -1
+        rotation = vecs.T
+        q = p @ rotation.T
+        integrals = {}
+        for order, group in ((2, EXPONENTS_2), (3, EXPONENTS_3), (4, EXPONENTS_4)):
+            # integrals that vanish by symmetry come out as round-off: zero them so that a
+            # symmetric cloud does not switch on the kernels' odd-order terms
+            floor = 1e-13 * float(np.sum(masses * np.linalg.norm(q, axis=1) ** order))
+            for l, m, n in group:
+                value = float(np.sum(masses * q[:, 0] ** l * q[:, 1] ** m * q[:, 2] ** n))
+                integrals[(l, m, n)] = value if abs(value) > floor else 0.0
+        radius = float(np.max(np.linalg.norm(q, axis=1))) if bounding_radius is None else bounding_radius
+        return cls(float(total), integrals, radius, name), rotation
+
+
+def Ellipsoid(a, b, c, density=None, *, mass=None, name="ellipsoid") -> Body:
+    """Uniform triaxial ellipsoid with semi-axes a ≥ b ≥ c (m) along x, y, z.
+
+    Give exactly one of ``density`` (kg m^-3, in [1, 1e5]: ``MIN_DENSITY``, ``MAX_DENSITY``)
+    or ``mass`` (kg, in [1e-9, 1e35]). Semi-axes lie in [1e-3, 1e10] m (``MIN_LENGTH``,
+    ``MAX_LENGTH``) and the body may not be a needle: (b² + c²)/(a² + b²) >= 1e-6 (its
+    smallest principal moment over its largest). x is the long axis and z the short one (the
+    spin axis of a principal-axis rotator)."""
+    for label, value in (("a", a), ("b", b), ("c", c)):
+        require_positive_scalar(label, value, MIN_LENGTH, MAX_LENGTH, "m")
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a string (got {show(name)})")
+    if not a >= b >= c:
+        raise ValueError(f"semi-axes must satisfy a >= b >= c (got a={a}, b={b}, c={c})")
+    a, b, c = float(a), float(b), float(c)
+    if (b * b + c * c) < MIN_MOMENT_RATIO * (a * a + b * b):
+        raise ValueError(f"semi-axes a={a:g}, b={b:g}, c={c:g} make a needle: (b² + c²)/(a² + b²) "
+                         f"must be >= {MIN_MOMENT_RATIO:g} (its smallest principal moment over "
+                         f"its largest)")
+    volume = 4.0 / 3.0 * math.pi * a * b * c
+    mass = _mass_from(volume, density, mass)
+    integrals = {}
+    for order in (2, 4):
+        for l in range(0, order + 1, 2):
+            for m in range(0, order - l + 1, 2):
+                n = order - l - m
+                integrals[(l, m, n)] = (
+                    3.0 * mass * a**l * b**m * c**n
+                    * _double_factorial(l - 1) * _double_factorial(m - 1) * _double_factorial(n - 1)
+                    / _double_factorial(l + m + n + 3))
+    body = Body(mass, integrals, float(a), name)
+    object.__setattr__(body, "semi_axes", (float(a), float(b), float(c)))
+    return body
+
+
+def Sphere(radius, density=None, *, mass=None, name="sphere") -> Body:
+    """Uniform sphere of ``radius`` (m); give ``density`` (kg m^-3) or ``mass`` (kg).
+
+    Its exterior field is exactly that of a point mass; the integrals are kept anyway so the
+    same kernels serve every body. ``radius`` in [1e-3, 1e10] m; density and mass bounds as
+    for :func:`Ellipsoid`."""
+    require_positive_scalar("radius", radius, MIN_LENGTH, MAX_LENGTH, "m")
+    return Ellipsoid(radius, radius, radius, density, mass=mass, name=name)
+
+
+def _mass_from(volume, density, mass):
+    if (density is None) == (mass is None):
+        raise ValueError("give exactly one of density (kg/m^3) or mass (kg)")
+    if mass is not None:
+        return require_positive_scalar("mass", mass, MIN_MASS, MAX_MASS, "kg")
+    density = require_positive_scalar("density", density, MIN_DENSITY, MAX_DENSITY, "kg/m^3")
+    return require_positive_scalar("mass (density × volume)", density * volume, MIN_MASS, MAX_MASS,
+                                   "kg")
