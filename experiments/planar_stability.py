@@ -78,7 +78,7 @@ def main():
     fig, axes = plt.subplots(len(names), 3, figsize=(13.5, 3.6 * len(names)), squeeze=False)
     arrays, numbers = {"theta_p": theta, "thetadot_p": thetadot}, {}
     common = dict(orbits=orbits, rtol=RTOL, megno_chaotic=MEGNO_CHAOTIC, fraction_orbits=(),
-                  progress=False)
+                  run=tso.Run(progress=False))
     for row, name in zip(axes, names):
         system = tso.catalog.system(name)
         planar = tso.chaos_map(system, theta, thetadot, indicator_space="planar", **common)

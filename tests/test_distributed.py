@@ -20,7 +20,7 @@ from ti_spinorbit.studies.chaosmap import chaos_map, parameter_map
 from ti_spinorbit.studies.overlap import overlap_threshold, overlap_vs_eccentricity
 from ti_spinorbit.studies.section import SectionResult
 
-from conftest import lumpy_body
+from conftest import lumpy_body, run_options
 
 pytest.importorskip("distributed")
 
@@ -46,6 +46,12 @@ def client():
 @pytest.fixture(scope="module")
 def vh_local(vh):
     return chaos_map(vh, THETA_P, THETADOT_P, ORBITS, rtol=RTOL)
+
+
+def sections(client, *args, **kw):
+    """surface_of_section on the cluster, its run options (chunk_size, retries, ...) given as
+    keywords."""
+    return tso.surface_of_section(*args, **run_options(client=client, **kw))
 
 
 def assert_sections_equal(got, want):
@@ -105,10 +111,10 @@ def test_chunks_with_different_crossing_counts_are_nan_padded(client):
     eccentric = tso.catalog.system("1991 VH", eccentricity=0.3)
     circular = tso.catalog.system("1991 VH", eccentricity=0.0)
     systems = [eccentric] * 3 + [circular] * 3
-    kwargs = dict(rtol=RTOL, escape_distance=1.1, indicators=True)
+    kwargs = dict(rtol=RTOL, integrator=tso.Integrator(escape_distance=1.1), indicators=True)
     local = tso.surface_of_section(systems, 0.0, np.linspace(0.5, 2.0, 6), ORBITS, **kwargs)
     assert local.count[:3].max() == 0 and local.count[3:].min() > 1
-    got = tsd.run_sections(client, systems, 0.0, np.linspace(0.5, 2.0, 6), ORBITS,
+    got = sections(client, systems, 0.0, np.linspace(0.5, 2.0, 6), ORBITS,
                            chunk_size=3, **kwargs)
     assert_sections_equal(got, local)
 
@@ -131,9 +137,9 @@ def test_overlap_scans_with_client_equal_local(client):
     assert got.decisions == local.decisions or all(  # NaN != NaN in the evidence
         repr(a) == repr(b) for a, b in zip(got.decisions, local.decisions))
     assert_sections_equal(got.sections, local.sections)
-    # overlap_vs_eccentricity passes client= through to every scan
-    _, _, _, scans = overlap_vs_eccentricity("1991 VH", [local.eccentricity], client=client,
-                                             **kwargs)
+    # overlap_vs_eccentricity passes run=Run(client=...) on to every scan
+    _, _, _, scans = overlap_vs_eccentricity("1991 VH", [local.eccentricity], **kwargs,
+                                             run=tso.Run(client=client))
     assert_sections_equal(scans[0].sections, local.sections)
 
 
@@ -197,7 +203,7 @@ def test_chunk_failing_every_retry_raises_naming_it(client, vh, faulty_workers):
     faulty_workers("always")
     with pytest.raises(tsd.ChunkError, match=r"chunk 1 of 3 \(members 5\.\.9\) failed after "
                                              r"2 attempts: ValueError: injected") as info:
-        tsd.run_sections(client, vh, THETA_P[:, None], THETADOT_P[None, :], ORBITS,
+        sections(client, vh, THETA_P[:, None], THETADOT_P[None, :], ORBITS,
                          chunk_size=5, retries=1, rtol=RTOL, indicators=True)
     assert info.value.chunk == 1 and info.value.members == slice(5, 10)
     assert isinstance(info.value.__cause__, ValueError)
@@ -205,20 +211,20 @@ def test_chunk_failing_every_retry_raises_naming_it(client, vh, faulty_workers):
 
 def test_argument_errors(client, vh):
     with pytest.raises(ValueError, match="chunk_size"):
-        tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, chunk_size=0)
+        sections(client, vh, 0.0, 1.0, ORBITS, chunk_size=0)
     with pytest.raises(ValueError, match="retries"):
-        tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, retries=-1)
+        sections(client, vh, 0.0, 1.0, ORBITS, retries=-1)
     with pytest.raises(TypeError):
-        tsd.run_sections(client, [], 0.0, 1.0, ORBITS)
+        sections(client, [], 0.0, 1.0, ORBITS)
     # raised on the client, before any chunk is sent (not retried as a ChunkError)
     with pytest.raises(ValueError, match="orbits"):
-        tsd.run_sections(client, vh, 0.0, 1.0, 0.0)
+        sections(client, vh, 0.0, 1.0, 0.0)
     with pytest.raises(ValueError, match="rtol"):
-        tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, rtol=0.5)
+        sections(client, vh, 0.0, 1.0, ORBITS, rtol=0.5)
     with pytest.raises(TypeError, match="rtool"):
-        tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, rtool=1e-9)
+        sections(client, vh, 0.0, 1.0, ORBITS, rtool=1e-9)
     with pytest.raises(ValueError, match="checkpoint"):       # chunks would share one file
-        tsd.run_sections(client, vh, 0.0, 1.0, ORBITS, checkpoint="run.ckpt")
+        sections(client, vh, 0.0, 1.0, ORBITS, checkpoint="run.ckpt")
 
 
 def test_ensemble_wide_model_choice_is_made_over_all_members(client, rng, faulty_workers):
@@ -233,17 +239,17 @@ def test_ensemble_wide_model_choice_is_made_over_all_members(client, rng, faulty
     faulty_workers("report")
     for systems, model in (([lumpy, plain, plain, plain], "3d"), ([plain] * 4, "planar")):
         with pytest.raises(tsd.ChunkError, match=f"chunk got model='{model}'"):
-            tsd.run_sections(client, systems, 30.0, [1.0, 0.8, 1.2, 1.6], ORBITS,
+            sections(client, systems, 30.0, [1.0, 0.8, 1.2, 1.6], ORBITS,
                              chunk_size=2, retries=0, rtol=RTOL)
 
 
 def test_full_space_chaos_map_with_client_equals_local(client, vh):
     """indicator_space="full" makes every chunk use the 3-D model (as one launch would), so
     the map equals the single-process one bit for bit (docs/physics.md §10.4)."""
-    kw = dict(rtol=RTOL, indicator_space="full", fraction_orbits=(), progress=False)
-    local = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, **kw)
+    kw = dict(rtol=RTOL, indicator_space="full", fraction_orbits=())
+    local = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, **kw, run=tso.Run(progress=False))
     remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:2], 2, **kw,
-                       run=tso.Run(client=client, chunk_size=2))
+                       run=tso.Run(client=client, chunk_size=2, progress=False))
     assert remote.indicator_space == local.indicator_space == "full"
     assert_sections_equal(remote.section, local.section)
 
@@ -252,15 +258,15 @@ def test_tilted_and_explicit_starts_go_to_the_cluster(client, vh):
     """The Dask runner takes the member table, so every kind of start goes to a cluster:
     a tilted chaos map and explicit 3-D states equal their single-process runs bit for bit
     (they were refused with a client before)."""
-    kw = dict(rtol=RTOL, tilt=(5.0, 2.0), fraction_orbits=(), progress=False)
-    local = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, **kw)
+    kw = dict(rtol=RTOL, tilt=(5.0, 2.0), fraction_orbits=())
+    local = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, **kw, run=tso.Run(progress=False))
     remote = chaos_map(vh, THETA_P[:2], THETADOT_P[:3], 2, **kw,
-                       run=tso.Run(client=client, chunk_size=2))
+                       run=tso.Run(client=client, chunk_size=2, progress=False))
     assert remote.section.max_tilt.max() > 1.0           # really out of the plane
     assert_sections_equal(remote.section, local.section)
     starts = [vh.tilted_start(30.0, 1.2, roll=3.0, pitch=0.0),
               vh.tilted_start(60.0, 0.9, roll=0.0, pitch=4.0)]
     alone = tso.surface_of_section(vh, initial_states=starts, orbits=2, rtol=RTOL)
-    split = tsd.run_sections(client, vh, None, None, 2, chunk_size=1, rtol=RTOL,
+    split = sections(client, vh, None, None, 2, chunk_size=1, rtol=RTOL,
                              initial_states=starts)
     assert_sections_equal(split, alone)

@@ -18,8 +18,8 @@ from ..engine import progress as _progress
 from ..engine.results import STATUS_NAMES, Status
 from ..files import check_name, claim, safe_part, target
 from ..model.coordinates import APSIDAL_MIN_ECCENTRICITY
+from ..output import plotting as _plotting
 from ..output.io import read_metadata, save
-from ..output.plotting import _pyplot, save_figure
 from ..system import catalog
 from ..system.systems import read_system_file
 
@@ -101,7 +101,7 @@ def check_plotting():
     try:
 
         choose_backend()
-        _pyplot()
+        _plotting._pyplot()
     except Exception as exc:  # noqa: BLE001 - any failure here would lose the figure later
         backend = os.environ.get("MPLBACKEND")
         if backend:
@@ -465,7 +465,7 @@ def write_outputs(result, data, extra, figure, out):
 
     data = _save(result, data, extra)
     try:
-        save_figure(figure(), out)
+        _plotting.save_figure(figure(), out)
     except Exception as exc:  # noqa: BLE001 - whatever Matplotlib raises, the data are safe
         raise FigureError(f"the figure {out!r} could not be written ({one_line(exc)}); "
                           f"the data are saved in {data}") from exc

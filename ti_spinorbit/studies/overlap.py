@@ -40,7 +40,6 @@ records them for the connecting trajectory, which should be clearly chaotic (⟨
 All elongations of a scan run in one ensemble launch (each member carries its own system).
 """
 
-import inspect
 from dataclasses import dataclass, field, replace
 from typing import Callable, List, Optional, Union
 
@@ -505,26 +504,34 @@ def _max_megno(sec, idx):
     return float(np.nanmax(megno)) if np.isfinite(megno).any() else float("nan")
 
 
-def overlap_vs_eccentricity(name, eccentricities, elongations=None, **kwargs):
-    """Overlap scans of a catalogued system at several eccentricities (same kwargs as
-    :func:`overlap_threshold`, ``client`` and ``coordinates`` included). Returns (eccentricities, numerical
-    first_overlap (NaN if none), analytic a/b at ω0^RO(e), list of OverlapScan)."""
+def overlap_vs_eccentricity(name, eccentricities, elongations=None, orbits=1000, *, rtol=None,
+                            method=None, integrator=None, run=None, centre_starts=48,
+                            separatrix_starts=32, libration_limit=LIBRATION_LIMIT_DEG,
+                            indicators=True, max_drift=None, include_inaccurate=False,
+                            coordinates="inertial", max_orbits=None, perturbations=None):
+    """Overlap scans of a catalogued system at several eccentricities: one
+    :func:`overlap_threshold` per eccentricity, every keyword passed on as it is (their
+    meaning is documented there; ``run=Run(client=...)`` sends every scan to the cluster).
+    Returns (eccentricities, numerical first_overlap (NaN if none), analytic a/b at
+    ω0^RO(e), list of OverlapScan)."""
     ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
     # every scan keeps its sections: size all of them together, before the first
-    default = {k: v.default for k, v in inspect.signature(overlap_threshold).parameters.items()}
-    args = dict(default, **kwargs)
     try:
         per_scan = (15 if elongations is None else np.size(elongations)) * \
-            (int(args["centre_starts"]) + int(args["separatrix_starts"]))
-        orbits = float(args["orbits"])
+            (int(centre_starts) + int(separatrix_starts))
+        length = float(orbits)
     except (TypeError, ValueError):
         per_scan = None                        # named by overlap_threshold's own checks
-    if per_scan and np.isfinite(orbits) and orbits > 0:
-        resources.check_memory("overlap_vs_eccentricity", ecc.size * per_scan, orbits,
+    if per_scan and np.isfinite(length) and length > 0:
+        resources.check_memory("overlap_vs_eccentricity", ecc.size * per_scan, length,
                                advice="use fewer eccentricities, elongations, starts or orbits")
-    scans = [overlap_threshold(name, elongations=elongations, eccentricity=float(e), **kwargs)
-             for e in ecc]
+    scan = dict(rtol=rtol, method=method, integrator=integrator, run=run,
+                centre_starts=centre_starts, separatrix_starts=separatrix_starts,
+                libration_limit=libration_limit, indicators=indicators, max_drift=max_drift,
+                include_inaccurate=include_inaccurate, coordinates=coordinates,
+                max_orbits=max_orbits, perturbations=perturbations)
+    scans = [overlap_threshold(name, elongations, float(e), orbits, **scan) for e in ecc]
     first = np.array([np.nan if s.first_overlap is None else s.first_overlap for s in scans])
     return ecc, first, np.array([s.elongation_ro for s in scans]), scans
 
