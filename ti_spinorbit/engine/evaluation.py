@@ -26,11 +26,15 @@ from ..system.systems import G
 from ..model.coordinates import apsidal_rate
 
 
+#: Parameter-row columns of integrals with an odd exponent, both bodies.
+_ODD_COLUMNS = np.array(odd_columns(ROW_LENGTH))
+
+
 def has_odd(par) -> bool:
     """Whether any member row holds an integral with an odd exponent (the kernels' odd
     terms are then compiled in), as ``Ensemble`` decides it."""
     par = np.asarray(par)
-    return bool(par.size and np.any(par[:, odd_columns(ROW_LENGTH)] != 0.0))
+    return bool(par.size and np.any(par[:, _ODD_COLUMNS] != 0.0))
 
 
 def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
@@ -92,11 +96,13 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     return V, F, out[:, 4:7].reshape(batch + (3,)), out[:, 7:10].reshape(batch + (3,))
 
 
-def true_acceleration(par, states, order=4):
+def true_acceleration(par, states, order=4, odd=None):
     """Relative acceleration d²R/dt² seen from the inertial frame, in primary-frame
     components, scaled units (G = 1, a = 1, n = 1), for 3-D states (M, 30) with parameter
     rows par (M, NPAR). It is −(∂U/∂R)/m: the kernels' dV/dt = V × Ω1 − (∂U/∂R)/m with the
-    frame term V × Ω1 removed (docs/physics.md §4.3)."""
+    frame term V × Ω1 removed (docs/physics.md §4.3). ``odd``: whether the odd terms are
+    needed (default: decided from ``par``; pass it when ``par`` repeats the rows of fewer
+    members, one per record, and the decision is known from those)."""
     from ..kernels import advance as K      # Taichi: imported on first use
 
     runtime.ensure_init()
@@ -105,18 +111,18 @@ def true_acceleration(par, states, order=4):
     if len(y) == 0:
         return np.zeros((0, 3))
     f = np.zeros_like(y)
-    K.SPATIAL.evaluate_rhs(par, y, f, int(order), has_odd(par))
+    K.SPATIAL.evaluate_rhs(par, y, f, int(order), has_odd(par) if odd is None else bool(odd))
     V = y[:, _S.Y_V:_S.Y_V + 3]
     om1 = par[:, _S.P_IA:_S.P_IA + 3] * y[:, _S.Y_W1:_S.Y_W1 + 3]
     return f[:, _S.Y_V:_S.Y_V + 3] + np.cross(om1, V)
 
 
-def apsidal_rates(par, states, order=4):
+def apsidal_rates(par, states, order=4, odd=None):
     """ϖ̇ (units of n) of scaled 3-D states (M, 30) with parameter rows par (M, NPAR): the
     exact rate of the osculating line of apsides under the true acceleration
     (:func:`ti_spinorbit.model.coordinates.apsidal_rate`)."""
     states = np.atleast_2d(states)
-    acc = true_acceleration(par, states, order)
+    acc = true_acceleration(par, states, order, odd)
     return apsidal_rate(states[:, _S.Y_R:_S.Y_R + 3], states[:, _S.Y_V:_S.Y_V + 3], acc)
 
 

@@ -82,6 +82,17 @@ def _segment_max(values, counts, floor):
     return out
 
 
+def _per_member(members, value):
+    """``value(system)`` (a number or a tuple of numbers) for every member, as an array with
+    one row per member, evaluated once per distinct system (no loop over members)."""
+    groups = member_groups(members)
+    first = np.asarray(value(groups[0][0]), dtype=np.float64) if groups else np.zeros(0)
+    out = np.empty((len(members),) + first.shape)
+    for system, idx in groups:
+        out[idx] = value(system)
+    return out
+
+
 def _state_rows_and_tilt(members, records_list, y0, y_end):
     """Per member: its start as a state row (docs/physics.md §6.8), the largest pole tilt and
     the largest angle of the spin angular momentum from the short axis (degrees,
@@ -305,8 +316,7 @@ def section_of(members: Members, orbits, *, integrator: Integrator, run: Run,
         rate, = _coords.mask_small_eccentricity(cols["e"], cols["apsidal_rate"],
                                                 what="pericentre passages")
         thetadot = thetadot - rate
-    n = np.array([s.mean_motion for s in systems])
-    a = np.array([s.a for s in systems])
+    n, a = _per_member(systems, lambda s: (s.mean_motion, s.a)).T
     energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end, out.exchange)
     limit = accuracy.drift_limit(ens.rtol, orbits, max_drift)
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
@@ -356,7 +366,8 @@ def _derived_columns(par, records, names, diagnostics=False, apsidal=False, orde
     cols = {"t": padded(flat[:, 0]), **{k: padded(d[k]) for k in names}}
     if apsidal:
         states = flat[:, 1:]
-        cols["apsidal_rate"] = padded(evaluation.apsidal_rates(par[member], states, order))
+        cols["apsidal_rate"] = padded(evaluation.apsidal_rates(par[member], states, order,
+                                                               evaluation.has_odd(par)))
         cols["true_anomaly"] = padded(_coords.true_anomaly(states[:, _S.Y_R:_S.Y_R + 3],
                                                            states[:, _S.Y_V:_S.Y_V + 3]))
     if diagnostics:
@@ -574,9 +585,9 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         theta = np.angle(np.exp(1j * (cols["alpha"] + cols["true_anomaly"])))
         cols["theta"], cols["thetadot"] = _coords.mask_small_eccentricity(
             cols["e"], theta, cols["thetadot"] - cols["apsidal_rate"], what="samples")
-    n = np.array([s.mean_motion for s in members])
-    a = np.array([s.a for s in members])
-    e_unit = np.array([s.total_mass * (s.a * s.mean_motion) ** 2 for s in members])[:, None]
+    n, a, e_unit = _per_member(
+        members, lambda s: (s.mean_motion, s.a, s.total_mass * (s.a * s.mean_motion) ** 2)).T
+    e_unit = e_unit[:, None]
     l_unit = (e_unit / n[:, None])[..., None]
     energies = {k: cols[k] * e_unit for k in ("energy_orbit", "energy_primary", "energy_secondary")}
     exchange = _padded_exchange(out, cols["t"].shape)
