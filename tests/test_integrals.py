@@ -12,6 +12,8 @@ import os
 import numpy as np
 import pytest
 
+from conftest import random_rotation
+
 try:
     from ti_spinorbit.system import integrals as I
 except ImportError:             # the package is being reorganised: load the file on its own
@@ -75,12 +77,6 @@ def torus_mesh(R, r, nu, nv):
     return V, F
 
 
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] *= -1
-    return q
 
 
 def degree_errors(T, ref, order):

@@ -22,6 +22,8 @@ from ti_spinorbit.model import multipole as mp
 sys.path.insert(0, os.path.dirname(__file__))
 import ellipsoid_exact as ex  # noqa: E402
 
+from conftest import random_rotation
+
 G = 6.67430e-11
 
 
@@ -40,12 +42,6 @@ def expm_hat(v):
     return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
 
 
-def random_rotation(rng):
-    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0:
-        q[:, 0] *= -1
-    return q
 
 
 def cloud(rng, n, radius, centred=True):
