@@ -106,7 +106,6 @@ def _checked_run(args):
     tiny bodies, a section at e ~ 0) printed once each as one line on stderr (none with
     --quiet); other warnings as Python shows them."""
 
-
     shown = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):

@@ -4,6 +4,8 @@ import os
 import platform
 import time
 
+import numpy as np
+
 from .. import Integrator, Run, runtime, surface_of_section
 from ..output.io import provenance
 from .common import (build_system, check_output, check_system_flags, claim_outputs, init_taichi,
@@ -41,9 +43,6 @@ def check(args):
 
 
 def run(args):
-    import numpy as np
-
-
     system = build_system(args)
     out = args.out or "benchmark.json"
     thetadot = np.linspace(*BENCH_THETADOT_RANGE, args.members)

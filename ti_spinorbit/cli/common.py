@@ -11,10 +11,12 @@ import re
 import sys
 import tempfile
 
+import numpy as np
+
 from .. import init
+from ..engine import progress as _progress
 from ..engine.checkpoint import check_target, holds_checkpoint, remove
 from ..engine.options import Integrator, Run
-from ..engine import progress as _progress
 from ..engine.results import STATUS_NAMES, Status
 from ..files import check_name, claim, safe_part, target
 from ..model.coordinates import APSIDAL_MIN_ECCENTRICITY
@@ -57,7 +59,6 @@ def check_output(flag, path, extensions):
     changes nothing, and always a temporary file beside it, where the atomic write will put
     its bytes), because permission bits do not tell for root or read-only mounts."""
 
-
     if path is None:
         return
     ext = os.path.splitext(path)[1].lower()
@@ -99,7 +100,6 @@ def check_plotting():
     """Matplotlib must load with the environment's backend before a run whose figure would
     otherwise fail at the end (an invalid MPLBACKEND raises at import)."""
     try:
-
         choose_backend()
         _plotting._pyplot()
     except Exception as exc:  # noqa: BLE001 - any failure here would lose the figure later
@@ -122,7 +122,6 @@ def check_figure_outputs(args):
 
 def init_taichi(args):
     """Start Taichi on --arch; with --quiet, Taichi's own "Starting on arch" line is hidden."""
-
 
     if not args.quiet:
         return init(arch=args.arch)
@@ -209,7 +208,6 @@ def check_system_flags(args):
     fails before any work, naming the flag rather than the library's argument. Returns the
     system (None for 'systems' without --show, or --show with a file)."""
 
-
     name = args.show if args.command == "systems" else getattr(args, "system", None)
     if name is None:
         return None
@@ -230,8 +228,6 @@ def check_system_flags(args):
              "eccentricity": "--eccentricity"}
     elongation = getattr(args, "elongation", None)
     if getattr(args, "elongations", None):
-        import numpy as np
-
         start, stop, step = args.elongations
         scan = np.round(np.arange(start, stop + step / 2, step), 10)      # as overlap.run
         elongation = float(scan.max()) if scan.size else None   # the most elongated is the worst
@@ -483,8 +479,6 @@ def accuracy_status(args, status, energy_drift, max_drift, what="members", stop_
     --allow-inaccurate. Collisions, escapes and step underflows within the drift limit are
     outcomes of a start, reported per member, and do not change the exit status.
     ``stop_status`` (the kernels' codes) names what inaccurate members stopped for."""
-    import numpy as np
-
 
     INACCURATE, NONFINITE, BUDGET = Status.INACCURATE, Status.NONFINITE, Status.STEP_BUDGET
     status = np.asarray(status)

@@ -4,6 +4,8 @@ status 1 above --max-drift)."""
 import math as m
 import sys
 
+import numpy as np
+
 from .. import time_series
 from ..system import catalog
 from .common import (EXIT_CHECK_FAILED, EXIT_OK, build_system, catalogue_name,
@@ -63,7 +65,6 @@ def _plot_energy(ts):
 def _work_line(ts, member=0):
     """The work the perturbations did on a time series member by its last sample, J, and the
     angular momentum they brought in (the drifts above are those of E - W and L - L_ext)."""
-    import numpy as np
 
     ok = np.isfinite(ts.t[member])
     work = float(ts.work[member][ok][-1])

@@ -5,6 +5,8 @@ import math
 import sys
 import warnings
 
+import numpy as np
+
 from ..engine.options import Run
 from ..engine.results import Status
 from ..output.plotting import plot_libration_search
@@ -69,9 +71,6 @@ def _status_code(name):
 
 
 def run(args):
-    import numpy as np
-
-
     system = build_system(args)
     out, data = output_paths(args, "libration", system.name)
     kwargs = dict(orbits=args.orbits, rtol=args.rtol, xtol=args.xtol, max_drift=args.max_drift,

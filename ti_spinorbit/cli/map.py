@@ -1,5 +1,7 @@
 """``ti-spinorbit map``: chaos map (MEGNO, Lyapunov, classes) over a (θ_p, θ̇_p/n) grid."""
 
+import numpy as np
+
 from ..studies.chaosmap import chaos_map
 from .common import (accuracy_status, build_system, check_figure_outputs, check_system_flags,
                      entry_options, finish_checkpoint, init_taichi, output_paths, progress_bar,
@@ -46,9 +48,6 @@ def check(args):
 
 
 def run(args):
-    import numpy as np
-
-
     system = build_system(args)
     nt, nd = args.grid
     lo, hi = args.thetadot_range

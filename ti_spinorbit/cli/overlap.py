@@ -1,5 +1,7 @@
 """``ti-spinorbit overlap``: 1:1 / 3:2 resonance-overlap scan over the elongation a/b."""
 
+import numpy as np
+
 from ..engine.options import Integrator, Run
 from ..studies.overlap import overlap_threshold
 from ..system import catalog
@@ -39,7 +41,6 @@ def add_parser(subparsers):
 
 def _scan(start, stop, step):
     """The a/b values of --elongations START STOP STEP (rounded to 10 digits)."""
-    import numpy as np
 
     return np.round(np.arange(start, stop + step / 2, step), 10)
 

@@ -1,5 +1,7 @@
 """``ti-spinorbit section``: surface of section of a system (PNG + .npz)."""
 
+import numpy as np
+
 from .. import surface_of_section
 from ..engine.results import STATUS_NAMES, Status
 from ..output.plotting import plot_section
@@ -51,9 +53,6 @@ def _status_text(result, k):
 
 
 def run(args):
-    import numpy as np
-
-
     system = build_system(args)
     known = catalogue_name(system)
     starts = args.thetadot or (catalog.section_starts(known) if known else

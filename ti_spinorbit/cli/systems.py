@@ -50,7 +50,6 @@ def run(args):
         return 0
     systems = [catalog.system(name) for name in catalog.names()]
     if args.out:
-
         write_json(args.out, [s.describe() for s in systems], indent=1)
     say(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} "
               f"{'omega0':>7s} {'P_orb (h)':>9s}  {'primary (m)':>17s}  "

@@ -62,7 +62,6 @@ def _warn_near_circular(members):
     """NearCircularWarning when a section's system has e < NEAR_CIRCULAR_E (pericentre
     ill-defined); a warning, since such a run is still a valid integration."""
 
-
     low = sorted({m.e for m in members if m.e < NEAR_CIRCULAR_E})
     if low:
         warnings.warn(f"surface_of_section: e = {low[0]:g} < {NEAR_CIRCULAR_E:g}: the pericentre "
@@ -487,7 +486,6 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     def attitude_class_names(self):
         """``attitude_class`` as text ("planar libration", ..., "" where not classified)."""
         return [CLASSES[c] if c >= 0 else "" for c in np.asarray(self.attitude_class).tolist()]
-
 
     def plot(self, ax=None, quantity="thetadot", members=None, title=None):
         """Each member's θ̇/n (or ``quantity`` "alpha", "theta", "r") against time:

@@ -65,7 +65,6 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
         kernels this variant uses first: integrator, and diagnostics when not used before) and ``seconds`` (the whole first run).
     """
 
-
     models = _choices("models", models, MODELS)
     indicators = _choices("indicators", indicators, (False, True))
     sampling = _choices("sampling", sampling, (False, True))
