@@ -36,6 +36,7 @@ from types import SimpleNamespace
 
 import taichi as ti
 
+from ti_spinorbit.layout import multipole as _MP
 from ti_spinorbit.layout import (C_ACCEPTED, C_REJECTED, C_RHS, COLLISION, DIAG_FIELDS, DONE,
                                  ESCAPE, INACCURATE, NONFINITE, RECORD_WIDTH, RUNNING,
                                  STATUS_NAMES, STEP_BUDGET, STEP_UNDERFLOW)
@@ -53,6 +54,10 @@ from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 # state, everything recorded kept). The host imports them from there, not from here.
 
 NEWTON_MAX_ITER = DEFAULT_CONTROLLER.event_max_iter
+#: Orders up to this one use the hand-written potential; the kernels take
+#: ``KERNEL_ORDER`` as their ``order`` template for every order above it (the tables carry
+#: the true order: ``kernels/multipole_gravity.py``).
+HAND_WRITTEN_MAX, KERNEL_ORDER = _MP.HAND_WRITTEN_MAX, _MP.KERNEL_ORDER
 #: Largest stage matrix (stages x state components) kept in registers with unrolled
 #: component loops: Cash-Karp planar (6 x 10). Larger ones (Cash-Karp 3-D 6 x 30, DOP853
 #: 12 x 10 and 12 x 30) spill anyway, and unrolled they took 3-6x longer to compile
@@ -92,7 +97,9 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
         # Cash-Karp kernel (6 x 14) unrolled runs 17 % faster (and now compiles in about 1 s)
         unroll_components = tableau.stages * NSTATE <= UNROLL_LIMIT
     state = model.state_perturbed if perturbed else model.state
-    rhs = model.rhs_perturbed if perturbed else model.rhs
+    # the order-N arguments (integral rows, scratch, tables) ride along; order <= 4 never
+    # reads them and compiles the code it always did
+    rhs = model.rhs_perturbed_mp if perturbed else model.rhs_mp
     stage_point, combine, put_stage = make_primitives(tableau, NK, unroll_components)
     kmat = stage_matrix_type(tableau, NK)
     error_norm = make_error_norm(tableau, unroll_components)
@@ -235,6 +242,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 h_nd: nd1f, t_end: nd1f, t_stop: nd1f, status: nd1i, counters: nd2l,
                 events: nd3f, n_events: nd1i, samples: nd3f, n_samples: nd1i, next_sample: nd1f,
                 shadow_nd: nd2f, shadow_f_nd: nd2f, ind: nd2f,
+                mpr: nd2f, mps: nd2f, mpi: nd1i, mpf: nd1f,
                 rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64, d0: ti.f64,
                 max_steps: ti.i64, order: ti.template(), odd: ti.template(), sampling: ti.template(),
                 indicators: ti.template()):
@@ -325,7 +333,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 pt = y_s
                             elif stage < _STAGES:
                                 pt = stage_point(y_s, K2, hs, stage)
-                        fc = rhs(par, i, pt, order, odd)          # the only RHS call site
+                        fc = rhs(par, i, pt, order, odd, mpr, mps, mpi, mpf)  # the only RHS call site
                         if stage > 0 or copy == 0:    # (the shadow's start is not counted)
                             calls += 1
                         if copy == 0:
@@ -443,10 +451,19 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     @ti.kernel
     def evaluate_rhs(par: nd2f, y_nd: nd2f, out: nd2f, order: ti.template(), odd: ti.template()):
         """dy/dt for each row of y (also the first stage of every member's first step)."""
+        ti.static_assert(order <= HAND_WRITTEN_MAX, "evaluate_rhs: order > 4 needs evaluate_rhs_mp")
         for i in range(y_nd.shape[0]):
-            _store(out, i, rhs(par, i, _load(y_nd, i), order, odd))
+            _store(out, i, rhs(par, i, _load(y_nd, i), order, odd, par, par, par, par))
 
-    return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs, load=_load,
+    @ti.kernel
+    def evaluate_rhs_mp(par: nd2f, y_nd: nd2f, out: nd2f, mpr: nd2f, mps: nd2f, mpi: nd1i,
+                        mpf: nd1f, order: ti.template(), odd: ti.template()):
+        """:func:`evaluate_rhs` at any order (order-N rows, scratch row i, tables)."""
+        for i in range(y_nd.shape[0]):
+            _store(out, i, rhs(par, i, _load(y_nd, i), order, odd, mpr, mps, mpi, mpf))
+
+    return SimpleNamespace(advance=advance, evaluate_rhs=evaluate_rhs,
+                           evaluate_rhs_mp=evaluate_rhs_mp, load=_load,
                            NSTATE=NK, MODEL_NSTATE=NSTATE, RECORD_WIDTH=1 + NK, model=model,
                            tableau=tableau, controller=controller, perturbed=bool(perturbed))
 
@@ -477,26 +494,42 @@ evaluate_rhs = SPATIAL.evaluate_rhs
 _load_spatial = SPATIAL.load
 
 
+@ti.func
+def _diagnose(par: ti.template(), i, k, y_nd: ti.template(), out: ti.template(),
+              order: ti.template(), odd: ti.template(), mpr: ti.template(), mps: ti.template(),
+              mpi: ti.template(), mpf: ti.template()):
+    """DIAG_FIELDS of state y_nd[k] of member i into out[k] (order-N scratch row k)."""
+    y = _load_spatial(y_nd, k)
+    e_orb, e1, e2 = eom.energy_split_mp(par, i, y, order, odd, mpr, mps, k, mpi, mpf)
+    l_orb, l1, l2 = eom.angular_momentum_split(par, i, y)
+    o, o1 = eom.orthonormality_error(y)
+    out[k, 0] = e_orb
+    out[k, 1] = e1
+    out[k, 2] = e2
+    for c in ti.static(range(3)):
+        out[k, 3 + c] = l_orb[c]
+        out[k, 6 + c] = l1[c]
+        out[k, 9 + c] = l2[c]
+    out[k, 12] = o
+    out[k, 13] = o1
+
+
 @ti.kernel
 def diagnostics(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, order: ti.template(),
                 odd: ti.template()):
     """Energy and angular-momentum split and orthonormality errors (columns DIAG_FIELDS) of
-    states y_nd[k] belonging to members member[k]."""
+    states y_nd[k] belonging to members member[k] (order <= 4)."""
+    ti.static_assert(order <= HAND_WRITTEN_MAX, "diagnostics: order > 4 needs diagnostics_mp")
     for k in range(y_nd.shape[0]):
-        i = member[k]
-        y = _load_spatial(y_nd, k)
-        e_orb, e1, e2 = eom.energy_split(par, i, y, order, odd)
-        l_orb, l1, l2 = eom.angular_momentum_split(par, i, y)
-        o, o1 = eom.orthonormality_error(y)
-        out[k, 0] = e_orb
-        out[k, 1] = e1
-        out[k, 2] = e2
-        for c in ti.static(range(3)):
-            out[k, 3 + c] = l_orb[c]
-            out[k, 6 + c] = l1[c]
-            out[k, 9 + c] = l2[c]
-        out[k, 12] = o
-        out[k, 13] = o1
+        _diagnose(par, member[k], k, y_nd, out, order, odd, par, par, par, par)
+
+
+@ti.kernel
+def diagnostics_mp(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, mpr: nd2f, mps: nd2f,
+                   mpi: nd1i, mpf: nd1f, order: ti.template(), odd: ti.template()):
+    """:func:`diagnostics` at any order: member[k]'s order-N integral row, scratch row k."""
+    for k in range(y_nd.shape[0]):
+        _diagnose(par, member[k], k, y_nd, out, order, odd, mpr, mps, mpi, mpf)
 
 
 @ti.kernel

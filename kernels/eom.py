@@ -22,9 +22,10 @@ dS/dt = hat(Ω2 − Ω1) S equals S hat(Ω2') − hat(Ω1) S because S hat(x) S�
 
 import taichi as ti
 
-from ti_spinorbit.layout import spatial as _L
+from ti_spinorbit.layout import multipole as _MP, spatial as _L
 
 from . import perturb
+from .multipole_gravity import mutual_n
 from .mutual_gravity import mat_t_vec, mat_vec, mutual, vec3, mat3
 
 # The state offsets and the member parameter row (two body rows, then derived constants,
@@ -69,14 +70,39 @@ def angular_velocities(p: ti.template(), i, y):
 
 
 @ti.func
+def gravity(p: ti.template(), i, k, G, R, S, order: ti.template(), odd: ti.template(),
+            mpr: ti.template(), mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
+    """U, ∂U/∂R, μ1, μ2 of member i (frame A): the hand-written formulas of
+    ``mutual_gravity.py`` for order <= 4 (the code as it always was), the table-driven ones
+    of ``multipole_gravity.py`` above (``order`` is then ``layout.multipole.KERNEL_ORDER``
+    and the tables ``mpi``, ``mpf`` hold the true order; member i's integral row is
+    ``mpr[i]``, the scratch row ``mps[k]``)."""
+    if ti.static(order > _MP.HAND_WRITTEN_MAX):
+        return mutual_n(mpr, i, mps, k, mpi, mpf, G, R, S)
+    else:
+        return mutual(p, i, BODY_A, BODY_B, G, R, S, order, odd)
+
+
+@ti.func
 def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
-    """dy/dt of the scaled state of member i (G = 1)."""
-    dy, om1, om2 = _rhs_and_rates(p, i, y, order, odd)
+    """dy/dt of the scaled state of member i (G = 1), order <= 4."""
+    return rhs_mp(p, i, y, order, odd, p, p, p, p)
+
+
+@ti.func
+def rhs_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+           mpr: ti.template(), mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
+    """dy/dt of the scaled state of member i (G = 1) at any order: ``mpr`` ... ``mpf`` the
+    order-N integral rows, scratch and tables (:func:`gravity`; not read at order <= 4,
+    where any array may stand in for them)."""
+    dy, om1, om2 = _rhs_and_rates(p, i, y, order, odd, mpr, mps, mpi, mpf)
     return dy
 
 
 @ti.func
-def _rhs_and_rates(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+def _rhs_and_rates(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+                   mpr: ti.template(), mps: ti.template(), mpi: ti.template(),
+                   mpf: ti.template()):
     """dy/dt and the two angular velocities Ω1, Ω2 it used (primary frame), so that the
     perturbed RHS does not compute them again."""
     R = get3(y, Y_R)
@@ -85,7 +111,7 @@ def _rhs_and_rates(p: ti.template(), i, y, order: ti.template(), odd: ti.templat
     w2 = get3(y, Y_W2)
     S = get33(y, Y_S)
     om1, om2 = angular_velocities(p, i, y)
-    U, dUdR, mu1, mu2 = mutual(p, i, BODY_A, BODY_B, 1.0, R, S, order, odd)
+    U, dUdR, mu1, mu2 = gravity(p, i, i, 1.0, R, S, order, odd, mpr, mps, mpi, mpf)
     dy = state(0.0)
     put3(dy, Y_R, R.cross(om1) + V)
     put3(dy, Y_V, V.cross(om1) - dUdR / p[i, P_MRED])
@@ -103,9 +129,17 @@ def _rhs_and_rates(p: ti.template(), i, y, order: ti.template(), odd: ti.templat
 
 @ti.func
 def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """:func:`rhs_perturbed_mp` at order <= 4."""
+    return rhs_perturbed_mp(p, i, y, order, odd, p, p, p, p)
+
+
+@ti.func
+def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+                     mpr: ti.template(), mps: ti.template(), mpi: ti.template(),
+                     mpf: ti.template()):
     """dy/dt with the tides, YORP and BYORP of member i's perturbation block (columns from
     NPAR, ``kernels/perturb.py``), and the accumulators' rates: work and external torque."""
-    base, om1, om2 = _rhs_and_rates(p, i, y, order, odd)
+    base, om1, om2 = _rhs_and_rates(p, i, y, order, odd, mpr, mps, mpi, mpf)
     R = get3(y, Y_R)
     V = get3(y, Y_V)
     S = get33(y, Y_S)
@@ -158,12 +192,21 @@ def osculating_elements(y):
 
 @ti.func
 def energy_split(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
-    """(orbit, primary spin, secondary spin) energies, scaled units: orbit = |P|²/2m + U."""
+    """:func:`energy_split_mp` at order <= 4."""
+    return energy_split_mp(p, i, y, order, odd, p, p, i, p, p)
+
+
+@ti.func
+def energy_split_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+                    mpr: ti.template(), mps: ti.template(), k, mpi: ti.template(),
+                    mpf: ti.template()):
+    """(orbit, primary spin, secondary spin) energies, scaled units: orbit = |P|²/2m + U
+    (at any order; the order-N scratch row ``k``)."""
     R = get3(y, Y_R)
     V = get3(y, Y_V)
     S = get33(y, Y_S)
     om1, om2 = angular_velocities(p, i, y)
-    U, dUdR, mu1, mu2 = mutual(p, i, BODY_A, BODY_B, 1.0, R, S, order, odd)
+    U, dUdR, mu1, mu2 = gravity(p, i, k, 1.0, R, S, order, odd, mpr, mps, mpi, mpf)
     e_orb = 0.5 * p[i, P_MRED] * V.dot(V) + U
     e1 = 0.5 * p[i, P_C1] * get3(y, Y_W1).dot(om1)
     e2 = 0.5 * p[i, P_C2] * get3(y, Y_W2).dot(om2)

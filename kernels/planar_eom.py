@@ -49,9 +49,10 @@ The torques about z are τ_k = −V_k, so m ℓ + Γ1 + Γ2 is conserved exactly
 
 import taichi as ti
 
-from ti_spinorbit.layout import planar as _L
+from ti_spinorbit.layout import multipole as _MP, planar as _L
 
 from . import perturb
+from .multipole_gravity import mutual_n
 
 # The state offsets and the member parameter row (scaled units) are ti_spinorbit.layout's,
 # shared with the host (ti_spinorbit.model.planar fills the row).
@@ -97,8 +98,40 @@ def _series(pv, o2: ti.template(), o3: ti.template(), o4: ti.template(), c, s,
 
 
 @ti.func
-def potential(pv, y, order: ti.template(), odd: ti.template()):
-    """V = −U and its derivatives (V, V_r, V_A, V_B) at the state y."""
+def potential(pv, y, order: ti.template(), odd: ti.template(), mpr: ti.template(), i,
+              mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
+    """V = −U and its derivatives (V, V_r, V_A, V_B) at the state y: the Fourier series
+    below for order <= 4, the table-driven order-N potential above (member i's integral
+    row ``mpr[i]``, scratch row ``mps[i]``)."""
+    if ti.static(order > _MP.HAND_WRITTEN_MAX):
+        return potential_n(y, mpr, i, mps, mpi, mpf)
+    else:
+        return potential_4(pv, y, order, odd)
+
+
+@ti.func
+def potential_n(y, mpr: ti.template(), i, mps: ti.template(), mpi: ti.template(),
+                mpf: ti.template()):
+    """(V, V_r, V_A, V_B) of the order-N potential (``multipole_gravity.mutual_n``) in the
+    plane: R = r (cos ψ_A, sin ψ_A, 0) in the primary's frame and S the z-rotation by
+    θ_B − θ_A = ψ_A − ψ_B. V_r = −∂U/∂R · R/r, and V_k = −τ_k,z (the torques about z;
+    docs/physics.md §5)."""
+    r = y[Y_R]
+    cA = y[Y_CA]
+    sA = y[Y_SA]
+    cB = y[Y_CB]
+    sB = y[Y_SB]
+    c = cA * cB + sA * sB                      # cos(ψ_A − ψ_B)
+    s = sA * cB - cA * sB                      # sin(ψ_A − ψ_B)
+    R = ti.Vector([r * cA, r * sA, 0.0], ti.f64)
+    S = ti.Matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], ti.f64)
+    U, dUdR, mu1, mu2 = mutual_n(mpr, i, mps, i, mpi, mpf, 1.0, R, S)
+    return -U, -(dUdR[0] * cA + dUdR[1] * sA), -mu1[2], -mu2[2]
+
+
+@ti.func
+def potential_4(pv, y, order: ti.template(), odd: ti.template()):
+    """(V, V_r, V_A, V_B) of the order <= 4 Fourier series."""
     inv_r = 1.0 / y[Y_R]
     mm = pv[P_MM]
     V = mm * inv_r
@@ -151,14 +184,29 @@ def member(p: ti.template(), i):
 
 @ti.func
 def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
-    """dy/dt of the planar scaled state of member i (G = 1)."""
+    """dy/dt of the planar scaled state of member i (G = 1), order <= 4."""
     return rhs_member(member(p, i), y, order, odd)
 
 
 @ti.func
+def rhs_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+           mpr: ti.template(), mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
+    """dy/dt of the planar scaled state of member i (G = 1) at any order; ``mpr`` ... ``mpf``
+    the order-N integral rows, scratch and tables (not read at order <= 4)."""
+    return rhs_member_mp(member(p, i), y, order, odd, mpr, i, mps, mpi, mpf)
+
+
+@ti.func
 def rhs_member(pv, y, order: ti.template(), odd: ti.template()):
-    """dy/dt for the parameter vector ``pv`` (:func:`member`)."""
-    V, Vr, VA, VB = potential(pv, y, order, odd)
+    """dy/dt for the parameter vector ``pv`` (:func:`member`), order <= 4."""
+    return rhs_member_mp(pv, y, order, odd, pv, 0, pv, pv, pv)
+
+
+@ti.func
+def rhs_member_mp(pv, y, order: ti.template(), odd: ti.template(), mpr: ti.template(), i,
+                  mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
+    """dy/dt for the parameter vector ``pv`` (:func:`member`) at any order."""
+    V, Vr, VA, VB = potential(pv, y, order, odd, mpr, i, mps, mpi, mpf)
     inv_r = 1.0 / y[Y_R]
     ell = y[Y_L]
     lam_dot = ell * inv_r * inv_r
@@ -181,11 +229,19 @@ def rhs_member(pv, y, order: ti.template(), odd: ti.template()):
 
 @ti.func
 def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
+    """:func:`rhs_perturbed_mp` at order <= 4."""
+    return rhs_perturbed_mp(p, i, y, order, odd, p, p, p, p)
+
+
+@ti.func
+def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+                     mpr: ti.template(), mps: ti.template(), mpi: ti.template(),
+                     mpf: ti.template()):
     """dy/dt with member i's tides, YORP and BYORP (``kernels/perturb.py``; the block starts
     at column NPAR) in the plane, and the accumulators' rates (work, external torque along
     z; the x and y components stay zero)."""
     pv = member(p, i)
-    base = rhs_member(pv, y, order, odd)
+    base = rhs_member_mp(pv, y, order, odd, mpr, i, mps, mpi, mpf)
     q = NPAR
     r = y[Y_R]
     vr = y[Y_VR]

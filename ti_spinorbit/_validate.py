@@ -10,6 +10,8 @@ import os
 
 import numpy as np
 
+from .layout import multipole as _multipole_layout
+
 #: require_memory refuses a request above this share of the available memory (the rest is
 #: left for the interpreter, Taichi and the operating system).
 MEMORY_FRACTION = 0.8
@@ -158,13 +160,24 @@ def require_positive_scalar(name, value, low, high, unit=""):
     return require_scalar(name, value, low, high, unit=unit)
 
 
+#: Highest truncation order of the mutual potential (the order-N kernels' tables).
+MAX_ORDER = _multipole_layout.MAX_ORDER
+
+
 def require_order(order):
-    """The truncation order of the mutual potential as an int: one of 0, 2, 3, 4."""
+    """The truncation order of the mutual potential as an int: 0 (point masses) or 2 to
+    MAX_ORDER (1 adds nothing to 0: first moments vanish about the centre of mass). Orders
+    up to 4 use the hand-written kernels, higher ones the table-driven ones."""
     if isinstance(order, (bool, np.bool_, str, bytes)) or np.ndim(order) != 0:
-        raise TypeError(f"order must be one of the integers 0, 2, 3, 4 (got {show(order)})")
-    if order not in (0, 2, 3, 4):
-        raise ValueError(f"order must be 0, 2, 3 or 4 (got {show(order)})")
-    return int(order)
+        raise TypeError(f"order must be an integer, 0 or in [2, {MAX_ORDER}] (got {show(order)})")
+    try:
+        value = float(order)
+    except (TypeError, ValueError):
+        raise TypeError(f"order must be an integer, 0 or in [2, {MAX_ORDER}] "
+                        f"(got {show(order)})") from None
+    if not (value == 0 or (value.is_integer() and 2 <= value <= MAX_ORDER)):
+        raise ValueError(f"order must be 0 or an integer in [2, {MAX_ORDER}] (got {show(order)})")
+    return int(value)
 
 
 def require_callable(name, value):

@@ -74,6 +74,35 @@ class planar:
     NPAR = 37
 
 
+class multipole:
+    """The order-N mutual potential's tables (``ti_spinorbit.engine.multipole_tables``,
+    ``kernels/multipole_gravity.py``): the positions of the header at the start of the
+    integer table. Every other position (table sections, per-member scratch offsets) is read
+    from this header at run time, so the kernels hold no size of their own."""
+
+    #: Highest truncation order the tables and the kernels accept (the host reference's).
+    MAX_ORDER = 16
+    #: Orders up to this one use the hand-written kernels (``kernels/mutual_gravity.py``);
+    #: above it the table-driven ones. The kernels are compiled once for every order above
+    #: it: ``KERNEL_ORDER`` is the template value they take for all of them.
+    HAND_WRITTEN_MAX = 4
+    KERNEL_ORDER = 5
+    (H_WIDTH_A,            # columns of the primary in a member's integral row: C(dA + 3, 3)
+     H_ND,                 # entries of D = ∂^γ(1/r) at R: C(N + 4, 3) (degrees 0..N+1)
+     H_NDB,                # entries of D at the secondary's frame R_B = Sᵀ R
+     H_NW,                 # entries of the combined moments W_γ: C(N + 3, 3)
+     H_KR,                 # top degree of the rotated secondary integrals (< 2: none)
+     H_NA,                 # primary terms (normalised primary integrals)
+     H_NB,                 # secondary-only terms
+     H_NBETA,              # secondary multi-indices β of the mixed terms
+     H_NGAM,               # entries of the energy and force sum over W
+     H_I_D, H_I_A, H_I_B, H_I_ROT, H_I_BETA, H_I_PAIR, H_I_GAM,   # sections, integer table
+     H_F_D, H_F_A, H_F_B, H_F_ROT, H_F_BETA,                      # sections, float table
+     H_S_D, H_S_DB, H_S_W, H_S_TA, H_S_TB, H_S_P0, H_S_P1,        # scratch offsets
+     H_SCRATCH,            # scratch columns per member
+     NHEAD) = range(30)
+
+
 class perturbation:
     """Columns of the perturbation block, relative to its start (a model's NPAR)."""
 

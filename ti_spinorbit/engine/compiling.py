@@ -45,7 +45,9 @@ from ..model import models as _models
 from . import progress
 from .. import runtime
 from ..kernels import tableau as _tableau
-from ..layout import DONE
+from ..layout import DONE, multipole as _multipole_layout
+
+_HAND_WRITTEN_MAX = _multipole_layout.HAND_WRITTEN_MAX
 
 _LOG = logging.getLogger("ti_spinorbit")
 
@@ -90,10 +92,14 @@ class KernelVariant:
     @property
     def name(self) -> str:
         """``planar/indicators/sections/order4/cash-karp`` (``.../perturbed/cash-karp`` with
-        tides, YORP or BYORP)."""
+        tides, YORP or BYORP; ``.../orderN/...`` for every order above 4)."""
+        # every order above 4 is one compiled variant (the table-driven potential: the
+        # tables, which are data, carry the order and the odd terms)
+        order_n = int(self.order) > _HAND_WRITTEN_MAX
         parts = [self.model, "indicators" if self.indicators else "plain",
-                 "sampling" if self.sampling else "sections", f"order{int(self.order)}"]
-        if self.odd:
+                 "sampling" if self.sampling else "sections",
+                 "orderN" if order_n else f"order{int(self.order)}"]
+        if self.odd and not order_n:
             parts.append("odd")
         if self.perturbed:
             parts.append("perturbed")

@@ -23,14 +23,15 @@ from typing import Callable, List, Optional
 import numpy as np
 
 from .. import layout, runtime
-from .._validate import (require_count, require_memory, require_positive, require_range,
-                         require_real)
+from .._validate import (require_count, require_memory, require_order, require_positive,
+                         require_range, require_real)
 from ..kernels.controller import DEFAULT_CONTROLLER
 from ..layout import ROW_LENGTH
 from ..model import models
 from ..model.perturbations import NACC, NPERT
 from ..system.bodies import row_columns
 from . import checkpoint as ckpt, compiling, cost, evaluation, resources
+from . import multipole_tables as _mp
 
 #: Default window, in orbits: the most one kernel launch advances (checkpoints and progress
 #: come between launches; slow windows are shortened, see PROGRESS_SECONDS).
@@ -111,14 +112,15 @@ class RunState:
     def from_dict(cls, d):
         return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
 
-    def launch(self, advance, par, t_end, t_stop, events_buf, n_events, samples_buf, n_samples,
-               rtol, atol, min_step, sample_dt, separation, max_steps, order, odd, sampling,
-               indicators):
+    def launch(self, advance, par, multipole, t_end, t_stop, events_buf, n_events, samples_buf,
+               n_samples, rtol, atol, min_step, sample_dt, separation, max_steps, order, odd,
+               sampling, indicators):
         """One launch of ``advance`` (a kernel set's ``advance``, or ``compiling.FirstUse``
-        wrapping it) on this state, updated in place."""
+        wrapping it) on this state, updated in place; ``multipole`` the four order-N arrays
+        (``multipole_tables.Multipole.arguments``, stand-ins at order <= 4)."""
         advance(par, self.y, self.yc, self.f, self.t, self.tc, self.h, t_end, t_stop,
                 self.status, self.counters, events_buf, n_events, samples_buf, n_samples,
-                self.next_sample, self.shadow, self.shadow_f, self.ind, rtol, atol,
+                self.next_sample, self.shadow, self.shadow_f, self.ind, *multipole, rtol, atol,
                 min_step, sample_dt, separation, max_steps, order, odd, sampling, indicators)
 
 
@@ -152,8 +154,10 @@ class Ensemble:
         Member parameter rows (``BinarySystem.parameter_row``).
     y0 : (N, 30) array
         Initial scaled states (``BinarySystem.initial_state``).
-    order : {0, 2, 3, 4}
-        Truncation order of the mutual potential.
+    order : int
+        Truncation order of the mutual potential: 0 or 2 to 16. Up to 4 the hand-written
+        kernels; above 4 the table-driven ones (``kernels/multipole_gravity.py``), which
+        need ``multipole_rows``.
     rtol, atol : float
         Tolerances on the scaled state (error in tolerance units, max norm).
     model : {"auto", "planar", "3d"}
@@ -174,11 +178,17 @@ class Ensemble:
         Scaled tides / YORP / BYORP blocks (``ti_spinorbit.model.perturbations.perturbation_rows``):
         the kernels then integrate the perturbed equations and carry the work and external
         angular momentum after the state (``kernels/perturb.py``; docs/physics.md §13).
+    multipole_rows : (N, width) array, optional
+        Order > 4 only (and then required): both bodies' integrals of degrees 0..dA and
+        0..dB in their own frames, scaled (``multipole_tables.integral_rows``).
+    degrees : (int, int), optional
+        Order > 4 only: degree caps (primary, secondary) of the integrals, each in
+        [0, order]; default (order, order).
     """
 
     def __init__(self, par, y0, *, order=4, rtol=1e-12, atol=None, odd=None,
                  min_step=MIN_STEP, model="auto", method="cash-karp", controller=None,
-                 perturbation_rows=None):
+                 perturbation_rows=None, multipole_rows=None, degrees=None):
         from ..kernels import eom
         from ..kernels.tableau import METHODS, check_method
 
@@ -188,11 +198,14 @@ class Ensemble:
         self._y_start = self.y.copy()
         if self.par.ndim != 2 or self.par.shape[1] != eom.NPAR or self.y.shape != (len(self.par), eom.NSTATE):
             raise ValueError("par must be (N, NPAR) and y0 (N, 30) with the same N")
-        if order not in (0, 2, 3, 4):
-            raise ValueError(f"order must be 0, 2, 3 or 4 (got {order!r})")
-        self.order = int(order)
+        self.order = require_order(order)
         self.rtol, self.atol = check_tolerances(rtol, atol)
-        if odd is None:  # any non-zero odd-index integral in either body row?
+        #: the order-N tables and integral rows (``multipole_tables.Multipole``), None at
+        #: order <= 4
+        self.multipole = _multipole(self.order, multipole_rows, degrees, len(self.par), odd)
+        if self.multipole is not None:
+            odd = self.multipole.tables.odd
+        elif odd is None:  # any non-zero odd-index integral in either body row?
             odd = bool(np.any(self.par[:, _odd_columns(ROW_LENGTH)] != 0.0))
         self.odd = bool(odd)
         self.min_step = float(min_step)
@@ -201,7 +214,7 @@ class Ensemble:
         self.controller = None if controller is None or controller == DEFAULT_CONTROLLER \
             else controller
         #: the model object (``ti_spinorbit.model.models``); ``model`` is its name
-        self.equations = models.choose(model, self.par, self.y)
+        self.equations = models.choose(model, self.par, self.y, self._planar_symmetric())
         self._model_request = model      # "auto" may still turn 3-D for full-space indicators
         self.model = self.equations.name
         self.prows = None
@@ -219,6 +232,31 @@ class Ensemble:
                                                 METHODS[self.method].error_exponent))
         self.status = np.zeros(n, dtype=np.int32)
         self.counters = np.zeros((n, 3), dtype=np.int64)
+
+    def _planar_symmetric(self):
+        """Order > 4: per member, whether no integral of its order-N row is odd in z (the
+        planar model needs it at every degree); None at order <= 4 (the rows say)."""
+        if self.multipole is None:
+            return None
+        mask = _mp.odd_mask(self.multipole.degrees, axis=2)
+        return ~np.any(self.multipole.rows[:, mask] != 0.0, axis=1)
+
+    @property
+    def kernel_order(self):
+        """The ``order`` template the kernels take: the order itself up to 4, one value
+        (``layout.multipole.KERNEL_ORDER``) for every higher one, whose tables carry it."""
+        return self.order if self.multipole is None else layout.multipole.KERNEL_ORDER
+
+    @property
+    def kernel_odd(self):
+        """The ``odd`` template the kernels take (above order 4 the tables decide: False)."""
+        return self.odd if self.multipole is None else False
+
+    def multipole_arguments(self, slots=None):
+        """The four order-N arrays of a launch (stand-ins at order <= 4)."""
+        if self.multipole is None:
+            return _mp.no_arguments()
+        return self.multipole.arguments(self.n if slots is None else slots)
 
     @property
     def perturbed(self):
@@ -255,7 +293,8 @@ class Ensemble:
         y = self.spatial(self.y) if y is None else y
         y = np.asarray(y, dtype=np.float64).reshape(-1, 30)
         member = np.arange(len(y), dtype=np.int32) if member is None else member
-        return evaluation.diagnostics(self.par, y, member, self.order, self.odd)
+        return evaluation.diagnostics(self.par, y, member, self.order, self.odd,
+                                      multipole=self.multipole)
 
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
             indicators=False, separation=SHADOW_SEPARATION,
@@ -315,8 +354,10 @@ class Ensemble:
         if indicators and indicator_space == "full":
             self._use_spatial()
             kern = self.kernels
-        require_memory("the recorded crossings and samples",
-                       _record_bytes(t_stop, sample_dt, kern.RECORD_WIDTH, cap),
+        scratch = 0 if self.multipole is None else self.multipole.bytes(n)
+        require_memory("the recorded crossings and samples" + (
+                       " and the order-N scratch" if scratch else ""),
+                       _record_bytes(t_stop, sample_dt, kern.RECORD_WIDTH, cap) + scratch,
                        "integrate fewer members or orbits per call, or sample less densely")
         estimate = cost.steps_per_orbit(self.par, self._y_start, self.rtol, self.method)
         orbits = t_stop / (2.0 * np.pi)
@@ -334,6 +375,8 @@ class Ensemble:
                     "max_steps": requested}
         if self.controller is not None:          # only then: older checkpoints stay valid
             settings["controller"] = repr(self.controller)
+        if self.multipole is not None:           # likewise: order-N runs only
+            settings["degrees"] = list(self.multipole.degrees)
         args = (t_stop, window_orbits, sample_dt, indicators, separation, progress, checkpoint,
                 resume, settings, budget)
         if checkpoint is None:
@@ -360,6 +403,7 @@ class Ensemble:
         advance = compiling.FirstUse(kern.advance, compiling.KernelVariant(
             self.model, bool(indicators), sampling, self.order, self.odd, self.method,
             self.perturbed, self.controller), lambda: self.status)
+        multipole = self.multipole_arguments()
         if st is None:
             with advance.other_kernels():
                 st = self._fresh_run_state(sampling, sample_dt, indicators, separation,
@@ -382,10 +426,10 @@ class Ensemble:
         while np.any(self.status == layout.RUNNING):
             t_end = np.minimum(t_stop, self.t + span)
             launched = time.perf_counter()
-            st.launch(advance, self.kpar, t_end, t_stop, events_buf, n_events, samples_buf,
-                      n_samples, self.rtol, self.atol, self.min_step, float(sample_dt or 0.0),
-                      float(separation), int(max_steps), self.order, self.odd,
-                      sampling, bool(indicators))
+            st.launch(advance, self.kpar, multipole, t_end, t_stop, events_buf, n_events,
+                      samples_buf, n_samples, self.rtol, self.atol, self.min_step,
+                      float(sample_dt or 0.0), float(separation), int(max_steps),
+                      self.kernel_order, self.kernel_odd, sampling, bool(indicators))
             compiled = advance.take_seconds()
             t0, launched = t0 + compiled, launched + compiled
             st.launches += 1
@@ -480,8 +524,11 @@ class Ensemble:
             return None if a is None else hashlib.sha256(
                 np.ascontiguousarray(a, dtype=np.float64).tobytes()).hexdigest()
 
-        return {"systems": digest(self.par), "initial states": digest(self._y_start),
-                "integration times": digest(t_stop), "perturbations": digest(self.prows)}
+        parts = {"systems": digest(self.par), "initial states": digest(self._y_start),
+                 "integration times": digest(t_stop), "perturbations": digest(self.prows)}
+        if self.multipole is not None:      # order-N runs only: older checkpoints stay valid
+            parts["order-N integrals"] = digest(self.multipole.rows)
+        return parts
 
     def _spatial_records(self, chunks_per_member):
         """Every member's record chunks as (count, 31) 3-D rows (time, state), and apart the
@@ -530,6 +577,27 @@ def _record_bytes(t_stop, sample_dt, width, cap):
 def _choose_model(model, par, y0):
     """"planar" or "3d" for Ensemble(model=...) (the name of ``models.choose``)."""
     return models.choose(model, par, y0).name
+
+
+def _multipole(order, rows, degrees, n, odd=None):
+    """The order-N data of an ensemble (``multipole_tables.Multipole``), None at order <= 4;
+    ``rows`` are required above 4 and refused below (as are ``degrees``)."""
+    if order <= layout.multipole.HAND_WRITTEN_MAX:
+        if rows is not None or degrees is not None:
+            raise ValueError(f"multipole_rows and degrees are for orders above "
+                             f"{layout.multipole.HAND_WRITTEN_MAX} (got order {order})")
+        return None
+    dA, dB = _mp.check_degrees(order, degrees)
+    if rows is None:
+        raise ValueError(f"order {order} needs multipole_rows: both bodies' integrals to "
+                         f"degrees ({dA}, {dB}) (multipole_tables.integral_rows)")
+    rows = np.ascontiguousarray(rows, dtype=np.float64)
+    if rows.ndim != 2 or len(rows) != n:
+        raise ValueError(f"multipole_rows must have one row per member ({n}; got shape "
+                         f"{rows.shape})")
+    if odd is None:
+        odd = _mp.odd_present(rows, (dA, dB))
+    return _mp.Multipole(_mp.tables(order, dA, dB, bool(odd)), rows)
 
 
 def _odd_columns(row_length):

@@ -24,6 +24,11 @@ from ..layout import ROW_LENGTH, spatial as _S
 from ..system.bodies import Body, odd_columns
 from ..system.systems import G
 from ..model.coordinates import apsidal_rate
+from . import multipole_tables as _mp
+
+#: States per launch of an order-N evaluation: each takes a scratch row of its own
+#: (``multipole_tables.Tables.scratch``), so long record lists go in blocks of this many.
+ORDER_N_BLOCK = 4096
 
 
 #: Parameter-row columns of integrals with an odd exponent, both bodies.
@@ -37,7 +42,7 @@ def has_odd(par) -> bool:
     return bool(par.size and np.any(par[:, _ODD_COLUMNS] != 0.0))
 
 
-def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
+def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4, degrees=None):
     """Mutual potential energy, force on the secondary and torques, SI, primary frame.
 
     Parameters
@@ -48,8 +53,13 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     S : array (..., 3, 3)
         Rotation taking secondary-frame vectors to the primary frame: orthonormal
         (|S^T S − 1| <= 1e-9) and proper (det S = +1; a reflection is no rigid motion).
-    order : {0, 2, 3, 4}
-        Truncation order (docs/physics.md §3; Ashenberg 2007; Hou et al. 2017).
+    order : int
+        Truncation order, 0 or 2..16 (docs/physics.md §3; Ashenberg 2007; Hou et al. 2017):
+        up to 4 the hand-written kernels, above 4 the table-driven ones (§3.6), which need
+        each body's integrals to the degree used (``body.integral``).
+    degrees : (int, int), optional
+        Order > 4 only: degree caps (primary, secondary) of the integrals, in [0, order];
+        default (order, order).
 
     Returns
     -------
@@ -85,6 +95,11 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     batch = R.shape[:-1]
     Rf = np.ascontiguousarray(R.reshape(-1, 3))
     Sf = np.ascontiguousarray(S.reshape(-1, 3, 3))
+    if order > layout.multipole.HAND_WRITTEN_MAX:
+        return _mutual_potential_n(primary, secondary, Rf, Sf, order, degrees, batch)
+    if degrees is not None:
+        raise ValueError(f"degrees is for orders above {layout.multipole.HAND_WRITTEN_MAX} "
+                         f"(got order {order})")
     par = np.zeros((len(Rf), _S.NPAR))
     par[:, _S.BODY_A:_S.BODY_A + ROW_LENGTH] = primary.as_row()
     par[:, _S.BODY_B:_S.BODY_B + ROW_LENGTH] = secondary.as_row()
@@ -96,13 +111,56 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4):
     return V, F, out[:, 4:7].reshape(batch + (3,)), out[:, 7:10].reshape(batch + (3,))
 
 
-def true_acceleration(par, states, order=4, odd=None):
+def _mutual_potential_n(primary, secondary, Rf, Sf, order, degrees, batch):
+    """:func:`mutual_potential` above order 4: the table-driven kernel in units of the
+    contact distance L = ρ_A + ρ_B and the total mass M (G = 1), so that no power of a length
+    in metres comes near the float range, then back to SI."""
+    from ..kernels import multipole_gravity as K     # Taichi: imported on first use
+
+    dA, dB = _mp.check_degrees(order, degrees)
+    _check_degree(primary, "primary", dA, order)
+    _check_degree(secondary, "secondary", dB, order)
+    M = primary.mass + secondary.mass
+    L = primary.bounding_radius + secondary.bounding_radius
+    row = np.concatenate([_mp.body_integrals(primary, dA, M, L),
+                          _mp.body_integrals(secondary, dB, M, L)])
+    rows = np.repeat(row[None], max(len(Rf), 1), axis=0)
+    tab = _mp.tables(order, dA, dB, _mp.odd_present(row[None], (dA, dB)))
+    out = np.zeros((len(Rf), 10))
+    if len(Rf):
+        runtime.ensure_init()
+        for lo in range(0, len(Rf), ORDER_N_BLOCK):
+            hi = min(lo + ORDER_N_BLOCK, len(Rf))
+            rows_, scr, ints, floats = _mp.Multipole(tab, rows[lo:hi]).arguments(hi - lo)
+            part = np.zeros((hi - lo, 10))
+            K.evaluate_multipole(rows_, np.ascontiguousarray(Rf[lo:hi] / L),
+                                 np.ascontiguousarray(Sf[lo:hi]), scr, ints, floats, part, 1.0)
+            out[lo:hi] = part
+    energy = G * M * M / L
+    V = out[:, 0].reshape(batch) * energy
+    F = -out[:, 1:4].reshape(batch + (3,)) * (energy / L)
+    return (V, F, out[:, 4:7].reshape(batch + (3,)) * energy,
+            out[:, 7:10].reshape(batch + (3,)) * energy)
+
+
+def _check_degree(body, label, degree, order):
+    """Refuse a body whose integrals stop below ``degree``: its missing ones would be taken
+    as zero and the order-``order`` potential silently be a lower one."""
+    provided = _mp.degrees_provided(body)
+    if provided < degree:
+        raise ValueError(f"the {label} holds integrals up to degree {provided}, but order "
+                         f"{order} needs degree {degree}: give it integrals of degree "
+                         f"{degree} or cap it with degrees=")
+
+
+def true_acceleration(par, states, order=4, odd=None, multipole=None):
     """Relative acceleration d²R/dt² seen from the inertial frame, in primary-frame
     components, scaled units (G = 1, a = 1, n = 1), for 3-D states (M, 30) with parameter
     rows par (M, NPAR). It is −(∂U/∂R)/m: the kernels' dV/dt = V × Ω1 − (∂U/∂R)/m with the
     frame term V × Ω1 removed (docs/physics.md §4.3). ``odd``: whether the odd terms are
     needed (default: decided from ``par``; pass it when ``par`` repeats the rows of fewer
-    members, one per record, and the decision is known from those)."""
+    members, one per record, and the decision is known from those). Above order 4
+    ``multipole`` (``multipole_tables.Multipole``) holds the order-N rows, one per state."""
     from ..kernels import advance as K      # Taichi: imported on first use
 
     runtime.ensure_init()
@@ -111,26 +169,35 @@ def true_acceleration(par, states, order=4, odd=None):
     if len(y) == 0:
         return np.zeros((0, 3))
     f = np.zeros_like(y)
-    K.SPATIAL.evaluate_rhs(par, y, f, int(order), has_odd(par) if odd is None else bool(odd))
+    if _order_n(order, multipole):
+        for lo, hi in _blocks(len(y)):
+            part = np.zeros_like(y[lo:hi])
+            K.SPATIAL.evaluate_rhs_mp(par[lo:hi], y[lo:hi], part,
+                                      *multipole.take(np.arange(lo, hi)).arguments(hi - lo),
+                                      layout.multipole.KERNEL_ORDER, False)
+            f[lo:hi] = part
+    else:
+        K.SPATIAL.evaluate_rhs(par, y, f, int(order), has_odd(par) if odd is None else bool(odd))
     V = y[:, _S.Y_V:_S.Y_V + 3]
     om1 = par[:, _S.P_IA:_S.P_IA + 3] * y[:, _S.Y_W1:_S.Y_W1 + 3]
     return f[:, _S.Y_V:_S.Y_V + 3] + np.cross(om1, V)
 
 
-def apsidal_rates(par, states, order=4, odd=None):
+def apsidal_rates(par, states, order=4, odd=None, multipole=None):
     """ϖ̇ (units of n) of scaled 3-D states (M, 30) with parameter rows par (M, NPAR): the
     exact rate of the osculating line of apsides under the true acceleration
-    (:func:`ti_spinorbit.model.coordinates.apsidal_rate`)."""
+    (:func:`ti_spinorbit.model.coordinates.apsidal_rate`; ``multipole`` above order 4: the
+    order-N rows, one per state)."""
     states = np.atleast_2d(states)
-    acc = true_acceleration(par, states, order, odd)
+    acc = true_acceleration(par, states, order, odd, multipole)
     return apsidal_rate(states[:, _S.Y_R:_S.Y_R + 3], states[:, _S.Y_V:_S.Y_V + 3], acc)
 
 
-def diagnostics(par, states, member, order=4, odd=None):
+def diagnostics(par, states, member, order=4, odd=None, multipole=None):
     """``layout.DIAG_FIELDS`` (three energies, three angular-momentum vectors, two
     orthonormality errors; scaled units) of 3-D states (M, 30) of the members ``member``
     (M,) whose rows are ``par`` (N, NPAR); ``odd`` as ``Ensemble`` decides it (default: from
-    the rows)."""
+    the rows); above order 4 ``multipole`` holds the members' order-N rows (N of them)."""
     from ..kernels import advance as K      # Taichi: imported on first use
 
     par = np.ascontiguousarray(par, dtype=np.float64)
@@ -139,8 +206,31 @@ def diagnostics(par, states, member, order=4, odd=None):
     out = np.zeros((len(y), len(layout.DIAG_FIELDS)))
     if len(y):
         runtime.ensure_init()
-        K.diagnostics(par, y, member, out, int(order), has_odd(par) if odd is None else odd)
+        if _order_n(order, multipole):
+            for lo, hi in _blocks(len(y)):
+                part = np.zeros((hi - lo, out.shape[1]))
+                rows, scr, ints, floats = multipole.arguments(hi - lo)
+                K.diagnostics_mp(par, y[lo:hi], member[lo:hi], part, rows, scr, ints, floats,
+                                 layout.multipole.KERNEL_ORDER, False)
+                out[lo:hi] = part
+        else:
+            K.diagnostics(par, y, member, out, int(order), has_odd(par) if odd is None else odd)
     return out
+
+
+def _order_n(order, multipole):
+    """Whether ``order`` needs the order-N kernels; then ``multipole`` must be given."""
+    if int(order) <= layout.multipole.HAND_WRITTEN_MAX:
+        return False
+    if multipole is None or multipole.order != int(order):
+        raise ValueError(f"order {order} needs the members' order-N integral rows "
+                         "(multipole=, a multipole_tables.Multipole of that order)")
+    return True
+
+
+def _blocks(n):
+    """[(lo, hi)] blocks of at most ORDER_N_BLOCK states."""
+    return [(lo, min(lo + ORDER_N_BLOCK, n)) for lo in range(0, n, ORDER_N_BLOCK)]
 
 
 __all__ = ["mutual_potential", "true_acceleration", "apsidal_rates", "diagnostics", "has_odd"]

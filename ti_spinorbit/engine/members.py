@@ -33,7 +33,7 @@ from ..model.perturbations import NACC, check_perturbations, perturbation_rows
 from ..system import catalog
 from ..system.initial import InitialState, as_scaled_states
 from ..system.systems import BinarySystem, ESCAPE_DISTANCE
-from . import evaluation, resources
+from . import evaluation, multipole_tables as _mp, resources
 
 
 
@@ -47,7 +47,11 @@ class Members:
     equations of motion decided for the whole table ("planar" or "3d");
     ``perturbations`` the Tides / YORP / BYORP objects and ``perturbation_rows`` their
     scaled blocks (N, NPERT), None without; ``order`` the potential's truncation order and
-    ``escape_distance`` (units of a) the escape radius the rows carry."""
+    ``escape_distance`` (units of a) the escape radius the rows carry. Above order 4,
+    ``degrees`` (primary, secondary) are the degree caps and ``multipole_rows`` (N, width)
+    both bodies' integrals to those degrees in their own frames, scaled
+    (``multipole_tables.integral_rows``): the order-N kernels' block beside the parameter
+    rows, which keep their order-4 layout; None at order <= 4."""
 
     systems: List[BinarySystem]
     par: np.ndarray
@@ -60,6 +64,8 @@ class Members:
     escape_distance: float = ESCAPE_DISTANCE
     perturbations: tuple = ()
     perturbation_rows: Optional[np.ndarray] = field(default=None, repr=False)
+    degrees: Optional[tuple] = None
+    multipole_rows: Optional[np.ndarray] = field(default=None, repr=False)
 
     def __len__(self):
         return len(self.systems)
@@ -81,12 +87,22 @@ class Members:
         return resources.estimate_bytes(len(self), orbits, samples_per_orbit,
                                         width=self.record_width, states=states)
 
+    def multipole(self):
+        """The order-N data of the table (``multipole_tables.Multipole``: its tables and
+        rows), None at order <= 4."""
+        if self.multipole_rows is None:
+            return None
+        odd = _mp.odd_present(self.multipole_rows, self.degrees)
+        return _mp.Multipole(_mp.tables(self.order, *self.degrees, odd), self.multipole_rows)
+
     def chunk(self, lo, hi) -> "Members":
         """Members lo..hi-1 as a table of their own, with the same decided model."""
         rows = None if self.perturbation_rows is None else self.perturbation_rows[lo:hi]
+        block = None if self.multipole_rows is None else self.multipole_rows[lo:hi]
         return replace(self, systems=self.systems[lo:hi], par=self.par[lo:hi],
                        y0=self.y0[lo:hi], theta_p=self.theta_p[lo:hi],
-                       thetadot_p=self.thetadot_p[lo:hi], perturbation_rows=rows)
+                       thetadot_p=self.thetadot_p[lo:hi], perturbation_rows=rows,
+                       multipole_rows=block)
 
     def chunks(self, size):
         """[(lo, hi, table)] of consecutive chunks of at most ``size`` members."""
@@ -98,17 +114,19 @@ class Members:
     @classmethod
     def from_starts(cls, system, theta_p, thetadot_p, escape_distance=ESCAPE_DISTANCE,
                     coordinates="inertial", order=4, model="auto", perturbations=None,
-                    full_indicators=False) -> "Members":
+                    full_indicators=False, degrees=None) -> "Members":
         """Broadcast systems and initial conditions into a member table.
 
         ``system`` one BinarySystem (or catalogue name) or a list of them; ``theta_p``
         deg, ``thetadot_p`` units of n, broadcast with the systems. ``escape_distance`` is
         in units of a and must exceed 1. With ``coordinates="apsidal"`` thetadot_p is the
         apsidal spin rate θ̇ − ϖ̇ at the start and y0 carries the inertial spin θ̇_p + ϖ̇(0)
-        (docs/physics.md §6.7; ϖ̇ of the ``order`` model)."""
+        (docs/physics.md §6.7; ϖ̇ of the ``order`` model). ``degrees`` (order > 4 only):
+        the caps (primary, secondary) of the integrals, default (order, order)."""
         _coords.check_coordinates(coordinates)
         check_escape_distance(escape_distance)
         systems = system_list(as_systems(system))
+        degrees = order_n_degrees(systems, order, degrees)
         # checked before the conversion, so complex values and text are refused, not cast
         theta_p = np.asarray(require_finite("theta_p", theta_p), dtype=np.float64)
         thetadot_p = np.asarray(require_spin("thetadot_p", thetadot_p), dtype=np.float64)
@@ -131,17 +149,21 @@ class Members:
             sel = np.flatnonzero(index == k)
             if len(sel):
                 y0[sel] = s.initial_states(np.radians(theta_p[sel]), thetadot_p[sel])
+        block = None if degrees is None else _mp.integral_rows(systems, degrees)[index]
         if coordinates == "apsidal":
             _coords.check_apsidal_start(members)
-            rate = evaluation.apsidal_rates(par, y0, order)
+            multipole = None if block is None else _mp.Multipole(
+                _mp.tables(order, *degrees, _mp.odd_present(block, degrees)), block)
+            rate = evaluation.apsidal_rates(par, y0, order, multipole=multipole)
             y0, _ = _coords.apsidal_initial_states(members, rate, theta_p, thetadot_p)
         return cls._decided(members, par, y0, theta_p.copy(), thetadot_p.copy(), model,
                             coordinates, order, escape_distance, perturbations,
-                            full_indicators)
+                            full_indicators, degrees, block)
 
     @classmethod
     def from_states(cls, system, initial_states, escape_distance=ESCAPE_DISTANCE, order=4,
-                    model="auto", perturbations=None, full_indicators=False) -> "Members":
+                    model="auto", perturbations=None, full_indicators=False,
+                    degrees=None) -> "Members":
         """Member table of explicit 3-D starts (:class:`ti_spinorbit.InitialState`): one
         member per state; ``system`` one system for all or one per state. θ_p and θ̇_p are
         each start's α (degrees, docs/physics.md §6.2) and inertial spin rate about the
@@ -155,35 +177,40 @@ class Members:
                              f"state (got {len(systems)} systems for {len(states)} states)")
         members = systems * len(states) if len(systems) == 1 else systems
         check_escape_distance(escape_distance)
+        degrees = order_n_degrees(systems, order, degrees)
         y0 = as_scaled_states(members, states)
         par = parameter_rows(members, escape_distance)
         d = derive(par, y0)
+        block = None if degrees is None else _mp.integral_rows(members, degrees)
         return cls._decided(members, par, y0, np.degrees(d["alpha"]), d["thetadot"], model,
                             "inertial", order, escape_distance, perturbations,
-                            full_indicators)
+                            full_indicators, degrees, block)
 
     @classmethod
     def _decided(cls, members, par, y0, theta_p, thetadot_p, model, coordinates, order,
-                 escape_distance, perturbations, full_indicators):
+                 escape_distance, perturbations, full_indicators, degrees=None, block=None):
         """The table with its model decided (once, over every member) and its perturbation
-        rows built."""
+        rows built. Above order 4 the planar model also needs every order-N integral odd in
+        z to vanish (the parameter rows only show degrees 2..4)."""
         if full_indicators:       # full-space indicators carry out-of-plane deviations
             if model == "planar":
                 raise ValueError("indicator_space='full' needs the 3-D model (the planar model "
                                  "cannot carry out-of-plane deviations): use model='auto' or "
                                  "'3d'")
             model = "3d"
-        decided = models.choose(model, par, y0).name
+        symmetric = None if block is None else \
+            ~np.any(block[:, _mp.odd_mask(degrees, axis=2)] != 0.0, axis=1)
+        decided = models.choose(model, par, y0, symmetric).name
         perturbations = check_perturbations(perturbations)
         return cls(members, par, y0, theta_p, thetadot_p, decided, coordinates, int(order),
                    float(escape_distance), perturbations,
-                   perturbation_rows(members, perturbations))
+                   perturbation_rows(members, perturbations), degrees, block)
 
     @classmethod
     def build(cls, what, system, theta_p, thetadot_p, initial_states, orbits, *,
               escape_distance=ESCAPE_DISTANCE, coordinates="inertial", order=4, model="auto",
               perturbations=None, full_indicators=False, samples_per_orbit=None,
-              states=False) -> "Members":
+              states=False, degrees=None) -> "Members":
         """The member table of the entry point ``what``, from (θ_p, θ̇_p) or from
         ``initial_states``, after the memory check (from the input sizes alone, before any
         member is built; ``samples_per_orbit`` for a time series, ``states`` when it keeps
@@ -191,7 +218,8 @@ class Members:
         system = as_systems(system)
         perturbed = bool(check_perturbations(perturbations))
         common = dict(escape_distance=escape_distance, order=order, model=model,
-                      perturbations=perturbations, full_indicators=full_indicators)
+                      perturbations=perturbations, full_indicators=full_indicators,
+                      degrees=degrees)
         if initial_states is None:
             if theta_p is None and thetadot_p is None:    # one None: from_starts names it
                 raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
@@ -236,6 +264,32 @@ def system_list(system):
         raise TypeError("system must be a BinarySystem, a catalogue name or a non-empty list "
                         f"of them (got {show(system)})")
     return systems
+
+
+def order_n_degrees(systems, order, degrees):
+    """The degree caps (primary, secondary) of an order-N table, None at order <= 4 (where
+    ``degrees`` must be None): ``degrees`` or (order, order), each body checked to hold its
+    integrals that far (``body.integral`` of a body that stops below would read zeros, and
+    the potential would silently be of a lower order)."""
+    if order <= _layout.multipole.HAND_WRITTEN_MAX:
+        if degrees is not None:
+            raise ValueError(f"degrees is for orders above "
+                             f"{_layout.multipole.HAND_WRITTEN_MAX} (got order {order})")
+        return None
+    dA, dB = _mp.check_degrees(order, degrees)
+    seen = set()
+    for s in systems:
+        if id(s) in seen:
+            continue
+        seen.add(id(s))
+        for label, body, degree in (("primary", s.primary, dA), ("secondary", s.secondary, dB)):
+            provided = _mp.degrees_provided(body)
+            if provided < degree:
+                raise ValueError(
+                    f"{s.name}: the {label} holds integrals up to degree {provided}, but order "
+                    f"{order} needs degree {degree}: give it integrals of degree {degree}, or "
+                    f"cap it with Integrator(degrees=...)")
+    return dA, dB
 
 
 def check_escape_distance(escape_distance):

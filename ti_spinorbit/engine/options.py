@@ -17,7 +17,7 @@ made, with a one-line message naming the field, never halfway through a run.
 
 from dataclasses import dataclass, replace
 from os import PathLike
-from typing import Any, Callable, Optional, Union
+from typing import Any, Callable, Optional, Tuple, Union
 
 from .._validate import require_bool, require_count, require_order, require_real, show
 from ..kernels.controller import DEFAULT_CONTROLLER, Controller
@@ -28,6 +28,10 @@ from . import checkpoint as _checkpoint
 from . import progress as _progress
 from .ensemble import DEFAULT_WINDOW_ORBITS, check_tolerances
 from .members import check_escape_distance
+from .multipole_tables import check_degrees
+from ..layout import multipole as _multipole_layout
+
+_HAND_WRITTEN_MAX = _multipole_layout.HAND_WRITTEN_MAX
 
 #: Default retries of a failed chunk on a Dask cluster before the run gives up.
 DEFAULT_RETRIES = 2
@@ -68,8 +72,13 @@ class Integrator:
     model : {"auto", "planar", "3d"}
         Equations of motion: "auto" takes the planar model when every member qualifies
         (planar starts, bodies symmetric about their equators), else the 3-D one.
-    order : {0, 2, 3, 4}
-        Order of the mutual potential's expansion in inertia integrals (4, the paper's).
+    order : int
+        Order of the mutual potential's expansion in inertia integrals: 0 or 2 to 16 (4, the
+        paper's, by default). Up to 4 the hand-written kernels; above 4 the table-driven
+        ones (docs/physics.md §3.6), which need both bodies' integrals to that degree.
+    degrees : (int, int), optional
+        Above order 4 only: caps (primary, secondary) on the degree of each body's integrals,
+        each in [0, order] (a small secondary usually needs fewer); default (order, order).
     escape_distance : float
         A member stops as "escape" beyond this separation, units of a, finite and > 1.
     controller : Controller
@@ -84,6 +93,7 @@ class Integrator:
     order: int = 4
     escape_distance: float = ESCAPE_DISTANCE
     controller: Controller = DEFAULT_CONTROLLER
+    degrees: Optional[Tuple[int, int]] = None
 
     def __post_init__(self):
         set_ = object.__setattr__                # frozen: normalise once, here
@@ -99,6 +109,12 @@ class Integrator:
             raise ValueError(f"model must be one of {', '.join(map(repr, models.REQUESTS))} "
                              f"(got {show(self.model)})")
         set_(self, "order", require_order(self.order))
+        if self.degrees is not None:
+            if self.order <= _HAND_WRITTEN_MAX:
+                raise ValueError(f"degrees is for orders above {_HAND_WRITTEN_MAX} (got "
+                                 f"order {self.order}; up to 4 every body uses its integrals "
+                                 "to the order)")
+            set_(self, "degrees", check_degrees(self.order, self.degrees))
         set_(self, "escape_distance", check_escape_distance(self.escape_distance))
         if not isinstance(self.controller, Controller):
             raise TypeError(f"controller must be a ti_spinorbit.kernels.controller.Controller "

@@ -166,14 +166,19 @@ MODELS = {"planar": PLANAR, "3d": SPATIAL}
 REQUESTS = ("auto", *MODELS)
 
 
-def choose(model, par, y0):
+def choose(model, par, y0, symmetric=None):
     """The model object for ``model`` in {"auto", "planar", "3d"}: "auto" takes the planar
-    model when every member qualifies (decided over the whole ensemble, never per chunk)."""
+    model when every member qualifies (decided over the whole ensemble, never per chunk).
+    ``symmetric`` (per member, optional) must hold too: at orders above 4 it says that no
+    integral of a member's order-N row is odd in z (the parameter rows hold degrees 2..4
+    only)."""
     if model not in REQUESTS:
         raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
     if model == "3d":
         return SPATIAL
     ok = PLANAR.qualifies(par, y0)
+    if symmetric is not None:
+        ok = ok & np.asarray(symmetric, dtype=bool)
     if model == "planar" and not np.all(ok):
         bad = np.nonzero(~ok)[0]
         raise ValueError(f"model='planar' needs planar starts and bodies symmetric about their "

@@ -288,6 +288,7 @@ def section_inputs(system, theta_p=None, thetadot_p=None, orbits=None, *,
     members = Members.build("surface_of_section", system, theta_p, thetadot_p, initial_states,
                             orbits, escape_distance=integrator.escape_distance,
                             coordinates=coordinates, order=integrator.order,
+                            degrees=integrator.degrees,
                             model=integrator.model, perturbations=perturbations,
                             full_indicators=bool(indicators) and indicator_space == "full")
     _warn_near_circular(members.systems)
@@ -309,7 +310,8 @@ def section_of(members: Members, orbits, *, integrator: Integrator, run: Run,
                       **run.checkpoint_keywords())
     par, systems, coordinates = members.par, members.systems, members.coordinates
     cols = _derived_columns(par, out.events, ("alpha", "thetadot", "r", "a", "e"),
-                            apsidal=coordinates == "apsidal", order=members.order)
+                            apsidal=coordinates == "apsidal", order=members.order,
+                            multipole=members.multipole())
     thetadot, rate = cols["thetadot"], None
     if coordinates == "apsidal":
         rate, = _coords.mask_small_eccentricity(cols["e"], cols["apsidal_rate"],
@@ -340,15 +342,18 @@ def _ensemble(members: Members, integrator: Integrator) -> Ensemble:
     return Ensemble(members.par, members.y0, order=members.order, rtol=integrator.rtol,
                     atol=integrator.atol, model=members.model, method=integrator.method,
                     controller=integrator.controller,
-                    perturbation_rows=members.perturbation_rows)
+                    perturbation_rows=members.perturbation_rows,
+                    multipole_rows=members.multipole_rows, degrees=members.degrees)
 
 
-def _derived_columns(par, records, names, diagnostics=False, apsidal=False, order=4):
+def _derived_columns(par, records, names, diagnostics=False, apsidal=False, order=4,
+                     multipole=None):
     """Observables of per-member record lists, padded with NaN to (N, max count): "t" and
     ``names`` (observables.derive); with ``diagnostics`` also the energy and angular-momentum
     split (scaled, ``engine.evaluation.diagnostics``); with ``apsidal`` also "apsidal_rate" (ϖ̇/n, model of ``order``) and
     "true_anomaly" (rad) of the osculating orbit (docs/physics.md §6.7). All records are
-    derived together: one NumPy pass, one kernel launch."""
+    derived together: one NumPy pass, one kernel launch. Above order 4 ``multipole`` holds
+    the members' order-N rows (``Members.multipole``)."""
 
     counts = np.array([len(r) for r in records])
     width = max(int(counts.max(initial=0)), 1)
@@ -365,12 +370,13 @@ def _derived_columns(par, records, names, diagnostics=False, apsidal=False, orde
     cols = {"t": padded(flat[:, 0]), **{k: padded(d[k]) for k in names}}
     if apsidal:
         states = flat[:, 1:]
-        cols["apsidal_rate"] = padded(evaluation.apsidal_rates(par[member], states, order,
-                                                               evaluation.has_odd(par)))
+        cols["apsidal_rate"] = padded(evaluation.apsidal_rates(
+            par[member], states, order, evaluation.has_odd(par),
+            None if multipole is None else multipole.take(member)))
         cols["true_anomaly"] = padded(_coords.true_anomaly(states[:, _S.Y_R:_S.Y_R + 3],
                                                            states[:, _S.Y_V:_S.Y_V + 3]))
     if diagnostics:
-        diag = evaluation.diagnostics(par, flat[:, 1:], member, order)
+        diag = evaluation.diagnostics(par, flat[:, 1:], member, order, multipole=multipole)
         for c, k in enumerate(("energy_orbit", "energy_primary", "energy_secondary")):
             cols[k] = padded(diag[:, c])
         for c, k in enumerate(("angmom_orbit", "angmom_primary", "angmom_secondary")):
@@ -567,8 +573,9 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     order = integrator.order
     table = Members.build("time_series", system, theta_p, thetadot_p, initial_states, orbits,
                           escape_distance=integrator.escape_distance, coordinates=coordinates,
-                          order=order, model=integrator.model, perturbations=perturbations,
-                          samples_per_orbit=samples_per_orbit, states=states)
+                          order=order, degrees=integrator.degrees, model=integrator.model,
+                          perturbations=perturbations, samples_per_orbit=samples_per_orbit,
+                          states=states)
     members, par, y0 = table.systems, table.par, table.y0
     tp, td, perturbations = table.theta_p, table.thetadot_p, table.perturbations
     ens = _ensemble(table, integrator)
@@ -578,7 +585,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
                       **run.checkpoint_keywords())
     apsidal = coordinates == "apsidal"
     cols = _derived_columns(par, out.samples, ("alpha", "theta", "thetadot", "r", "e"),
-                            diagnostics=True, apsidal=apsidal, order=order)
+                            diagnostics=True, apsidal=apsidal, order=order,
+                            multipole=table.multipole())
     if apsidal:   # θ from the osculating apsidal line: α + f, wrapped to (−π, π]
         theta = np.angle(np.exp(1j * (cols["alpha"] + cols["true_anomaly"])))
         cols["theta"], cols["thetadot"] = _coords.mask_small_eccentricity(

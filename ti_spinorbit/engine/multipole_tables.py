@@ -1,0 +1,390 @@
+"""Tables of the order-N mutual potential, built once on the host per (order, degree caps,
+odd terms), and the per-member integral rows that go with them (NumPy only).
+
+The kernels (``kernels/multipole_gravity.py``) evaluate the mutual potential, the force and
+both torques of two rigid bodies at any truncation order N by walking these tables at run
+time: every member walks the same entries in the same order, so no thread diverges, and no
+term is unrolled at compile time, so one compiled kernel serves every order above 4
+(``layout.multipole.KERNEL_ORDER``). What the tables encode (docs/physics.md §3.6 derives
+it; ``ti_spinorbit.model.multipole`` is the independent host reference):
+
+Normalised quantities. With D_γ(R) = ∂^γ(1/|R|) (γ a multi-index, |γ| its degree),
+t̂_A^α = (−1)^{|α|} T_A^α / α! and t̂_B'^β = T'_B^β / β! (T'_B: the secondary's integrals
+carried into the primary's frame), the truncated potential is
+
+    U_N = −G Σ_{|α|+|β| ≤ N} t̂_A^α t̂_B'^β D_{α+β}(R),
+
+the Cartesian multipole–multipole expansion of ``model/multipole.py`` with its coefficient
+(−1)^{|α|} (α+β)!/(α!β!) a_{α+β} absorbed: every pair costs one product, no coefficient.
+
+Three kinds of terms, so that the secondary is rotated only as far as the mixed terms need:
+
+* **monopole and primary-only terms** (β = 0): t̂_A^α m_B, added to the combined moments
+  W_γ = Σ_{α+β=γ} t̂_A^α t̂_B'^β;
+* **secondary-only terms** (α = 0): Σ_β T'^β_B a_β(R) is invariant under a common rotation of
+  the integrals and R, so they are evaluated in the secondary's own frame with D at
+  R_B = Sᵀ R (a second, cheap recurrence), never rotated. Their torque on the secondary is
+  R × ∂U/∂R of the same terms;
+* **mixed terms** (|α|, |β| ≥ 2, |α| + |β| ≤ N): the secondary's integrals rotated up to
+  degree min(dB, N − 2) only, by the exact recurrence
+  P_{p+1}[β' + e_i][δ] = Σ_j S_ij P_p[β'][δ + e_j] (P_p[β'][δ] = ∫ (S x)^{β'} x^δ dm,
+  |β'| + |δ| = k), which needs two buffers of at most C(p+2, 2) C(k−p+2, 2) numbers, not a
+  rotation matrix of every degree. Stored by β with the α of each β after it (a CSR
+  table): per pair, acc_β += t̂_A^α D_γ and W_γ += t̂_A^α t̂_B'^β. The torque on the
+  secondary is G Σ_β acc_β ∂t̂_B'^β/∂ε, with the rotation generator
+  ∂t̂'^β/∂ε_d = Σ_{c,e} ε_{cde} (β_e + 1) t̂'^{β − e_c + e_e} (β_c > 0).
+
+Energy and force from W: U = −G (Σ_γ W_γ D_γ + m_A Σ_δ t̂_B^δ D_δ(R_B)),
+∂U/∂R_i = −G (Σ_γ W_γ D_{γ+e_i} + m_A [S ∇_B]_i) (∂D_γ/∂R_i = D_{γ+e_i}); the torque on
+the primary is R × ∂U/∂R − μ_B, the identity of the order-4 kernels (total angular momentum
+conserved to round-off by construction).
+
+D_γ from the two-term recurrence (n = |γ| ≥ 1, D_0 = 1/r)
+
+    n r² D_γ = −(2n − 1) Σ_i γ_i R_i D_{γ−e_i} − (n − 1) Σ_i γ_i (γ_i − 1) D_{γ−2e_i},
+
+the recurrence of ``model/multipole.py`` with a_γ = D_γ / γ!; an index with a negative
+component gets weight 0 and index 0, so every entry has six terms.
+
+Degree caps ``(degree_a, degree_b)`` keep |α| ≤ dA and |β| ≤ dB; with ``odd`` False (every
+odd-exponent integral of both bodies zero in its own frame, e.g. ellipsoids) the primary's
+and the secondary-only terms with an odd exponent are left out of the tables (the rotated
+secondary integrals are general and stay). First moments (degree 1) are zero about the
+centre of mass and are never read.
+
+Layout: the integer table starts with the header of ``ti_spinorbit.layout.multipole``; the
+positions of every section (integer and float) and of the per-member scratch are read from
+it. A member's integral row (:func:`integral_rows`) is the primary's integrals of degrees
+0..dA and then the secondary's of degrees 0..dB, each in its own frame in
+``model.multipole.multi_indices`` order, in the units of the parameter rows
+(T / ((m1 + m2) a^{l+m+n}), :meth:`ti_spinorbit.system.systems.BinarySystem.scaled_body_row`).
+"""
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..layout import multipole as _H
+from ..model.multipole import multi_indices
+
+MAX_ORDER = _H.MAX_ORDER
+
+
+def count(degree):
+    """Multi-indices with l + m + n <= degree: C(degree + 3, 3) (0 for degree < 0)."""
+    return 0 if degree < 0 else (degree + 1) * (degree + 2) * (degree + 3) // 6
+
+
+def per_degree(degree):
+    """Multi-indices of one degree: C(degree + 2, 2)."""
+    return (degree + 1) * (degree + 2) // 2
+
+
+@lru_cache(maxsize=None)
+def _lookup(top):
+    """{exponent triple: flat index} of multi_indices(top)."""
+    return {tuple(int(x) for x in e): k for k, e in enumerate(multi_indices(top))}
+
+
+def _fact(e):
+    return math.factorial(e[0]) * math.factorial(e[1]) * math.factorial(e[2])
+
+
+def _even(e):
+    return not (e[0] % 2 or e[1] % 2 or e[2] % 2)
+
+
+@dataclass(frozen=True, eq=False)
+class Tables:
+    """The tables of one (order, degree_a, degree_b, odd): ``ints`` (int32) and ``floats``
+    (float64), read-only, and the sizes the host needs (``width_a``, ``width_b`` the
+    columns of each body in an integral row, ``scratch`` the per-member scratch columns)."""
+
+    order: int
+    degree_a: int
+    degree_b: int
+    odd: bool
+    ints: np.ndarray
+    floats: np.ndarray
+
+    @property
+    def width_a(self):
+        return count(self.degree_a)
+
+    @property
+    def width_b(self):
+        return count(self.degree_b)
+
+    @property
+    def width(self):
+        """Columns of an integral row: both bodies."""
+        return self.width_a + self.width_b
+
+    @property
+    def scratch(self):
+        """Per-member scratch columns (float64)."""
+        return int(self.ints[_H.H_SCRATCH])
+
+    @property
+    def pairs(self):
+        """Mixed (α, β) pairs the tables hold."""
+        h = self.ints
+        return int((h[_H.H_I_GAM] - h[_H.H_I_PAIR]) // 2)
+
+    def bytes_per_member(self):
+        """Bytes of a member's integral row and scratch (float64)."""
+        return 8 * (self.width + self.scratch)
+
+
+def check_degrees(order, degrees):
+    """(degree_a, degree_b) for ``order``: None gives (order, order); a pair must hold two
+    integers in [0, order]."""
+    if degrees is None:
+        return int(order), int(order)
+    try:
+        caps = tuple(degrees)
+    except TypeError:
+        caps = None
+    if caps is None or len(caps) != 2 or any(
+            isinstance(d, (bool, np.bool_)) or not isinstance(d, (int, np.integer))
+            or not 0 <= int(d) <= order for d in caps):
+        raise ValueError(f"degrees must be None or a pair (primary, secondary) of integers in "
+                         f"[0, order={order}] (got {degrees!r})")
+    return int(caps[0]), int(caps[1])
+
+
+@lru_cache(maxsize=32)
+def tables(order, degree_a, degree_b, odd=True) -> Tables:
+    """The tables of the order-``order`` potential with degree caps (``degree_a``,
+    ``degree_b``) and odd terms on or off (see the module docstring), built once per
+    process."""
+    N, dA, dB = int(order), int(degree_a), int(degree_b)
+    if not 0 <= N <= MAX_ORDER or not 0 <= dA <= N or not 0 <= dB <= N:
+        raise ValueError(f"tables need 0 <= degrees <= order <= {MAX_ORDER} (got order {N}, "
+                         f"degrees ({dA}, {dB}))")
+    odd = bool(odd)
+    top = N + 1
+    look = _lookup(top)
+    E = [tuple(int(x) for x in e) for e in multi_indices(top)]
+    eye = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+
+    def idx(e):
+        return look[e]
+
+    def add(e, f, s=1):
+        return (e[0] + s * f[0], e[1] + s * f[1], e[2] + s * f[2])
+
+    def keep(e):
+        return odd or _even(e)
+
+    ints = {name: [] for name in ("D", "A", "B", "ROT", "BETA", "PAIR", "GAM")}
+    floats = {name: [] for name in ("D", "A", "B", "ROT", "BETA")}
+    nD = count(N + 1)
+    eB = min(dB, N)                     # the secondary-only terms' top degree
+    nDB = count(eB + 1) if eB >= 2 else 1
+    nW = count(N)
+    KR = min(dB, N - 2)                 # rotated secondary integrals (mixed terms)
+    KA = min(dA, N - 2)                 # primary degree of the mixed terms
+
+    # D recurrence, entries 1..nD-1: indices of γ − e_i, γ − 2e_i and their weights
+    for g in E[1:nD]:
+        n = sum(g)
+        for i in range(3):
+            ok = g[i] >= 1
+            ints["D"].append(idx(add(g, eye[i], -1)) if ok else 0)
+            floats["D"].append((2 * n - 1) * g[i] / n if ok else 0.0)
+        for i in range(3):
+            ok = g[i] >= 2
+            ints["D"].append(idx(add(g, add(eye[i], eye[i]), -1)) if ok else 0)
+            floats["D"].append((n - 1) * g[i] * (g[i] - 1) / n if ok else 0.0)
+
+    # primary terms: normalisation (−1)^|α|/α! of 2 <= |α| <= min(dA, N)
+    a_set = [e for e in E[:count(min(dA, N))] if sum(e) >= 2 and keep(e)]
+    for e in a_set:
+        ints["A"].append(idx(e))
+        floats["A"].append((-1.0) ** sum(e) / _fact(e))
+
+    # secondary-only terms, own frame: δ, δ + e_j, 1/δ!
+    b_set = [e for e in E[:count(eB)] if sum(e) >= 2 and keep(e)]
+    for e in b_set:
+        ints["B"] += [idx(e)] + [idx(add(e, eye[j])) for j in range(3)]
+        floats["B"].append(1.0 / _fact(e))
+
+    # rotation: per global index q up to degree max(KR, 0): parent (local, degree d − 1),
+    # axis, and the local indices of q + e_j in degree d + 1; 1/β! per q
+    for q, e in enumerate(E[:count(max(KR, 0))]):
+        d = sum(e)
+        if d:
+            axis = next(i for i in range(3) if e[i] > 0)
+            parent = idx(add(e, eye[axis], -1)) - count(d - 2)
+        else:
+            axis, parent = 0, 0
+        ints["ROT"] += [parent, axis] + [idx(add(e, eye[j])) - count(d) for j in range(3)]
+        floats["ROT"].append(1.0 / _fact(e))
+
+    # mixed terms: β with 2 <= |β| <= KR, then its α (2 <= |α| <= min(KA, N − |β|))
+    levi = {0: ((1, 2, -1.0), (2, 1, 1.0)), 1: ((2, 0, -1.0), (0, 2, 1.0)),
+            2: ((0, 1, -1.0), (1, 0, 1.0))}   # (c, e, ε_cde) with ε_cde ≠ 0, for each d
+    pairs = 0
+    for b in (E[:count(KR)] if KR >= 2 else ()):
+        if sum(b) < 2:
+            continue
+        alphas = [a for a in a_set if sum(a) <= min(KA, N - sum(b))]
+        if not alphas:
+            continue
+        gen_i, gen_f = [], []
+        for d in range(3):
+            for c, e_, s in levi[d]:
+                if b[c] > 0:
+                    gen_i.append(idx(add(add(b, eye[c], -1), eye[e_])))
+                    gen_f.append(s * (b[e_] + 1))
+                else:
+                    gen_i.append(idx(b))
+                    gen_f.append(0.0)
+        ints["BETA"] += [idx(b), pairs, pairs + len(alphas)] + gen_i
+        floats["BETA"] += gen_f
+        for a in alphas:
+            ints["PAIR"] += [idx(a), idx(add(a, b))]
+        pairs += len(alphas)
+
+    # energy and force over W: γ of degree 0 and 2..N, with the indices of γ + e_i in D
+    for g in E[:nW]:
+        if sum(g) == 1:
+            continue
+        ints["GAM"] += [idx(g)] + [idx(add(g, eye[i])) for i in range(3)]
+
+    maxP = max([per_degree(p) * per_degree(k - p) for k in range(2, KR + 1)
+                for p in range(k + 1)], default=0)
+    head = [0] * _H.NHEAD
+    head[_H.H_WIDTH_A] = count(dA)
+    head[_H.H_ND] = nD
+    head[_H.H_NDB] = nDB
+    head[_H.H_NW] = nW
+    head[_H.H_KR] = KR
+    head[_H.H_NA] = len(a_set)
+    head[_H.H_NB] = len(b_set)
+    head[_H.H_NBETA] = len(ints["BETA"]) // 9
+    head[_H.H_NGAM] = len(ints["GAM"]) // 4
+    flat_i, flat_f = list(head), []
+    for name, key in (("D", _H.H_I_D), ("A", _H.H_I_A), ("B", _H.H_I_B), ("ROT", _H.H_I_ROT),
+                      ("BETA", _H.H_I_BETA), ("PAIR", _H.H_I_PAIR), ("GAM", _H.H_I_GAM)):
+        flat_i[key] = len(flat_i)
+        flat_i += ints[name]
+    for name, key in (("D", _H.H_F_D), ("A", _H.H_F_A), ("B", _H.H_F_B), ("ROT", _H.H_F_ROT),
+                      ("BETA", _H.H_F_BETA)):
+        flat_i[key] = len(flat_f)
+        flat_f += floats[name]
+    offset = 0
+    for key, size in ((_H.H_S_D, nD), (_H.H_S_DB, nDB), (_H.H_S_W, nW),
+                      (_H.H_S_TA, count(min(dA, N))), (_H.H_S_TB, count(max(KR, 0))),
+                      (_H.H_S_P0, maxP), (_H.H_S_P1, maxP)):
+        flat_i[key] = offset
+        offset += size
+    flat_i[_H.H_SCRATCH] = offset
+    ints_arr = np.array(flat_i, dtype=np.int32)
+    floats_arr = np.array(flat_f + [0.0], dtype=np.float64)   # never empty
+    ints_arr.setflags(write=False)
+    floats_arr.setflags(write=False)
+    return Tables(N, dA, dB, odd, ints_arr, floats_arr)
+
+
+@dataclass(frozen=True, eq=False)
+class Multipole:
+    """An ensemble's order-N data: the ``tables`` and the members' integral ``rows``
+    (N, tables.width). :meth:`arguments` gives the four arrays the kernels take."""
+
+    tables: Tables
+    rows: np.ndarray
+
+    def __post_init__(self):
+        rows = np.ascontiguousarray(self.rows, dtype=np.float64)
+        if rows.ndim != 2 or rows.shape[1] != self.tables.width or not np.all(np.isfinite(rows)):
+            raise ValueError(f"multipole rows must be a finite (N, {self.tables.width}) array "
+                             f"(degrees {self.tables.degree_a}, {self.tables.degree_b}; got "
+                             f"shape {np.shape(self.rows)})")
+        if len(rows) and not (np.all(rows[:, 0] > 0) and np.all(rows[:, self.tables.width_a] > 0)):
+            raise ValueError("multipole rows must start each body with its mass (> 0)")
+        object.__setattr__(self, "rows", rows)
+
+    @property
+    def order(self):
+        return self.tables.order
+
+    @property
+    def degrees(self):
+        return self.tables.degree_a, self.tables.degree_b
+
+    def take(self, index) -> "Multipole":
+        """The rows ``index`` (one per state, e.g. the member of each record)."""
+        return Multipole(self.tables, self.rows[np.asarray(index)])
+
+    def arguments(self, slots):
+        """(rows, scratch, ints, floats) for a launch with ``slots`` scratch rows (one per
+        thread's slot: the member in the integrator, the state in the diagnostics)."""
+        return (self.rows, np.zeros((max(int(slots), 1), self.tables.scratch)),
+                self.tables.ints, self.tables.floats)
+
+    def bytes(self, slots):
+        """Bytes of the rows and of ``slots`` scratch rows."""
+        return 8 * (self.rows.size + max(int(slots), 1) * self.tables.scratch)
+
+
+def no_arguments():
+    """Stand-ins for the four order-N arrays of a launch at order <= 4 (never read)."""
+    return (np.zeros((1, 1)), np.zeros((1, 1)), np.zeros(1, dtype=np.int32), np.zeros(1))
+
+
+def body_integrals(body, degree, mass_unit=1.0, length_unit=1.0):
+    """A body's integrals of degrees 0..``degree`` (``body.integral(l, m, n)``, its own
+    frame) in ``multi_indices`` order, divided by mass_unit · length_unit^(l+m+n)."""
+    mass_unit, length_unit = float(mass_unit), float(length_unit)   # never integer powers
+    return np.array([body.integral(l, m, n) / (mass_unit * length_unit ** (l + m + n))
+                     for l, m, n in multi_indices(degree).tolist()], dtype=np.float64)
+
+
+def integral_rows(systems, degrees):
+    """(N, width) integral rows of ``systems`` (one BinarySystem per member) for degree caps
+    ``degrees`` = (dA, dB): the primary's integrals of degrees 0..dA, then the secondary's of
+    0..dB, in the parameter rows' scaled units (mass m1 + m2, length a), one row per distinct
+    system, spread over its members."""
+    dA, dB = degrees
+    rows = {}
+    for s in systems:
+        if id(s) not in rows:
+            M, a = s.total_mass, s.a
+            rows[id(s)] = np.concatenate([body_integrals(s.primary, dA, M, a),
+                                          body_integrals(s.secondary, dB, M, a)])
+    width = count(dA) + count(dB)
+    if not systems:
+        return np.zeros((0, width))
+    return np.stack([rows[id(s)] for s in systems])
+
+
+def odd_present(rows, degrees):
+    """Whether any integral row holds a non-zero integral with an odd exponent (either
+    body, its own frame): then the tables keep the odd terms."""
+    mask = odd_mask(degrees)
+    rows = np.asarray(rows)
+    return bool(rows.size and np.any(rows[:, mask] != 0.0))
+
+
+def odd_mask(degrees, axis=None):
+    """Boolean mask over an integral row's columns: the integrals with an odd exponent (of
+    ``axis`` 0, 1, 2 only when given; e.g. 2: odd in z, which tilts a planar motion)."""
+    out = []
+    for d in degrees:
+        for e in multi_indices(d):
+            out.append(bool(e[axis] % 2) if axis is not None else bool(any(x % 2 for x in e)))
+    return np.array(out, dtype=bool)
+
+
+def degrees_provided(body):
+    """The highest degree of integrals ``body`` holds: its ``order`` (a Body answers
+    ``integral`` up to it), 4 for a body that does not say (the order-4 row's)."""
+    return int(getattr(body, "order", None) or 4)
+
+
+__all__ = ["Tables", "Multipole", "no_arguments", "tables", "check_degrees", "count", "per_degree", "integral_rows",
+           "body_integrals", "odd_present", "odd_mask", "degrees_provided", "MAX_ORDER"]
