@@ -48,7 +48,7 @@ def run(args):
     thetadot = np.linspace(*BENCH_THETADOT_RANGE, args.members)
     init_taichi(args)
     started = time.perf_counter()
-    options = dict(rtol=args.rtol, method=args.method, integrator=Integrator(model=args.model),
+    options = dict(rtol=args.rtol, method=args.method, integrator=Integrator(model=args.model, order=args.order),
                    run=Run(progress=False))
     surface_of_section(system, 0.0, thetadot[:1], orbits=1.0, **options)   # compile / load
     warmup = time.perf_counter() - started

@@ -262,7 +262,7 @@ def check_derived(args, system):
 #: e0.1, tp30 (--theta-p), td1.13-1.63 (--thetadot; over three values: first-last n count),
 #: g64x64 (--grid), tdr0.5-2 (--thetadot-range), ab1.01-1.1-0.01 (--elongations), cand0.2-1.3-45
 #: (--candidates), xtol1e-8, spo128 (--samples-per-orbit), o1000 (--orbits), maxo8000
-#: (--max-orbits), rtol1e-13, tilt5-0-0, sxy0-0.1, inc10; --model, --coordinates, --method and
+#: (--max-orbits), rtol1e-13, ord8 (--order), tilt5-0-0, sxy0-0.1, inc10; --model, --coordinates, --method and
 #: --indicator-space by their value alone (3d, apsidal, dop853, full); tides, YORP and BYORP:
 #: tide-secondary (--tide), k2 (--k2), dt600 (--time-lag), Q100 (--Q), yorp0.0005 (--yorp),
 #: yorp-primary (--yorp-body), yorp-one-turn (--yorp-convention), byorp1e-3, str1e6
@@ -273,7 +273,8 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("elongations", "ab"), ("theta_p", "tp"), ("thetadot", "td"), ("grid", "g"),
              ("thetadot_range", "tdr"), ("candidates", "cand"), ("xtol", "xtol"),
              ("samples_per_orbit", "spo"), ("orbits", "o"), ("max_orbits", "maxo"),
-             ("rtol", "rtol"), ("model", ""), ("coordinates", ""), ("method", ""),
+             ("rtol", "rtol"), ("model", ""), ("order", "ord"), ("coordinates", ""),
+             ("method", ""),
              ("tilt", "tilt"), ("spin_xy", "sxy"), ("inclination", "inc"),
              ("indicator_space", ""), ("tide", "tide-"), ("k2", "k2"), ("time_lag", "dt"),
              ("Q", "Q"), ("yorp", "yorp"), ("yorp_body", "yorp-"),
@@ -408,7 +409,8 @@ def entry_options(args, data, bar):
     checkpoint and resume) from the flags; the directory was checked by :func:`output_paths`
     before any work."""
 
-    return {"method": args.method, "integrator": Integrator(model=args.model),
+    return {"method": args.method,
+            "integrator": Integrator(model=args.model, order=getattr(args, "order", 4)),
             "run": Run(progress=bar, checkpoint=checkpoint_path(args, data), resume=args.resume,
                        overwrite=args.overwrite_checkpoint)}
 

@@ -10,7 +10,7 @@ import argparse
 import math
 import re
 
-from .._validate import MAX_DENSITY, MAX_SPIN, MIN_DENSITY  # bounds shared with the library
+from .._validate import MAX_DENSITY, MAX_ORDER, MAX_SPIN, MIN_DENSITY  # the library's bounds
 from ..engine.compiling import METHODS
 from ..model import models as _models  # the model requests (one registry)
 from ..model import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
@@ -88,7 +88,23 @@ class Bounded:
             raise ValueError(f"{flag} {self._refusal(value)}")
 
 
+class Order(Bounded):
+    """``--order``: 0 or an integer in [2, MAX_ORDER] (1 adds nothing to 0: first moments
+    vanish about the centre of mass), refused during parsing as every bounded flag is."""
+
+    def __init__(self):
+        super().__init__(int, 2, MAX_ORDER)
+
+    @property
+    def interval(self):
+        return f"{{0}} ∪ [2, {MAX_ORDER}]"
+
+    def holds(self, value):
+        return value == 0 or super().holds(value)
+
+
 ORBITS = Bounded(float, 0.0, MAX_ORBITS, low_open=True)
+ORDER = Order()
 RTOL = Bounded(float, *RTOL_RANGE)
 ELONGATION = Bounded(float, 1.0, MAX_ELONGATION)
 DENSITY = Bounded(float, MIN_DENSITY, MAX_DENSITY)
@@ -169,6 +185,10 @@ def run_options(s, out_help, data=True, orbits=300.0, rtol=1e-10, model=True, re
         s.add_argument("--model", choices=_models.REQUESTS, default="auto",
                        help="equations of motion: the reduced planar model for planar "
                             "starts (auto, default) or the general 3-D one (3d)")
+        s.add_argument("--order", type=ORDER, default=4,
+                       help=f"truncation order of the mutual potential, 0 or 2..{MAX_ORDER} "
+                            "(default 4, the paper's; above 4 the table-driven order-N "
+                            "kernels, with every body's integrals to that degree)")
     if resume:
         s.add_argument("--checkpoint", default=None, metavar="DIR",
                        help="write a checkpoint directory after every window (default "

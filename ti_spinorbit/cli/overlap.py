@@ -72,7 +72,7 @@ def run(args):
     with progress_bar(args) as bar:
         scan = overlap_threshold(args.system, elongations=q, eccentricity=args.eccentricity,
                                  orbits=args.orbits, rtol=args.rtol, method=args.method,
-                                 integrator=Integrator(model=args.model),
+                                 integrator=Integrator(model=args.model, order=args.order),
                                  run=Run(progress=bar), max_drift=args.max_drift,
                                  include_inaccurate=args.allow_inaccurate,
                                  max_orbits=args.max_orbits, coordinates=args.coordinates,

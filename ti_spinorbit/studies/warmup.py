@@ -52,8 +52,9 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
         Without and/or with tides, YORP and BYORP in the equations (``perturbations=``,
         docs/physics.md §13; a separate kernel set). Default without only; ``(False, True)``
         compiles both (``ti-spinorbit warmup --perturbed``).
-    order : {0, 2, 3, 4}
-        Potential order of the variants (default 4, every entry point's default).
+    order : int
+        Potential order of the variants (default 4, every entry point's default): 0 or
+        2..16; every order above 4 is one variant (the table-driven potential).
     verbose : bool
         Print one line per variant (what, how, seconds) on ``stream`` (default stdout).
 
@@ -84,7 +85,8 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
         kw = {} if method == "cash-karp" else {"method": method}
         if pert:
             kw["perturbation_rows"] = rows
-        ens = Ensemble(par, y0, order=order, model=model, **kw)
+        ens = Ensemble(par, y0, order=order, model=model, multipole_rows=table.multipole_rows,
+                       degrees=table.degrees, **kw)
         before = len(compiling._SEEN), compiling._TOTAL[0]
         ens.run(2.0 * np.pi * 0.01, sample_dt=2.0 * np.pi / 64 if samp else None,
                 indicators=ind)
