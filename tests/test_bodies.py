@@ -316,11 +316,20 @@ def test_body_rejects_non_principal_integrals(key):
     Body(1.0, {**GOOD_SECOND, key: 1e-14}, 1.0)               # round-off is tolerated
 
 
-@pytest.mark.parametrize("key", [(1, 0, 0), (0, 0, 0), (5, 0, 0), (3, 1, 1), (-1, 3, 0),
-                                 (2, 0), (1, 1, 1, 1)])
+@pytest.mark.parametrize("key", [(1, 0, 0), (0, 0, 0), (17, 0, 0), (9, 4, 4), (-1, 3, 0),
+                                 (2, 0), (1, 1, 1, 1), (1.5, 0.5, 0), (True, 1, 1)])
 def test_body_rejects_bad_integral_keys(key):
     with pytest.raises(ValueError, match=r"^integrals: key"):
         Body(1.0, {**GOOD_SECOND, key: 0.1}, 1.0)
+
+
+@pytest.mark.parametrize("key", [(5, 0, 0), (3, 1, 1)])
+def test_keys_beyond_an_explicit_order_are_refused(key):
+    """Without order= a key of degree 5 makes an order-5 body; with order=4 it is refused."""
+    assert Body(1.0, {**GOOD_SECOND, key: 0.01}, 1.0).order == 5
+    with pytest.raises(ValueError, match=r"^integrals: key .* has degree 5, above order=4 "
+                                         r"\(raise order or drop the key\)$"):
+        Body(1.0, {**GOOD_SECOND, key: 0.01}, 1.0, order=4)
 
 
 @pytest.mark.parametrize("value", [float("nan"), float("inf")])
@@ -350,3 +359,137 @@ def test_point_masses_reject_bad_input():
         m[5] = value
         with pytest.raises(ValueError, match=r"^masses must all be finite and > 0"):
             Body.from_point_masses(pts, m)
+
+
+# ---- any order -----------------------------------------------------------------------------
+def test_ellipsoid_holds_the_closed_form_at_every_order_and_the_row_is_unchanged():
+    """Default order 16; every integral equals integrals.ellipsoid_integrals (an independent
+    implementation: exact Fractions) to 1e-15, odd ones exactly 0; a lower order= holds the
+    same values up to it, and as_row() is the same bit for bit at every order."""
+    from ti_spinorbit.system import integrals
+
+    a, b, c = AXES
+    body = Ellipsoid(a, b, c, DENSITY)
+    assert body.order == 16
+    exact = integrals.ellipsoid_integrals(a, b, c, body.mass, 16)
+    for key, want in exact.items():
+        got = body.integral(*key)
+        if any(i % 2 for i in key) or sum(key) == 1:
+            assert got == 0.0, key
+        else:
+            assert got == pytest.approx(want, rel=1e-15, abs=0.0), key
+    for order in (4, 5, 8, 12):
+        low = Ellipsoid(a, b, c, DENSITY, order=order)
+        assert low.order == order
+        assert low.as_row().tobytes() == body.as_row().tobytes()
+        assert all(low.integral(*k) == body.integral(*k) for k in integrals.multi_indices(order))
+    sphere = Sphere(2.0, DENSITY, order=6)
+    assert sphere.order == 6 and sphere.integral(6, 0, 0) == pytest.approx(
+        sphere.mass * 2.0**6 / 21.0, rel=1e-15)        # 3 M r⁶ 5!!/9!! = M r⁶/21
+
+
+@pytest.mark.parametrize("key", [(6, 0, 0), (2, 2, 2), (4, 0, 2), (0, 8, 0), (6, 2, 4)])
+def test_ellipsoid_high_order_integrals_match_volume_quadrature(key):
+    a, b, c = AXES
+    body = Ellipsoid(a, b, c, DENSITY)
+    assert body.integral(*key) == pytest.approx(
+        ellipsoid_quadrature(a, b, c, DENSITY, key, n_r=12, n_theta=60, n_phi=40), rel=1e-12)
+
+
+def test_integral_refuses_beyond_the_order_in_one_line():
+    body = Ellipsoid(*AXES, DENSITY, order=6, name="Dimorphos")
+    assert body.integral(5, 1, 0) == 0.0 and body.integral(6, 0, 0) > 0
+    with pytest.raises(ValueError) as info:
+        body.integral(4, 3, 0)
+    assert str(info.value) == ("body 'Dimorphos' holds its integrals up to order 6: "
+                               "T^(4, 3, 0) of degree 7 is beyond it (build the body with "
+                               "order >= 7)")
+    cloud = Body(1.0, GOOD_SECOND, 1.0, "hand")                  # order 4 by default
+    assert cloud.order == 4 and cloud.integral(4, 0, 0) == 0.0
+    with pytest.raises(ValueError, match=r"^body 'hand' holds its integrals up to order 4: "
+                                         r"T\^\(0, 0, 5\) of degree 5"):
+        cloud.integral(0, 0, 5)
+    with pytest.raises(ValueError, match=r"up to order 4"):
+        cloud.integral_set(5)
+    with pytest.raises(ValueError, match=r"up to order 4"):
+        cloud.moment_tensor(5)
+    with pytest.raises(ValueError, match=r"^body 'hand': T\^lmn needs three non-negative"):
+        cloud.integral(-1, 2, 0)
+    for bad in (3, 17, 4.5, True, "8"):
+        with pytest.raises((TypeError, ValueError), match=r"^order must be"):
+            Body(1.0, GOOD_SECOND, 1.0, order=bad)
+
+
+def test_integral_set_is_the_dense_set_of_the_integrals_module():
+    from ti_spinorbit.system import integrals
+
+    body = Ellipsoid(*AXES, DENSITY, order=8)
+    T = body.integral_set()
+    assert list(T) == list(integrals.multi_indices(8))
+    assert T[(0, 0, 0)] == body.mass and T[(1, 0, 0)] == 0.0 and T[(3, 1, 0)] == 0.0
+    assert all(T[k] == body.integral(*k) for k in T)
+    assert list(body.integral_set(4)) == list(integrals.multi_indices(4))
+    moved = integrals.shift_integrals(T, (1.0, -2.0, 0.5))     # accepted as an integral set
+    assert moved[(1, 0, 0)] == pytest.approx(body.mass, rel=1e-15)
+
+
+def test_point_masses_at_any_order_are_direct_sums_and_keep_the_order_4_row():
+    pts, masses = lumpy_cloud()
+    body4, rot4 = Body.from_point_masses(pts, masses, order=4)
+    body, rotation = Body.from_point_masses(pts, masses, order=11)
+    assert body.order == 11 and body4.order == 4
+    assert body.as_row().tobytes() == body4.as_row().tobytes()
+    np.testing.assert_array_equal(rotation, rot4)
+    np.testing.assert_array_equal(body.rotation, rotation)
+    np.testing.assert_allclose(body.offset, (masses[:, None] * pts).sum(0) / masses.sum(),
+                               rtol=1e-15)
+    q = body_frame_points(pts, masses, rotation)
+    for order in (5, 8, 11):
+        scale = np.sum(masses * np.linalg.norm(q, axis=1) ** order)
+        for l, m, n in itertools.product(range(order + 1), repeat=3):
+            if l + m + n == order:
+                direct = np.sum(masses * q[:, 0] ** l * q[:, 1] ** m * q[:, 2] ** n)
+                assert abs(body.integral(l, m, n) - direct) <= 1e-13 * scale, (l, m, n)
+    assert Body.from_point_masses(pts, masses)[0].order == 8      # DATA_ORDER
+
+
+def test_hand_given_integrals_at_any_order():
+    high = {**GOOD_SECOND, (6, 0, 0): 0.05, (3, 2, 2): -1e-3}
+    body = Body(1.0, high, 1.0)
+    assert body.order == 7 and body.integral(3, 2, 2) == -1e-3 and body.integral(7, 0, 0) == 0.0
+    assert Body(1.0, high, 1.0, order=12).integral(12, 0, 0) == 0.0
+    assert body.has_odd_integrals
+    assert body.as_row().tobytes() == Body(1.0, GOOD_SECOND, 1.0).as_row().tobytes()
+    with pytest.raises(ValueError, match=r"^bounding_radius must be >= "):   # |T600| <= M ρ⁶
+        Body(1.0, {**GOOD_SECOND, (6, 0, 0): 2.0}, 1.0)
+
+
+def test_bodies_of_any_order_round_trip_through_saved_descriptions():
+    """io.describe_system writes a general body's integrals up to its order and the order
+    where it cannot be inferred; an ellipsoid keeps its order; an old description (no
+    "order") gives the ellipsoid MAX_ORDER and the general body its highest key."""
+    import json
+
+    from ti_spinorbit.output import io
+
+    pts, masses = lumpy_cloud()
+    cloud = Body.from_point_masses(pts * 100.0, masses * 1e9, name="cloud", order=10)[0]
+    sparse = Body(cloud.mass, {k: v for k, v in cloud.integrals.items() if sum(k) <= 6},
+                  cloud.bounding_radius, "sparse", order=9)           # degrees 7-9 all zero
+    for primary, secondary in ((Ellipsoid(3000.0, 2000.0, 1500.0, 2000.0, order=6), cloud),
+                               (Sphere(2500.0, 2000.0), sparse)):
+        system = BinarySystem(primary, secondary, 2e4, 0.1, primary_spin_period=1e4)
+        d = json.loads(json.dumps(io.describe_system(system)))
+        back = BinarySystem.from_description(d)
+        assert back == system
+        for was, now in ((system.primary, back.primary), (system.secondary, back.secondary)):
+            assert now.order == was.order and now.integrals == was.integrals
+            assert hasattr(now, "semi_axes") == hasattr(was, "semi_axes")
+    assert "order" not in io.describe_system(system)["primary"]    # a sphere of order 16
+    system = BinarySystem(Ellipsoid(3000.0, 2000.0, 1500.0, 2000.0, order=6), sparse, 2e4, 0.1)
+    d = io.describe_system(system)
+    assert d["primary"]["order"] == 6 and d["secondary"]["order"] == 9
+    for body in (d["primary"], d["secondary"]):
+        del body["order"]
+    back = BinarySystem.from_description(d)
+    assert back.primary.order == 16 and back.secondary.order == 6

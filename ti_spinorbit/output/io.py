@@ -174,13 +174,21 @@ class _Systems:
 def describe_system(system):
     """``system.describe()`` plus each body's inertia integrals (``"integrals"``,
     ``{"l,m,n": T^{lmn}}`` in kg m^(l+m+n), non-zero entries), so that
-    :meth:`BinarySystem.from_description` rebuilds any body exactly, not only ellipsoids."""
+    :meth:`BinarySystem.from_description` rebuilds any body exactly, not only ellipsoids.
+
+    A general body's integrals are written up to its order (those of degree <= 4 first, in
+    the kernels' row order, then the higher ones by degree); a uniform ellipsoid's only up to
+    degree 4, as a check, since its ``semi_axes_m`` and ``mass_kg`` give every order."""
     d = system.describe()
     for label, body in (("primary", system.primary), ("secondary", system.secondary)):
         row = body.as_row()[1:]
         keys = EXPONENTS_2 + EXPONENTS_3 + EXPONENTS_4
-        d[label] = {**d[label], "integrals": {",".join(map(str, k)): float(v)
-                                              for k, v in zip(keys, row) if v != 0.0}}
+        table = {",".join(map(str, k)): float(v) for k, v in zip(keys, row) if v != 0.0}
+        if not hasattr(body, "semi_axes"):
+            higher = sorted((k for k in body.integrals if sum(k) > 4),
+                            key=lambda k: (sum(k), -k[0], -k[1]))
+            table.update({",".join(map(str, k)): float(body.integrals[k]) for k in higher})
+        d[label] = {**d[label], "integrals": table}
     return d
 
 

@@ -27,7 +27,7 @@ from .._validate import (MAX_BULK_DENSITY, MAX_MASS, MAX_MASS_RATIO, MAX_PRIMARY
                          MIN_MOMENT_RATIO, check_heliocentric, refuse_unknown_keys,
                          require_finite, require_positive_scalar, require_range, require_real,
                          show)
-from .bodies import Body, Ellipsoid
+from .bodies import MAX_ORDER, ROW_ORDER, Body, Ellipsoid, check_order
 from .. import display as _display
 from .initial import tilted_start as _tilted_start
 from ..layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
@@ -324,6 +324,8 @@ class BinarySystem(_display.Readable):
             d = {"name": b.name, "mass_kg": b.mass, "bounding_radius_m": b.bounding_radius}
             if hasattr(b, "semi_axes"):
                 d["semi_axes_m"] = list(b.semi_axes)
+            if b.order != _default_order(b):
+                d["order"] = b.order
             return d
         return {"name": self.name, "primary": body(self.primary), "secondary": body(self.secondary),
                 "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
@@ -346,6 +348,11 @@ class BinarySystem(_display.Readable):
           is also given and the ellipsoid's integrals equal the saved ones exactly;
         * else from ``"semi_axes_m"`` (m) and ``"mass_kg"`` as a uniform ellipsoid, which is
           exact because an ellipsoid's integrals depend on nothing else.
+
+        ``"order"`` (optional, 4..16) is the order of the body's integrals; without it an
+        ellipsoid has ``MAX_ORDER`` (16, as :func:`Ellipsoid` gives it) and a general body the
+        highest degree among its ``integrals``, at least 4 (:meth:`describe` writes it only
+        where it differs from these).
 
         A general body described by :meth:`describe` alone (no semi-axes, no integrals)
         cannot be rebuilt: ValueError.
@@ -419,7 +426,7 @@ class BinarySystem(_display.Readable):
 SYSTEM_KEYS = ("name", "primary", "secondary", "a_m", "e", "primary_spin_period_s",
                "heliocentric_a_au", "heliocentric_e", "mean_motion_rad_s", "mass_ratio",
                "omega0", "orbital_period_h", "density_scale")
-BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals")
+BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals", "order")
 #: Relative tolerance of a derived entry against its value recomputed from the inputs: the
 #: package writes them unrounded (JSON keeps every bit), so only an edit differs.
 DERIVED_RTOL = 1e-9
@@ -440,13 +447,17 @@ def _body_from(b, label, mismatches):
             raise ValueError(f"{label} description lacks {key!r} (has {', '.join(map(repr, b))})")
     name = b.get("name", "body")
     mass = require_real(f"{label} mass_kg", b["mass_kg"])
+    order = b.get("order")
+    if order is not None:
+        order = check_order(order, f"{label} order")
     ellipsoid = None
     if axes is not None:
         if not isinstance(axes, (list, tuple)) or len(axes) != 3:
             raise TypeError(f"{label} semi_axes_m must be a list [a, b, c] of three lengths in m "
                             f"(got {show(axes)})")
         try:
-            ellipsoid = Ellipsoid(*axes, mass=mass, name=name)
+            ellipsoid = Ellipsoid(*axes, mass=mass, name=name,
+                                  order=MAX_ORDER if order is None else order)
         except (TypeError, ValueError) as exc:
             raise type(exc)(f"{label}: {exc}") from None
     if integrals is None:
@@ -475,7 +486,8 @@ def _body_from(b, label, mismatches):
         table[lmn] = require_real(f"{label} integrals[{key!r}]", value)
     try:
         general = Body(mass, table, require_real(f"{label} bounding_radius_m",
-                                                 b["bounding_radius_m"]), name)
+                                                 b["bounding_radius_m"]), name,
+                       order if order is not None or ellipsoid is None else ellipsoid.order)
     except (TypeError, ValueError) as exc:
         raise type(exc)(f"{label}: {exc}") from None
     if ellipsoid is None:
@@ -583,10 +595,22 @@ def _scaled_body(body: Body, factor: float) -> Body:
     integral) multiplied by ``factor``. A uniform ellipsoid is rebuilt from its semi-axes
     and new mass, so that its description (semi-axes, mass) rebuilds it bit for bit."""
     if hasattr(body, "semi_axes"):
-        return Ellipsoid(*body.semi_axes, mass=body.mass * factor, name=body.name)
+        return Ellipsoid(*body.semi_axes, mass=body.mass * factor, name=body.name,
+                         order=body.order)
     scaled = Body(body.mass * factor, {k: v * factor for k, v in body.integrals.items()},
-                  body.bounding_radius, body.name)
+                  body.bounding_radius, body.name, body.order)
+    for attribute in ("offset", "rotation"):               # the shape's frame is kept
+        if hasattr(body, attribute):
+            object.__setattr__(scaled, attribute, getattr(body, attribute))
     return scaled
+
+
+def _default_order(body: Body) -> int:
+    """The order a description without "order" gives a body: MAX_ORDER for a uniform
+    ellipsoid, else the highest degree of its (non-zero) integrals, at least ROW_ORDER."""
+    if hasattr(body, "semi_axes"):
+        return MAX_ORDER
+    return max([ROW_ORDER] + [sum(k) for k in body.integrals])
 
 
 _dataclass_init = BinarySystem.__init__
