@@ -592,9 +592,10 @@ def _multipole(order, rows, degrees, n, odd=None):
         raise ValueError(f"order {order} needs multipole_rows: both bodies' integrals to "
                          f"degrees ({dA}, {dB}) (multipole_tables.integral_rows)")
     rows = np.ascontiguousarray(rows, dtype=np.float64)
-    if rows.ndim != 2 or len(rows) != n:
-        raise ValueError(f"multipole_rows must have one row per member ({n}; got shape "
-                         f"{rows.shape})")
+    width = _mp.count(dA) + _mp.count(dB)
+    if rows.ndim != 2 or rows.shape != (n, width):
+        raise ValueError(f"multipole_rows must be ({n}, {width}): one row per member, both "
+                         f"bodies' integrals to degrees ({dA}, {dB}) (got shape {rows.shape})")
     if odd is None:
         odd = _mp.odd_present(rows, (dA, dB))
     return _mp.Multipole(_mp.tables(order, dA, dB, bool(odd)), rows)
