@@ -1,0 +1,299 @@
+"""What the order of the mutual potential costs: member-orbits per second, cold compile and
+memory per member at orders 2, 4, 6, 8, 12 (and degree caps), both models.
+
+The system is an ellipsoid pair: 1991 VH's orbit (a = 3300 m, e = 0.05) with a triaxial
+primary (660 × 600 × 545 m, 1581 kg/m³, about 1991 VH's primary volume) and 1991 VH's
+a/b = 1.5 secondary as an ellipsoid (294 × 196 × 190 m, 2618 kg/m³); the members are the
+throughput benchmark's (``bench_throughput.starts``: θ_p, θ̇_p/n on an R2 sequence). The
+order-N integral rows come from the ellipsoids' closed form (``system.integrals``), so the
+script runs whatever order the bodies store. Integration through ``Ensemble`` (Cash-Karp,
+rtol = atol = 1e-12, escape distance 1000 a); orders up to 4 run the hand-written kernels,
+higher ones the table-driven ones (docs/physics.md §3.6). Each point integrates about
+``--seconds`` of wall time (a pilot run sizes it; at least 0.05 orbit), after a 1-member
+launch that compiles or loads the variant. Sections:
+
+rates
+    member-orbits/s per (model, order, degree caps) at ``--members`` (default 1024), the
+    ratio to the order-4 rate of the same model, accepted steps per orbit, and the time per
+    right-hand side on one core (process CPU seconds / RHS calls: integrator overhead
+    included); the targets of the order-N work (3-D: order 6 >= 1/4 and order 8 >= 1/12 of
+    the order-4 rate) are printed with MET/MISS.
+split
+    one core, the order-N potential alone (``multipole_gravity.mutual_n`` in a loop on 256
+    states, a dependent chain as in bench_throughput's RHS loop), and with each part of it
+    switched off in turn through its table header (the secondary-frame derivatives, the
+    rotation of the secondary's integrals, the mixed pairs): where its time goes.
+compile
+    cold compile of each order's variant in a fresh process with an empty kernel cache (the
+    integrator and the diagnostics kernels, as ``tso.warmup`` counts them), per model.
+memory
+    bytes per member of the order-N block: the integral row and the scratch row
+    (``multipole_tables.Tables``), beside the ~100 numbers every member carries anyway.
+
+    python experiments/bench_orders.py                        # everything, ~10 min on 2 cores
+    python experiments/bench_orders.py --sections rates --models 3d --orders 4 6 8
+    python experiments/bench_orders.py --quick                # N = 16, 0.2 s per point
+"""
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+EXPERIMENTS = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, EXPERIMENTS)
+
+RTOL = 1e-12
+ESCAPE = 1000.0
+PRIMARY = (660.0, 600.0, 545.0, 1581.0)        # semi-axes (m), density (kg/m³)
+SECONDARY = (294.0, 196.0, 190.0, 2618.0)
+A_M, E = 3300.0, 0.05
+ORDERS = (2, 4, 6, 8, 12)
+#: degree caps measured beside the full ones: a secondary described to degree 4 only
+CAPS = {8: (8, 4), 12: (12, 4)}
+TARGETS = {6: 1 / 4, 8: 1 / 12}               # 3-D rate / order-4 rate
+SECTIONS = ("rates", "split", "compile", "memory")
+
+CHILD_COMPILE = """
+import json, sys, time
+sys.path.insert(0, {experiments!r})
+import bench_orders as B
+import ti_spinorbit as tso
+from ti_spinorbit.engine import compiling
+tso.init()
+model, order = sys.argv[1], int(sys.argv[2])
+par, y0, rows, degrees = B.members(1, order)
+ens = B.ensemble(par, y0, rows, degrees, order, model)
+before = compiling._TOTAL[0]
+ens.run(2.0 * 3.141592653589793 * 0.01)
+print(json.dumps({{"compile_s": compiling._TOTAL[0] - before}}))
+""".format(experiments=EXPERIMENTS)
+
+
+def system():
+    import ti_spinorbit as tso
+    p = tso.Ellipsoid(*PRIMARY[:3], PRIMARY[3], name="triaxial primary")
+    s = tso.Ellipsoid(*SECONDARY[:3], SECONDARY[3], name="1991 VH secondary, a/b 1.5")
+    return tso.BinarySystem(p, s, A_M, E, name="ellipsoid pair")
+
+
+def integral_rows(sys_, order, degrees):
+    """(1, width) scaled order-N row of the pair from the closed form."""
+    from ti_spinorbit.engine import multipole_tables as MT
+    from ti_spinorbit.model.multipole import multi_indices
+    from ti_spinorbit.system import integrals as I
+
+    M, a = sys_.total_mass, float(sys_.a)
+    parts = []
+    for ax, body, d in ((PRIMARY[:3], sys_.primary, degrees[0]),
+                        (SECONDARY[:3], sys_.secondary, degrees[1])):
+        T = I.ellipsoid_integrals(*(x / a for x in ax), body.mass / M, d)
+        parts.append([T[tuple(int(x) for x in e)] for e in multi_indices(d)])
+    row = np.concatenate(parts)[None]
+    assert row.shape[1] == MT.count(degrees[0]) + MT.count(degrees[1])
+    return row
+
+
+def members(n, order, degrees=None):
+    """(par, y0, order-N rows or None, degrees or None) of the first n members."""
+    from bench_throughput import starts
+    from ti_spinorbit.engine import multipole_tables as MT
+    from ti_spinorbit.engine.members import Members
+
+    s = system()
+    tp, td = starts(n)
+    table = Members.from_starts(s, tp, td, ESCAPE)
+    if order <= 4:
+        return table.par, table.y0, None, None
+    degrees = MT.check_degrees(order, degrees)
+    return table.par, table.y0, np.repeat(integral_rows(s, order, degrees), n, 0), degrees
+
+
+def ensemble(par, y0, rows, degrees, order, model):
+    from ti_spinorbit.engine.ensemble import Ensemble
+    return Ensemble(par, y0, order=order, rtol=RTOL, model=model, multipole_rows=rows,
+                    degrees=degrees)
+
+
+def run(par, y0, rows, degrees, order, model, orbits):
+    """(member-orbits/s, accepted steps per orbit, CPU ns per RHS call) of one run."""
+    ens = ensemble(par, y0, rows, degrees, order, model)
+    cpu = time.process_time()
+    out = ens.run(2.0 * np.pi * orbits)
+    cpu = time.process_time() - cpu
+    n = len(par)
+    rhs = float(out.counters[:, 2].sum())
+    return (n * orbits / out.seconds, float(out.counters[:, 0].mean()) / orbits,
+            cpu / rhs * 1e9)
+
+
+def rates(models, orders, n, seconds):
+    rows = []
+    for model in models:
+        for order in orders:
+            for caps in [None] + ([CAPS[order]] if order in CAPS else []):
+                par, y0, mp, degrees = members(n, order, caps)
+                run(par[:1], y0[:1], None if mp is None else mp[:1], degrees, order, model, 0.01)
+                rate, _, _ = run(par[:16], y0[:16], None if mp is None else mp[:16], degrees,
+                                 order, model, 0.02)           # pilot: sizes the timed run
+                orbits = max(0.05, float(f"{seconds * rate / n:.2g}"))
+                rate, steps, ns = run(par, y0, mp, degrees, order, model, orbits)
+                rows.append({"model": model, "order": order, "degrees": degrees or (order, order),
+                             "members": n, "orbits": orbits, "member_orbits_per_s": rate,
+                             "steps_per_orbit": steps, "cpu_ns_per_rhs": ns})
+                print(f"  {model:6s} order {order:2d} degrees {str(degrees or (order, order)):8s}"
+                      f" {rate:9.1f} member-orbits/s, {steps:5.0f} steps/orbit, "
+                      f"{ns:7.0f} ns per RHS (one core), {orbits:g} orbits", flush=True)
+    for r in rows:
+        four = [q for q in rows if q["model"] == r["model"] and q["order"] == 4]
+        r["ratio_to_order_4"] = r["member_orbits_per_s"] / four[0]["member_orbits_per_s"] \
+            if four else None
+    return rows
+
+
+def split(orders, n=256, reps=200):
+    """ns per order-N evaluation on one core, whole and with parts switched off."""
+    import taichi as ti
+    from ti_spinorbit.engine import multipole_tables as MT
+    from ti_spinorbit.kernels.multipole_gravity import mutual_n, vec3
+    from ti_spinorbit.layout import multipole as H
+
+    nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
+    nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
+    nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
+
+    @ti.kernel
+    def loop(rows: nd2f, R_nd: nd2f, scr: nd2f, ints: nd1i, floats: nd1f, out: nd1f,
+             repeats: ti.i32):
+        for i in range(R_nd.shape[0]):
+            R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])
+            c, s = ti.cos(0.3 * i), ti.sin(0.3 * i)
+            S = ti.Matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], ti.f64)
+            acc = 0.0
+            for _ in range(repeats):
+                U, dUdR, mu1, mu2 = mutual_n(rows, i, scr, i, ints, floats, 1.0, R, S)
+                acc += U + mu2[2]
+                R[0] += 1e-14 * dUdR[0]              # a dependent chain: nothing hoisted
+            out[i] = acc
+
+    s = system()
+    R = np.column_stack([0.95 + 0.1 * np.sin(np.arange(n)), 0.2 * np.cos(np.arange(n)),
+                         0.05 * np.ones(n)])
+    out = []
+    for order in orders:
+        if order <= 4:
+            continue
+        for caps in [None] + ([CAPS[order]] if order in CAPS else []):
+            degrees = MT.check_degrees(order, caps)
+            tab = MT.tables(order, *degrees, False)
+            rows = np.repeat(integral_rows(s, order, degrees), n, 0)
+            parts = {"whole": {}, "without D at R_B": {H.H_NDB: 1},
+                     "without the rotation": {H.H_KR: 0}, "without the mixed pairs":
+                     {H.H_NBETA: 0}}
+            row = {"order": order, "degrees": degrees}
+            for name, patch in parts.items():
+                ints = tab.ints.copy()
+                for k, v in patch.items():
+                    ints[k] = v
+                scr = np.zeros((n, tab.scratch))
+                res = np.zeros(n)
+                loop(rows, R, scr, ints, tab.floats, res, 1)
+                t0 = time.process_time()
+                loop(rows, R, scr, ints, tab.floats, res, reps)
+                row[name] = (time.process_time() - t0) / (n * reps) * 1e9
+            out.append(row)
+            print(f"  order {order:2d} degrees {str(degrees):8s} " + ", ".join(
+                f"{k} {v:.0f} ns" for k, v in row.items() if k not in ("order", "degrees")),
+                flush=True)
+    return out
+
+
+def compile_times(models, orders):
+    rows = []
+    for model in models:
+        for order in orders:
+            with tempfile.TemporaryDirectory(prefix="ti_spinorbit_cache_") as cache:
+                env = dict(os.environ, TI_OFFLINE_CACHE_FILE_PATH=cache)
+                t0 = time.perf_counter()
+                p = subprocess.run([sys.executable, "-c", CHILD_COMPILE, model, str(order)],
+                                   capture_output=True, text=True, env=env, cwd=EXPERIMENTS)
+                wall = time.perf_counter() - t0
+            if p.returncode:
+                raise RuntimeError(p.stderr[-3000:])
+            seconds = json.loads(p.stdout.strip().splitlines()[-1])["compile_s"]
+            rows.append({"model": model, "order": order, "compile_s": seconds,
+                         "process_s": wall})
+            print(f"  cold compile {model:6s} order {order:2d}: {seconds:.2f} s "
+                  f"(fresh process {wall:.1f} s)", flush=True)
+    return rows
+
+
+def memory(orders):
+    from ti_spinorbit.engine import multipole_tables as MT
+    rows = []
+    for order in orders:
+        if order <= 4:
+            continue
+        for caps in [None] + ([CAPS[order]] if order in CAPS else []):
+            degrees = MT.check_degrees(order, caps)
+            t = MT.tables(order, *degrees, False)
+            rows.append({"order": order, "degrees": degrees, "row_bytes": 8 * t.width,
+                         "scratch_bytes": 8 * t.scratch, "pairs": t.pairs,
+                         "table_bytes": t.ints.nbytes + t.floats.nbytes})
+            print(f"  order {order:2d} degrees {str(degrees):8s}: {8 * t.width} B row + "
+                  f"{8 * t.scratch} B scratch per member; tables {t.ints.nbytes + t.floats.nbytes}"
+                  f" B shared, {t.pairs} mixed pairs", flush=True)
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sections", nargs="+", choices=SECTIONS, default=list(SECTIONS))
+    ap.add_argument("--models", nargs="+", choices=("planar", "3d"), default=["3d", "planar"])
+    ap.add_argument("--orders", nargs="+", type=int, default=list(ORDERS))
+    ap.add_argument("--members", type=int, default=1024)
+    ap.add_argument("--seconds", type=float, default=8.0)
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--out", default=None, help="JSON path (default: print only)")
+    args = ap.parse_args()
+    if args.quick:
+        args.members, args.seconds = 16, 0.2
+    import ti_spinorbit as tso
+    tso.init()
+    report = {"rtol": RTOL, "members": args.members, "load_before": os.getloadavg()}
+    if "memory" in args.sections:
+        print("memory per member", flush=True)
+        report["memory"] = memory(args.orders)
+    if "rates" in args.sections:
+        print("rates", flush=True)
+        report["rates"] = rates(args.models, args.orders, args.members, args.seconds)
+        for r in report["rates"]:
+            if r["model"] == "3d" and r["order"] in TARGETS and r["degrees"] == (r["order"],) * 2 \
+                    and r["ratio_to_order_4"] is not None:
+                goal = TARGETS[r["order"]]
+                print(f"  target 3-D order {r['order']} >= {goal:.3g} x order 4: "
+                      f"{r['ratio_to_order_4']:.4f} ({r['ratio_to_order_4'] / goal:.2f} of the "
+                      f"target) {'MET' if r['ratio_to_order_4'] >= goal else 'MISS'}")
+    if "split" in args.sections:
+        print("split (one core, the potential alone)", flush=True)
+        tso.init(cpu_max_num_threads=1)
+        report["split"] = split(args.orders, 64 if args.quick else 256, 20 if args.quick else 200)
+    if "compile" in args.sections:
+        print("cold compile", flush=True)
+        report["compile"] = compile_times(args.models, [o for o in args.orders if o != 2])
+    report["load_after"] = os.getloadavg()
+    report["max_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"load average {report['load_before'][0]:.2f} before, {report['load_after'][0]:.2f} after")
+    if args.out:
+        with open(args.out, "w") as f:
+            json.dump(report, f, indent=1, default=list)
+
+
+if __name__ == "__main__":
+    main()
