@@ -193,8 +193,8 @@ def split(orders, n=256, reps=200):
             degrees = MT.check_degrees(order, caps)
             tab = MT.tables(order, *degrees, False)
             rows = np.repeat(integral_rows(s, order, degrees), n, 0)
-            parts = {"whole": {}, "without D at R_B": {H.H_NDB: 1},
-                     "without the rotation": {H.H_KR: 0}, "without the mixed pairs":
+            parts = {"whole": {}, "without D at R_B": {H.H_TOP_DB: 0},
+                     "without the rotation": {H.H_KR: 0, H.H_NROT: 0}, "without the mixed pairs":
                      {H.H_NBETA: 0}}
             row = {"order": order, "degrees": degrees}
             for name, patch in parts.items():

@@ -48,28 +48,34 @@ def _count(d):
 
 
 @ti.func
-def _per_degree(d):
-    return (d + 1) * (d + 2) // 2
-
-
-@ti.func
-def _derivatives(scr: ti.template(), k, base, n, tab_i: ti.template(), tab_f: ti.template(),
+def _derivatives(scr: ti.template(), k, base, top, tab_i: ti.template(), tab_f: ti.template(),
                  R, inv_r, inv_r2):
-    """D_γ = ∂^γ(1/|R|) for the first ``n`` multi-indices, into scr[k, base + γ]: the
-    two-term recurrence of six terms per entry (weights and indices from the tables)."""
+    """D_γ = ∂^γ(1/|R|) for every |γ| <= ``top``, into scr[k, base + γ]. Per degree d, the
+    2d + 1 entries with z exponent <= 1 from the two-term recurrence (five terms: the
+    z second-order one vanishes there), the others from harmonicity,
+    D_(l,m,n) = −D_(l+2,m,n−2) − D_(l,m+2,n−2) (∇²(1/r) = 0: two loads, no recurrence), in
+    order of increasing n; indices and weights from the tables."""
     scr[k, base] = inv_r
     oi = tab_i[_H.H_I_D]
     of = tab_i[_H.H_F_D]
-    for g in range(1, n):
-        t = oi + 6 * (g - 1)
-        f = of + 6 * (g - 1)
-        s1 = (tab_f[f] * R[0] * scr[k, base + tab_i[t]]
-              + tab_f[f + 1] * R[1] * scr[k, base + tab_i[t + 1]]
-              + tab_f[f + 2] * R[2] * scr[k, base + tab_i[t + 2]])
-        s2 = (tab_f[f + 3] * scr[k, base + tab_i[t + 3]]
-              + tab_f[f + 4] * scr[k, base + tab_i[t + 4]]
-              + tab_f[f + 5] * scr[k, base + tab_i[t + 5]])
-        scr[k, base + g] = -inv_r2 * (s1 + s2)
+    oh = tab_i[_H.H_I_DH]
+    rec = 0
+    har = 0
+    for d in range(1, top + 1):
+        for e in range(rec, rec + 2 * d + 1):
+            t = oi + 6 * e
+            f = of + 5 * e
+            s = (tab_f[f] * R[0] * scr[k, base + tab_i[t + 1]]
+                 + tab_f[f + 1] * R[1] * scr[k, base + tab_i[t + 2]]
+                 + tab_f[f + 2] * R[2] * scr[k, base + tab_i[t + 3]]
+                 + tab_f[f + 3] * scr[k, base + tab_i[t + 4]]
+                 + tab_f[f + 4] * scr[k, base + tab_i[t + 5]])
+            scr[k, base + tab_i[t]] = -inv_r2 * s
+        rec += 2 * d + 1
+        for e in range(har, har + d * (d - 1) // 2):
+            t = oh + 3 * e
+            scr[k, base + tab_i[t]] = -scr[k, base + tab_i[t + 1]] - scr[k, base + tab_i[t + 2]]
+        har += d * (d - 1) // 2
 
 
 @ti.func
@@ -77,39 +83,30 @@ def _rotate_secondary(rows: ti.template(), j, wA, scr: ti.template(), k, tab_i: 
                       tab_f: ti.template(), S):
     """The secondary's integrals of degrees 2..KR carried into the primary's frame,
     T'^β = ∫ (S x)^β dm, by the exact recurrence P_{p+1}[β'+e_i][δ] = Σ_j S_ij P_p[β'][δ+e_j]
-    (ping-pong between two scratch buffers), then normalised by 1/β! into scr[k, TB + β]."""
+    (P_p[β'][δ] = ∫ (S x)^{β'} x^δ dm), then normalised by 1/β! in scr[k, TB + β].
+
+    Every stage of every degree is one entry list, walked in one flat loop: an entry names
+    its output, its three inputs and 3 × the axis it peels (the row of S, copied into the
+    scratch first), all as scratch offsets (``multipole_tables``), so no short loop nest
+    runs and no index is computed here."""
     KR = tab_i[_H.H_KR]
-    rot = tab_i[_H.H_I_ROT]
-    frot = tab_i[_H.H_F_ROT]
+    sP = tab_i[_H.H_S_P]
+    sS = tab_i[_H.H_S_S]
     tb = tab_i[_H.H_S_TB]
-    for deg in range(2, KR + 1):
-        nk = _per_degree(deg)
-        bk = _count(deg - 1)
-        src = tab_i[_H.H_S_P0]
-        dst = tab_i[_H.H_S_P1]
-        for c in range(nk):
-            scr[k, src + c] = rows[j, wA + bk + c]
-        for p in range(deg):
-            cols_in = _per_degree(deg - p)
-            rows_out = _per_degree(p + 1)
-            cols_out = _per_degree(deg - p - 1)
-            base_rows = _count(p)
-            base_cols = _count(deg - p - 2)
-            for b in range(rows_out):
-                q = rot + 5 * (base_rows + b)
-                ax = tab_i[q + 1]
-                s0 = ti.select(ax == 0, S[0, 0], ti.select(ax == 1, S[1, 0], S[2, 0]))
-                s1 = ti.select(ax == 0, S[0, 1], ti.select(ax == 1, S[1, 1], S[2, 1]))
-                s2 = ti.select(ax == 0, S[0, 2], ti.select(ax == 1, S[1, 2], S[2, 2]))
-                row = src + tab_i[q] * cols_in
-                out = dst + b * cols_out
-                for c in range(cols_out):
-                    u = rot + 5 * (base_cols + c) + 2
-                    scr[k, out + c] = (s0 * scr[k, row + tab_i[u]] + s1 * scr[k, row + tab_i[u + 1]]
-                                       + s2 * scr[k, row + tab_i[u + 2]])
-            src, dst = dst, src
-        for b in range(nk):
-            scr[k, tb + bk + b] = scr[k, src + b] * tab_f[frot + bk + b]
+    for r in ti.static(range(3)):
+        for c in ti.static(range(3)):
+            scr[k, sS + 3 * r + c] = S[r, c]
+    for q in range(4, _count(KR)):                 # the copy: degrees 2..KR
+        scr[k, sP + q] = rows[j, wA + q]
+    rot = tab_i[_H.H_I_ROT]
+    for e in range(tab_i[_H.H_NROT]):
+        t = rot + 5 * e
+        a = sS + tab_i[t + 4]
+        scr[k, tab_i[t]] = (scr[k, a] * scr[k, tab_i[t + 1]] + scr[k, a + 1] * scr[k, tab_i[t + 2]]
+                            + scr[k, a + 2] * scr[k, tab_i[t + 3]])
+    frot = tab_i[_H.H_F_ROT]
+    for q in range(4, _count(KR)):
+        scr[k, tb + q] *= tab_f[frot + q]
 
 
 @ti.func
@@ -130,9 +127,9 @@ def mutual_n(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     inv_r2 = 1.0 / r2
     inv_r = ti.sqrt(inv_r2)
     # derivatives of 1/r at R (primary frame) and at R_B = Sᵀ R (secondary frame)
-    _derivatives(scr, k, sD, tab_i[_H.H_ND], tab_i, tab_f, R, inv_r, inv_r2)
+    _derivatives(scr, k, sD, tab_i[_H.H_TOP_D], tab_i, tab_f, R, inv_r, inv_r2)
     RB = mat_t_vec(S, R)
-    _derivatives(scr, k, sDB, tab_i[_H.H_NDB], tab_i, tab_f, RB, inv_r, inv_r2)
+    _derivatives(scr, k, sDB, tab_i[_H.H_TOP_DB], tab_i, tab_f, RB, inv_r, inv_r2)
     # combined moments W: the monopole, then the primary-only terms
     for g in range(tab_i[_H.H_NW]):
         scr[k, sW + g] = 0.0

@@ -88,19 +88,20 @@ class multipole:
     HAND_WRITTEN_MAX = 4
     KERNEL_ORDER = 5
     (H_WIDTH_A,            # columns of the primary in a member's integral row: C(dA + 3, 3)
-     H_ND,                 # entries of D = ∂^γ(1/r) at R: C(N + 4, 3) (degrees 0..N+1)
-     H_NDB,                # entries of D at the secondary's frame R_B = Sᵀ R
+     H_TOP_D,              # top degree of D = ∂^γ(1/r) at R: N + 1
+     H_TOP_DB,             # top degree of D at the secondary's frame R_B = Sᵀ R (0: none)
      H_NW,                 # entries of the combined moments W_γ: C(N + 3, 3)
      H_KR,                 # top degree of the rotated secondary integrals (< 2: none)
      H_NA,                 # primary terms (normalised primary integrals)
      H_NB,                 # secondary-only terms
      H_NBETA,              # secondary multi-indices β of the mixed terms
      H_NGAM,               # entries of the energy and force sum over W
-     H_I_D, H_I_A, H_I_B, H_I_ROT, H_I_BETA, H_I_PAIR, H_I_GAM,   # sections, integer table
+     H_NROT,               # entries of the rotation recurrence (all stages, in order)
+     H_I_D, H_I_DH, H_I_A, H_I_B, H_I_ROT, H_I_BETA, H_I_PAIR, H_I_GAM,   # integer table
      H_F_D, H_F_A, H_F_B, H_F_ROT, H_F_BETA,                      # sections, float table
-     H_S_D, H_S_DB, H_S_W, H_S_TA, H_S_TB, H_S_P0, H_S_P1,        # scratch offsets
+     H_S_D, H_S_DB, H_S_W, H_S_TA, H_S_TB, H_S_P, H_S_S,          # scratch offsets
      H_SCRATCH,            # scratch columns per member
-     NHEAD) = range(30)
+     NHEAD) = range(32)
 
 
 class perturbation:

@@ -179,7 +179,7 @@ def tables(order, degree_a, degree_b, odd=True) -> Tables:
     def keep(e):
         return odd or _even(e)
 
-    ints = {name: [] for name in ("D", "A", "B", "ROT", "BETA", "PAIR", "GAM")}
+    ints = {name: [] for name in ("D", "DH", "A", "B", "BETA", "PAIR", "GAM")}
     floats = {name: [] for name in ("D", "A", "B", "ROT", "BETA")}
     nD = count(N + 1)
     eB = min(dB, N)                     # the secondary-only terms' top degree
@@ -188,17 +188,23 @@ def tables(order, degree_a, degree_b, odd=True) -> Tables:
     KR = min(dB, N - 2)                 # rotated secondary integrals (mixed terms)
     KA = min(dA, N - 2)                 # primary degree of the mixed terms
 
-    # D recurrence, entries 1..nD-1: indices of γ − e_i, γ − 2e_i and their weights
-    for g in E[1:nD]:
-        n = sum(g)
-        for i in range(3):
-            ok = g[i] >= 1
-            ints["D"].append(idx(add(g, eye[i], -1)) if ok else 0)
-            floats["D"].append((2 * n - 1) * g[i] / n if ok else 0.0)
-        for i in range(3):
-            ok = g[i] >= 2
-            ints["D"].append(idx(add(g, add(eye[i], eye[i]), -1)) if ok else 0)
-            floats["D"].append((n - 1) * g[i] * (g[i] - 1) / n if ok else 0.0)
+    # D, degree by degree: first the 2d + 1 entries with z exponent <= 1 from the recurrence
+    # (target; γ − e_x, γ − e_y, γ − e_z, γ − 2e_x, γ − 2e_y and their weights), then the
+    # others by increasing z exponent from harmonicity (target; (l+2, m, n−2), (l, m+2, n−2))
+    for d in range(1, top + 1):
+        block = [e for e in E[count(d - 1):count(d)]]
+        for g in (e for e in block if e[2] <= 1):
+            ints["D"].append(idx(g))
+            for i in range(3):
+                ok = g[i] >= 1
+                ints["D"].append(idx(add(g, eye[i], -1)) if ok else 0)
+                floats["D"].append((2 * d - 1) * g[i] / d if ok else 0.0)
+            for i in range(2):
+                ok = g[i] >= 2
+                ints["D"].append(idx(add(g, add(eye[i], eye[i]), -1)) if ok else 0)
+                floats["D"].append((d - 1) * g[i] * (g[i] - 1) / d if ok else 0.0)
+        for g in sorted((e for e in block if e[2] >= 2), key=lambda e: e[2]):
+            ints["DH"] += [idx(g), idx((g[0] + 2, g[1], g[2] - 2)), idx((g[0], g[1] + 2, g[2] - 2))]
 
     # primary terms: normalisation (−1)^|α|/α! of 2 <= |α| <= min(dA, N)
     a_set = [e for e in E[:count(min(dA, N))] if sum(e) >= 2 and keep(e)]
@@ -212,17 +218,33 @@ def tables(order, degree_a, degree_b, odd=True) -> Tables:
         ints["B"] += [idx(e)] + [idx(add(e, eye[j])) for j in range(3)]
         floats["B"].append(1.0 / _fact(e))
 
-    # rotation: per global index q up to degree max(KR, 0): parent (local, degree d − 1),
-    # axis, and the local indices of q + e_j in degree d + 1; 1/β! per q
-    for q, e in enumerate(E[:count(max(KR, 0))]):
-        d = sum(e)
-        if d:
-            axis = next(i for i in range(3) if e[i] > 0)
-            parent = idx(add(e, eye[axis], -1)) - count(d - 2)
-        else:
-            axis, parent = 0, 0
-        ints["ROT"] += [parent, axis] + [idx(add(e, eye[j])) - count(d) for j in range(3)]
-        floats["ROT"].append(1.0 / _fact(e))
+    # rotation: one flat list of entries (dst, src0, src1, src2, 3·axis), stage after stage
+    # (degree k = 2..KR, step p = 0..k−1), scratch offsets within the slot; the copy of the
+    # secondary's integrals at the start of the P region, then two buffers the stages write
+    # in turn, the last stage of each degree writing into TB (unnormalised; 1/β! after)
+    P0 = count(max(KR, 0))                       # P region: the copy, then two buffers
+    maxP = max([per_degree(p + 1) * per_degree(k - p - 1) for k in range(2, KR + 1)
+                for p in range(k - 1)], default=0)
+    p_size = P0 + 2 * maxP
+    rot_entries = []
+    for k in range(2, KR + 1):
+        in_base, in_rel = None, count(k - 1)     # p = 0 reads the copy of degree k
+        for p in range(k):
+            cols_out, cols_in = per_degree(k - p - 1), per_degree(k - p)
+            last = p == k - 1
+            block = P0 + (p % 2) * maxP          # stage p writes one buffer, reads the other
+            out_base = ("TB", count(k - 1)) if last else ("P", block)
+            for b, beta in enumerate(E[count(p):count(p + 1)]):     # degree p + 1
+                axis = next(i for i in range(3) if beta[i] > 0)
+                parent = idx(add(beta, eye[axis], -1)) - count(p - 1)
+                for c, delta in enumerate(E[count(k - p - 2):count(k - p - 1)]):
+                    up = [idx(add(delta, eye[jj])) - count(k - p - 1) for jj in range(3)]
+                    src = [("P", (in_rel if in_base is None else in_base)
+                            + parent * cols_in + u) for u in up]
+                    rot_entries.append((out_base[0], out_base[1] + b * cols_out + c, src, axis))
+            if not last:
+                in_base = block
+    floats["ROT"] = [1.0 / _fact(e) for e in E[:count(max(KR, 0))]]
 
     # mixed terms: β with 2 <= |β| <= KR, then its α (2 <= |α| <= min(KA, N − |β|))
     levi = {0: ((1, 2, -1.0), (2, 1, 1.0)), 1: ((2, 0, -1.0), (0, 2, 1.0)),
@@ -255,12 +277,10 @@ def tables(order, degree_a, degree_b, odd=True) -> Tables:
             continue
         ints["GAM"] += [idx(g)] + [idx(add(g, eye[i])) for i in range(3)]
 
-    maxP = max([per_degree(p) * per_degree(k - p) for k in range(2, KR + 1)
-                for p in range(k + 1)], default=0)
     head = [0] * _H.NHEAD
     head[_H.H_WIDTH_A] = count(dA)
-    head[_H.H_ND] = nD
-    head[_H.H_NDB] = nDB
+    head[_H.H_TOP_D] = N + 1
+    head[_H.H_TOP_DB] = eB + 1 if b_set else 0
     head[_H.H_NW] = nW
     head[_H.H_KR] = KR
     head[_H.H_NA] = len(a_set)
@@ -268,7 +288,7 @@ def tables(order, degree_a, degree_b, odd=True) -> Tables:
     head[_H.H_NBETA] = len(ints["BETA"]) // 9
     head[_H.H_NGAM] = len(ints["GAM"]) // 4
     flat_i, flat_f = list(head), []
-    for name, key in (("D", _H.H_I_D), ("A", _H.H_I_A), ("B", _H.H_I_B), ("ROT", _H.H_I_ROT),
+    for name, key in (("D", _H.H_I_D), ("DH", _H.H_I_DH), ("A", _H.H_I_A), ("B", _H.H_I_B),
                       ("BETA", _H.H_I_BETA), ("PAIR", _H.H_I_PAIR), ("GAM", _H.H_I_GAM)):
         flat_i[key] = len(flat_i)
         flat_i += ints[name]
@@ -279,10 +299,18 @@ def tables(order, degree_a, degree_b, odd=True) -> Tables:
     offset = 0
     for key, size in ((_H.H_S_D, nD), (_H.H_S_DB, nDB), (_H.H_S_W, nW),
                       (_H.H_S_TA, count(min(dA, N))), (_H.H_S_TB, count(max(KR, 0))),
-                      (_H.H_S_P0, maxP), (_H.H_S_P1, maxP)):
+                      (_H.H_S_P, p_size), (_H.H_S_S, 9)):
         flat_i[key] = offset
         offset += size
     flat_i[_H.H_SCRATCH] = offset
+    # the rotation entries, now that the regions have their offsets
+    region = {"P": flat_i[_H.H_S_P], "TB": flat_i[_H.H_S_TB]}
+    rot = []
+    for where, dst, src, axis in rot_entries:
+        rot += [region[where] + dst] + [region[w] + o for w, o in src] + [3 * axis]
+    flat_i[_H.H_NROT] = len(rot_entries)
+    flat_i[_H.H_I_ROT] = len(flat_i)
+    flat_i += rot
     ints_arr = np.array(flat_i, dtype=np.int32)
     floats_arr = np.array(flat_f + [0.0], dtype=np.float64)   # never empty
     ints_arr.setflags(write=False)
