@@ -24,7 +24,7 @@ TABLE = {  # name: (R_p, rho_p, c, ab, a/b, rho_s, a, e) from docs/physics.md §
 
 
 def test_every_table_row_is_catalogued():
-    assert set(TABLE) | {"test"} == set(catalog.names())
+    assert set(TABLE) | {"test", "Didymos (radar shape)"} == set(catalog.names())
 
 
 @pytest.mark.parametrize("name", sorted(TABLE))
@@ -60,6 +60,8 @@ def test_energy_test_case():
 
 def test_names_are_forgiving_but_unknown_ones_list_the_catalogue():
     assert catalog.system("1991vh").name == catalog.system("1991_VH").name == "1991 VH"
+    assert catalog.system("didymos_radar_shape").name == catalog.system(
+        "Didymos-Radar-Shape").name == "Didymos (radar shape)"
     with pytest.raises(ValueError, match="known systems: test, 1991 VH"):
         catalog.system("Ida")
 

@@ -21,6 +21,7 @@ if not (_Path(__file__).parent / "kernels").is_dir() and (_checkout / "kernels" 
     __path__.append(str(_checkout))        # noqa: F821 (the package's own module __path__)
 
 from .system.bodies import Body, Ellipsoid, Sphere
+from .system.shapes import Composite, Part, Polyhedron, read_shape
 from .engine.evaluation import mutual_potential
 from .runtime import init
 from .engine.options import Integrator, Run
@@ -41,7 +42,8 @@ from .model.perturbations import BYORP, YORP, Tides
 from .studies.warmup import warmup
 from ._version import __version__
 
-__all__ = ["Body", "Ellipsoid", "Sphere", "BinarySystem", "G", "init", "mutual_potential",
+__all__ = ["Body", "Ellipsoid", "Sphere", "Polyhedron", "read_shape", "Composite", "Part",
+           "BinarySystem", "G", "init", "mutual_potential",
            "Integrator", "Run",
            "ImplausibleInputWarning", "NearCircularWarning", "InitialState",
            "surface_of_section", "time_series", "SectionResult", "TimeSeriesResult", "catalog",

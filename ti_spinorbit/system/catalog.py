@@ -1,9 +1,17 @@
-"""Catalogue of the binary systems of Naidu & Margot 2015, Table 1 (packaged data).
+"""Catalogue of the binary systems of Naidu & Margot 2015, Table 1 (packaged data), and
+"Didymos (radar shape)": Didymos with its radar shape model as the primary.
 
 The numbers live in ``data/systems.json`` with their source notes; this module turns an
 entry into a :class:`~ti_spinorbit.system.systems.BinarySystem` following the paper's secondary
 prescription (docs/physics.md §7): a = sqrt(ab · a/b), b = sqrt(ab / (a/b)), mass
-ρ_s (4/3) π ab c, whatever the elongation.
+ρ_s (4/3) π ab c, whatever the elongation. The primary is a sphere (``R_p``, ``rho_p``),
+except where the entry gives ``primary`` as a packaged shape model
+(``{"shape": "polyhedron", "packaged": ..., "density": ..., "order": ...}``,
+:func:`~ti_spinorbit.system.shapes.packaged_shape`) with its ``primary_spin_period_h``; that
+polyhedron is built once per process (it does not depend on the secondary's options).
+
+Names are matched ignoring case and everything but letters and digits: "Didymos (radar
+shape)", "didymos_radar_shape" and "DidymosRadarShape" are the same entry.
 """
 
 import json
@@ -13,7 +21,8 @@ from importlib import resources
 
 from .._validate import (MAX_DENSITY, MIN_DENSITY, require_positive_scalar, require_range,
                          require_real, show)
-from .bodies import Ellipsoid, Sphere
+from .bodies import DATA_ORDER, Ellipsoid, Sphere
+from .shapes import packaged_shape
 from .systems import BinarySystem
 
 HOUR = 3600.0
@@ -38,11 +47,16 @@ def entry(name):
     return dict(_data()[_resolve(name)])
 
 
+def _normal(name):
+    """A name without case and without anything but letters and digits."""
+    return "".join(ch for ch in name.lower() if ch.isalnum())
+
+
 def _resolve(name):
     table = _data()
     if not isinstance(name, str):
         raise TypeError(f"system name must be a string (got {name!r})")
-    key = {k.lower().replace(" ", ""): k for k in table}.get(name.lower().replace(" ", "").replace("_", ""))
+    key = {_normal(k): k for k in table}.get(_normal(name))
     if key is None:
         raise ValueError(f"unknown system {name!r}; known systems: {', '.join(table)}")
     return key
@@ -95,10 +109,25 @@ def _system(key, d, e, elongation, secondary_density):
         raise ValueError(f"elongation {q} makes b = {b_s:.4g} m < c = {c_s} m for {key}: "
                          f"the largest allowed is {d['ab'] / c_s**2:.4g}")
     mass_s = rho_s * 4.0 / 3.0 * math.pi * d["ab"] * c_s
-    primary = Sphere(d["R_p"], d["rho_p"], name=f"{key} primary")
     secondary = Ellipsoid(a_s, b_s, c_s, mass=mass_s, name=f"{key} secondary")
-    return BinarySystem(primary, secondary, d["a_m"], e, name=key,
+    period = d.get("primary_spin_period_h")
+    return BinarySystem(_primary(key, d), secondary, d["a_m"], e,
+                        primary_spin_period=None if period is None else period * HOUR, name=key,
                         heliocentric_orbit=heliocentric_orbit(key))
+
+
+def _primary(key, d):
+    """A sphere (R_p, rho_p), or the packaged shape model the entry names."""
+    p = d.get("primary")
+    if p is None:
+        return Sphere(d["R_p"], d["rho_p"], name=f"{key} primary")
+    return _shape_primary(key, p["packaged"], p["density"], p.get("order", DATA_ORDER))
+
+
+@lru_cache(maxsize=None)
+def _shape_primary(key, packaged, density, order):
+    # a Body is immutable (its offset and rotation arrays read-only), so one serves all
+    return packaged_shape(packaged, density=density, name=f"{key} primary", order=order)
 
 
 def secondary_spin_period(name):

@@ -27,7 +27,9 @@ from .._validate import (MAX_BULK_DENSITY, MAX_MASS, MAX_MASS_RATIO, MAX_PRIMARY
                          MIN_MOMENT_RATIO, check_heliocentric, refuse_unknown_keys,
                          require_finite, require_positive_scalar, require_range, require_real,
                          show)
-from .bodies import MAX_ORDER, ROW_ORDER, Body, Ellipsoid, check_order
+from .bodies import DATA_ORDER, MAX_ORDER, ROW_ORDER, Body, Ellipsoid, check_order
+from . import shapes as _shapes
+from .integrals import _check_rotation
 from .. import display as _display
 from .initial import tilted_start as _tilted_start
 from ..layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
@@ -99,9 +101,9 @@ class BinarySystem(_display.Readable):
         just above osmium), so P lies in [2π sqrt(a³ / (G 25000 V)), 2π sqrt(a³ / (G 100 V))],
         V = V1 + V2; the error names that range and the implied density (a period in the wrong
         unit, e.g. 1 s or 1e20 s, lands outside). V of an ellipsoid is (4/3)π abc; of a
-        general :class:`Body`, that of the uniform ellipsoid with its second moments,
-        semi-axes sqrt(5 T^200 / m) etc. (docs/physics.md §7.5). Not stored: the scaled
-        bodies are, with ``density_scale``.
+        polyhedron its own ``volume``; of any other :class:`Body`, that of the uniform
+        ellipsoid with its second moments, semi-axes sqrt(5 T^200 / m) etc. (docs/physics.md
+        §7.5). Not stored: the scaled bodies are, with ``density_scale``.
 
     Attributes
     ----------
@@ -319,13 +321,25 @@ class BinarySystem(_display.Readable):
         ``mean_motion_rad_s``, ``mass_ratio``, ``omega0``, ``orbital_period_h`` (and each
         body's ``bounding_radius_m``, for an ellipsoid its largest semi-axis), which
         :meth:`from_description` checks against the inputs rather than reads.
-        ``density_scale`` is not written: the masses written already carry it."""
+        ``density_scale`` is not written: the masses written already carry it.
+
+        A body read from a shape file (:func:`~ti_spinorbit.system.shapes.read_shape`, or a
+        packaged shape) is written as that file (``shape``, ``file`` or ``packaged``,
+        ``unit``, ``density`` or ``mass_kg``, ``order``), so the description rebuilds it; a
+        body in its principal frame from a shape (polyhedron, composite, point cloud) also
+        gets its ``offset_m`` and ``rotation`` (shape frame -> body frame)."""
         def body(b):
             d = {"name": b.name, "mass_kg": b.mass, "bounding_radius_m": b.bounding_radius}
             if hasattr(b, "semi_axes"):
                 d["semi_axes_m"] = list(b.semi_axes)
-            if b.order != _default_order(b):
+            source = getattr(b, "source", None)         # read from a shape file
+            if source is not None:
+                d.update(source)
+            if source is not None or b.order != _default_order(b):
                 d["order"] = b.order
+            for attribute, key in (("offset", "offset_m"), ("rotation", "rotation")):
+                if getattr(b, attribute, None) is not None:
+                    d[key] = np.asarray(getattr(b, attribute), dtype=np.float64).tolist()
             return d
         return {"name": self.name, "primary": body(self.primary), "secondary": body(self.secondary),
                 "a_m": self.a, "e": self.e, "primary_spin_period_s": self.primary_spin_period,
@@ -335,7 +349,7 @@ class BinarySystem(_display.Readable):
                    dict(zip(("heliocentric_a_au", "heliocentric_e"), self.heliocentric_orbit)))}
 
     @classmethod
-    def from_description(cls, d: dict) -> "BinarySystem":
+    def from_description(cls, d: dict, *, directory=None) -> "BinarySystem":
         """Rebuild a system from :meth:`describe` output (e.g. read back from a saved file).
 
         The result has the identical :meth:`parameter_row` and :meth:`initial_state`.
@@ -349,10 +363,25 @@ class BinarySystem(_display.Readable):
         * else from ``"semi_axes_m"`` (m) and ``"mass_kg"`` as a uniform ellipsoid, which is
           exact because an ellipsoid's integrals depend on nothing else.
 
+        * else from a shape file, ``{"shape": "polyhedron", "file": PATH, "unit": "km",
+          "density": kg/m^3}`` (``"mass_kg"`` instead of ``"density"``; optional ``"facets"``
+          for the GUBAS CSV pair, ``"format"``, ``"order"``, default 8, and ``"name"``,
+          default the file's stem), read with
+          :func:`~ti_spinorbit.system.shapes.read_shape`; a relative PATH is relative to
+          ``directory`` (the system file's folder when read by :meth:`from_file`, else the
+          current directory). ``{"shape": "polyhedron", "packaged": "didymos_radar", ...}``
+          names a shape packaged with ti_spinorbit (``shapes.PACKAGED``) instead. With
+          ``"density"``, ``"mass_kg"`` is derived (checked), and so are
+          ``"bounding_radius_m"``, ``"offset_m"`` and ``"rotation"``. A shape body that also
+          has ``"integrals"`` (as saved results hold it) is rebuilt from them, and the file
+          is not read.
+
         ``"order"`` (optional, 4..16) is the order of the body's integrals; without it an
-        ellipsoid has ``MAX_ORDER`` (16, as :func:`Ellipsoid` gives it) and a general body the
-        highest degree among its ``integrals``, at least 4 (:meth:`describe` writes it only
-        where it differs from these).
+        ellipsoid has ``MAX_ORDER`` (16, as :func:`Ellipsoid` gives it), a shape file 8
+        (``DATA_ORDER``) and a general body the highest degree among its ``integrals``, at
+        least 4 (:meth:`describe` writes it where it differs from these, and for every shape
+        file). ``"offset_m"`` and ``"rotation"`` of a body given by its integrals are kept on
+        it as given.
 
         A general body described by :meth:`describe` alone (no semi-axes, no integrals)
         cannot be rebuilt: ValueError.
@@ -379,8 +408,10 @@ class BinarySystem(_display.Readable):
             raise ValueError(f"system description lacks {', '.join(map(repr, missing))} "
                              f"(has {', '.join(map(repr, d))}); expected BinarySystem.describe() output")
         mismatches = []           # derived entries that disagree, all named in one message
-        primary = _body_from(d["primary"], "primary", mismatches)
-        secondary = _body_from(d["secondary"], "secondary", mismatches)
+        if directory is not None and not isinstance(directory, (str, os.PathLike)):
+            raise TypeError(f"directory must be a folder path or None (got {show(directory)})")
+        primary = _body_from(d["primary"], "primary", mismatches, directory)
+        secondary = _body_from(d["secondary"], "secondary", mismatches, directory)
         period = d.get("primary_spin_period_s")
         system = cls(primary, secondary, require_real("a_m", d["a_m"]), require_real("e", d["e"]),
                      primary_spin_period=None if period is None else
@@ -426,19 +457,144 @@ class BinarySystem(_display.Readable):
 SYSTEM_KEYS = ("name", "primary", "secondary", "a_m", "e", "primary_spin_period_s",
                "heliocentric_a_au", "heliocentric_e", "mean_motion_rad_s", "mass_ratio",
                "omega0", "orbital_period_h", "density_scale")
-BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals", "order")
+BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals", "order",
+             "shape", "file", "facets", "unit", "format", "packaged", "density", "offset_m",
+             "rotation")
+#: The keys of a body given by a shape file (with "shape": "polyhedron").
+SHAPE_KEYS = ("shape", "file", "facets", "unit", "format", "packaged", "density")
 #: Relative tolerance of a derived entry against its value recomputed from the inputs: the
 #: package writes them unrounded (JSON keeps every bit), so only an edit differs.
 DERIVED_RTOL = 1e-9
 
 
-def _body_from(b, label, mismatches):
+def _body_from(b, label, mismatches, directory=None):
     """A body of a system description (see BinarySystem.from_description); a derived
     bounding_radius_m that disagrees is added to ``mismatches``."""
     if not isinstance(b, dict):
         raise TypeError(f"{label} must be an object with the keys {', '.join(BODY_KEYS)} "
                         f"(got {show(b)})")
     refuse_unknown_keys(b, BODY_KEYS, repr(label))
+    if "shape" in b:
+        return _shape_body_from(b, label, mismatches, directory)
+    stray = [k for k in SHAPE_KEYS if k in b]
+    if stray:
+        raise ValueError(f"{label} {stray[0]!r} belongs to a body given by a shape file: add "
+                         "\"shape\": \"polyhedron\" and \"file\" (or \"packaged\"), or delete it")
+    body = _plain_body_from(b, label, mismatches)
+    _record_frame(body, b, label)
+    return body
+
+
+def _record_frame(body, b, label):
+    """Keep a description's offset_m and rotation on a body rebuilt from its integrals."""
+    if "offset_m" in b:
+        offset = np.asarray(require_finite(f"{label} offset_m", b["offset_m"]), dtype=np.float64)
+        if offset.shape != (3,):
+            raise ValueError(f"{label} offset_m must be a list of 3 lengths in m (got "
+                             f"{show(b['offset_m'])})")
+        offset.setflags(write=False)
+        object.__setattr__(body, "offset", offset)
+    if "rotation" in b:
+        try:
+            rotation = _check_rotation(b["rotation"]).copy()
+        except ValueError as exc:
+            raise ValueError(f"{label} rotation: {exc}") from None
+        rotation.setflags(write=False)
+        object.__setattr__(body, "rotation", rotation)
+
+
+def _table_from(integrals, label):
+    if not isinstance(integrals, dict):
+        raise TypeError(f"{label} integrals must be an object {{'l,m,n': T^lmn}} "
+                        f"(got {show(integrals)})")
+    table = {}
+    for key, value in integrals.items():
+        try:
+            lmn = tuple(int(i) for i in key.split(","))
+        except (AttributeError, ValueError):
+            raise ValueError(f"{label} integrals: key {show(key)} is not 'l,m,n'") from None
+        table[lmn] = require_real(f"{label} integrals[{key!r}]", value)
+    return table
+
+
+def _shape_body_from(b, label, mismatches, directory):
+    """A body given by a shape file (or, with "integrals", by the integrals saved with it)."""
+    if b["shape"] != "polyhedron":
+        raise ValueError(f"{label} shape must be 'polyhedron' (a shape-model file; an ellipsoid "
+                         f"is given by semi_axes_m) (got {show(b['shape'])})")
+    if "semi_axes_m" in b:
+        raise ValueError(f"{label}: a polyhedron has no semi_axes_m; delete it")
+    if ("file" in b) == ("packaged" in b):
+        raise ValueError(f"{label} needs exactly one of 'file' (a shape-model file, relative to "
+                         f"the system file) and 'packaged' (a shape packaged with ti_spinorbit: "
+                         f"{', '.join(map(repr, _shapes.PACKAGED))})")
+    if "packaged" in b:
+        extra = [k for k in ("facets", "unit", "format") if k in b]
+        if extra:
+            raise ValueError(f"{label} {extra[0]!r} is for a shape file, not a packaged shape")
+    order = check_order(b.get("order", DATA_ORDER), f"{label} order")
+    density = b.get("density")
+    if density is None and "mass_kg" not in b:
+        raise ValueError(f"{label} needs 'density' (kg/m^3) or 'mass_kg' (its shape gives the "
+                         f"other)")
+    if density is not None:
+        density = require_real(f"{label} density", density)
+    mass = None if density is not None else require_real(f"{label} mass_kg", b["mass_kg"])
+    source = {k: b[k] for k in SHAPE_KEYS if k in b}
+    name = b.get("name")
+    if "integrals" in b:                            # a saved body: its integrals are read
+        for key in ("mass_kg", "bounding_radius_m"):
+            if key not in b:
+                raise ValueError(f"{label} description lacks {key!r} (has "
+                                 f"{', '.join(map(repr, b))})")
+        try:
+            body = Body(require_real(f"{label} mass_kg", b["mass_kg"]),
+                        _table_from(b["integrals"], label),
+                        require_real(f"{label} bounding_radius_m", b["bounding_radius_m"]),
+                        "body" if name is None else name, order)
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"{label}: {exc}") from None
+        if density is not None:
+            object.__setattr__(body, "density", density)
+            object.__setattr__(body, "volume", body.mass / density)
+        _record_frame(body, b, label)
+        object.__setattr__(body, "source", _shapes.MappingProxyType(
+            {**source, **({} if density is not None else {"mass_kg": body.mass})}))
+        return body
+    try:
+        if "packaged" in b:
+            body = _shapes.packaged_shape(b["packaged"], density=density, mass=mass, name=name,
+                                          order=order)
+        else:
+            def resolve(p):
+                if not isinstance(p, str):
+                    raise TypeError(f"file paths must be strings (got {show(p)})")
+                return p if os.path.isabs(p) else os.path.join(directory or os.getcwd(), p)
+
+            body = _shapes.read_shape(resolve(b["file"]), unit=b.get("unit", "km"),
+                                      density=density, mass=mass, format=b.get("format"),
+                                      facets=None if "facets" not in b else resolve(b["facets"]),
+                                      name=name, order=order)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{label}: {exc}") from None
+    checks = [("mass_kg", body.mass, 0.0)] if density is not None else []
+    checks += [("bounding_radius_m", body.bounding_radius, 0.0),
+               ("offset_m", body.offset, body.bounding_radius),
+               ("rotation", body.rotation, 1.0)]
+    for key, value, scale in checks:
+        if key in b:
+            given = np.asarray(require_finite(f"{label} {key}", b[key]), dtype=np.float64)
+            want = np.asarray(value, dtype=np.float64)
+            if given.shape != want.shape or not np.allclose(
+                    given, want, rtol=DERIVED_RTOL, atol=DERIVED_RTOL * scale):
+                mismatches.append(f"{label} {key} is {show(given.tolist())} in the "
+                                  f"description, but its shape file gives "
+                                  f"{show(want.tolist())}")
+    return body
+
+
+def _plain_body_from(b, label, mismatches):
+    """An ellipsoid (semi_axes_m) or a general body (integrals)."""
     axes, integrals = b.get("semi_axes_m"), b.get("integrals")
     needed = ("mass_kg",) if axes is not None and integrals is None else \
         ("mass_kg", "bounding_radius_m")
@@ -474,16 +630,7 @@ def _body_from(b, label, mismatches):
                                   f"description, but its semi_axes_m give {derived:.12g} (an "
                                   "ellipsoid's is its largest semi-axis)")
         return ellipsoid
-    if not isinstance(integrals, dict):
-        raise TypeError(f"{label} integrals must be an object {{'l,m,n': T^lmn}} "
-                        f"(got {show(integrals)})")
-    table = {}
-    for key, value in integrals.items():
-        try:
-            lmn = tuple(int(i) for i in key.split(","))
-        except (AttributeError, ValueError):
-            raise ValueError(f"{label} integrals: key {show(key)} is not 'l,m,n'") from None
-        table[lmn] = require_real(f"{label} integrals[{key!r}]", value)
+    table = _table_from(integrals, label)
     try:
         general = Body(mass, table, require_real(f"{label} bounding_radius_m",
                                                  b["bounding_radius_m"]), name,
@@ -581,7 +728,7 @@ def read_system_file(path, what="path"):
                          "one JSON object (BinarySystem.describe() output, as 'ti-spinorbit "
                          "systems --show NAME --out PATH' writes)")
     try:
-        return BinarySystem.from_description(d)
+        return BinarySystem.from_description(d, directory=os.path.dirname(os.path.abspath(p)))
     except RecursionError:
         raise ValueError(f"{what}: {p!r} holds a value nested too deeply") from None
     except (TypeError, ValueError, KeyError, AttributeError) as exc:
@@ -599,9 +746,11 @@ def _scaled_body(body: Body, factor: float) -> Body:
                          order=body.order)
     scaled = Body(body.mass * factor, {k: v * factor for k, v in body.integrals.items()},
                   body.bounding_radius, body.name, body.order)
-    for attribute in ("offset", "rotation"):               # the shape's frame is kept
+    for attribute in ("offset", "rotation", "volume"):      # the shape and its frame are kept
         if hasattr(body, attribute):
             object.__setattr__(scaled, attribute, getattr(body, attribute))
+    if getattr(body, "density", None) is not None:         # not its source: that density
+        object.__setattr__(scaled, "density", body.density * factor)   # is no longer the body's
     return scaled
 
 
@@ -617,9 +766,11 @@ _dataclass_init = BinarySystem.__init__
 
 
 def _volume(body: Body) -> float:
-    """A body's volume, m³, for its bulk density: (4/3)π abc of an ellipsoid; of a general
-    Body, that of the uniform ellipsoid with its second moments (semi-axes sqrt(5 T^200 / m),
-    sqrt(5 T^020 / m), sqrt(5 T^002 / m))."""
+    """A body's volume, m³, for its bulk density: (4/3)π abc of an ellipsoid, the
+    ``volume`` of a polyhedron; of any other Body, that of the uniform ellipsoid with its
+    second moments (semi-axes sqrt(5 T^200 / m), sqrt(5 T^020 / m), sqrt(5 T^002 / m))."""
+    if getattr(body, "volume", None) is not None:          # a polyhedron
+        return float(body.volume)
     axes = getattr(body, "semi_axes", None) or \
         [math.sqrt(5.0 * body.integral(*k) / body.mass) for k in EXPONENTS_2]
     return 4.0 / 3.0 * math.pi * axes[0] * axes[1] * axes[2]
