@@ -2,7 +2,7 @@
 table-driven.
 
 The formulation and the tables are those of ``ti_spinorbit.engine.multipole_tables`` (its
-module docstring; docs/physics.md §3.6): the Cartesian multipole–multipole expansion
+module docstring; docs/physics.md §3.8): the Cartesian multipole–multipole expansion
 
     U_N = −G Σ_{|α|+|β| ≤ N} t̂_A^α t̂_B'^β D_{α+β}(R),   D_γ = ∂^γ(1/|R|),
 

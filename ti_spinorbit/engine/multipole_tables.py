@@ -5,7 +5,7 @@ The kernels (``kernels/multipole_gravity.py``) evaluate the mutual potential, th
 both torques of two rigid bodies at any truncation order N by walking these tables at run
 time: every member walks the same entries in the same order, so no thread diverges, and no
 term is unrolled at compile time, so one compiled kernel serves every order above 4
-(``layout.multipole.KERNEL_ORDER``). What the tables encode (docs/physics.md §3.6 derives
+(``layout.multipole.KERNEL_ORDER``). What the tables encode (docs/physics.md §3.8 derives
 it; ``ti_spinorbit.model.multipole`` is the independent host reference):
 
 Normalised quantities. With D_γ(R) = ∂^γ(1/|R|) (γ a multi-index, |γ| its degree),
@@ -28,8 +28,11 @@ Three kinds of terms, so that the secondary is rotated only as far as the mixed 
 * **mixed terms** (|α|, |β| ≥ 2, |α| + |β| ≤ N): the secondary's integrals rotated up to
   degree min(dB, N − 2) only, by the exact recurrence
   P_{p+1}[β' + e_i][δ] = Σ_j S_ij P_p[β'][δ + e_j] (P_p[β'][δ] = ∫ (S x)^{β'} x^δ dm,
-  |β'| + |δ| = k), which needs two buffers of at most C(p+2, 2) C(k−p+2, 2) numbers, not a
-  rotation matrix of every degree. Stored by β with the α of each β after it (a CSR
+  |β'| + |δ| = k, β' + e_i peeled along its first non-zero axis), which needs two buffers
+  of at most C(p+3, 2) C(k−p+1, 2) numbers, not a rotation matrix of every degree; every
+  stage of every degree is one flat list of entries (output, three inputs, axis), walked in
+  one loop (measured faster than the loop nest over rows and columns, whose loops are a
+  few iterations long). The pairs are stored by β with the α of each β after it (a CSR
   table): per pair, acc_β += t̂_A^α D_γ and W_γ += t̂_A^α t̂_B'^β. The torque on the
   secondary is G Σ_β acc_β ∂t̂_B'^β/∂ε, with the rotation generator
   ∂t̂'^β/∂ε_d = Σ_{c,e} ε_{cde} (β_e + 1) t̂'^{β − e_c + e_e} (β_c > 0).
@@ -43,8 +46,11 @@ D_γ from the two-term recurrence (n = |γ| ≥ 1, D_0 = 1/r)
 
     n r² D_γ = −(2n − 1) Σ_i γ_i R_i D_{γ−e_i} − (n − 1) Σ_i γ_i (γ_i − 1) D_{γ−2e_i},
 
-the recurrence of ``model/multipole.py`` with a_γ = D_γ / γ!; an index with a negative
-component gets weight 0 and index 0, so every entry has six terms.
+the recurrence of ``model/multipole.py`` with a_γ = D_γ / γ!, for the 2d + 1 entries of each
+degree d whose z exponent is at most 1 (five terms: the z second-order one vanishes; an
+index with a negative component gets weight 0 and index 0, so every entry has five); the
+other entries, (d − 1) d / 2 of them, follow from ∇²(1/r) = 0,
+D_(l,m,n) = −D_(l+2,m,n−2) − D_(l,m+2,n−2), in order of increasing n (two loads each).
 
 Degree caps ``(degree_a, degree_b)`` keep |α| ≤ dA and |β| ≤ dB; with ``odd`` False (every
 odd-exponent integral of both bodies zero in its own frame, e.g. ellipsoids) the primary's
