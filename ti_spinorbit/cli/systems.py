@@ -51,12 +51,13 @@ def run(args):
     systems = [catalog.system(name) for name in catalog.names()]
     if args.out:
         write_json(args.out, [s.describe() for s in systems], indent=1)
-    say(args, f"{'name':12s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} "
+    width = max([12] + [len(s.name) for s in systems])      # "Didymos (radar shape)"
+    say(args, f"{'name':{width}s} {'mass ratio':>10s} {'a (m)':>8s} {'e':>7s} {'a/b':>5s} "
               f"{'omega0':>7s} {'P_orb (h)':>9s}  {'primary (m)':>17s}  "
               f"{'secondary semi-axes (m)':>23s}")
     for s in systems:
         ax = s.secondary.semi_axes
-        say(args, f"{s.name:12s} {s.mass_ratio:10.2f} {s.a:8.0f} {s.e:7.4f} "
+        say(args, f"{s.name:{width}s} {s.mass_ratio:10.2f} {s.a:8.0f} {s.e:7.4f} "
                   f"{ax[0] / ax[1]:5.2f} {s.omega0:7.3f} {s.orbital_period / 3600:9.2f}  "
                   f"{_body_size(s.primary):>17s}  {_body_size(s.secondary):>23s}")
     return 0

@@ -143,12 +143,13 @@ def _mesh_arrays(vertices, faces, name):
 
 
 def _centroid(v, f):
-    """Centre of volume of a closed mesh, m: the first moments about the facet corners'
-    mean, divided by the volume."""
+    """Volume (m³) and centre of volume (m) of a closed mesh: the moments of orders 0 and 1
+    about the facet corners' mean."""
     counts = np.bincount(f.ravel(), minlength=len(v)).astype(np.float64)
     mean = counts @ v / counts.sum()
     T1 = _integrals.polyhedron_integrals(v - mean, f, 1, 1.0)
-    return mean + np.array([T1[(1, 0, 0)], T1[(0, 1, 0)], T1[(0, 0, 1)]]) / T1[(0, 0, 0)]
+    volume = float(T1[(0, 0, 0)])
+    return volume, mean + np.array([T1[(1, 0, 0)], T1[(0, 1, 0)], T1[(0, 0, 1)]]) / volume
 
 
 def Polyhedron(vertices, faces, *, density=None, mass=None, name="polyhedron",
@@ -187,13 +188,12 @@ def Polyhedron(vertices, faces, *, density=None, mass=None, name="polyhedron",
     _check_name(name)
     order = check_order(order)
     v, f = _mesh_arrays(vertices, faces, name)
-    volume = _integrals.volume_of(v, f)
-    mass = _mass_from(volume, density, mass)
-    rho = float(density) if density is not None else mass / volume
     # integrate about the centre of mass itself (found at order 1 first): moving integrals
     # of degree n by a distance d costs up to ((d + size) / size)^n of their precision, so
     # neither the model's origin nor the shift to the centre of mass may come after them
-    centre = _centroid(v, f)
+    volume, centre = _centroid(v, f)
+    mass = _mass_from(volume, density, mass)
+    rho = float(density) if density is not None else mass / volume
     T = _integrals.polyhedron_integrals(v - centre, f, order, rho)
     used = v[np.unique(f)] - centre
 
