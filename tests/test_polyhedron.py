@@ -20,6 +20,7 @@
 import itertools
 import json
 import math
+import pickle
 from fractions import Fraction
 
 import numpy as np
@@ -452,6 +453,12 @@ def test_the_didymos_radar_system_is_built_from_the_packaged_shape(radar):
     d = radar.describe()
     assert d["primary"]["packaged"] == "didymos_radar" and d["primary"]["order"] == 12
     assert tso.BinarySystem.from_description(json.loads(json.dumps(d))) == radar
+    # systems travel to Dask workers by pickle, frame and source included
+    back = pickle.loads(pickle.dumps(radar))
+    assert back == radar and back.primary.source == radar.primary.source
+    np.testing.assert_array_equal(back.primary.rotation, radar.primary.rotation)
+    with pytest.raises(TypeError, match="source cannot be changed"):
+        radar.primary.source["density"] = 1000.0
 
 
 def test_a_system_with_a_polyhedron_saves_and_loads_exactly(radar, tmp_path):

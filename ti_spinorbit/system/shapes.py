@@ -64,7 +64,7 @@ from . import shapefiles as _shapefiles
 from .bodies import DATA_ORDER, Body, _mass_from, check_order
 
 __all__ = ["Polyhedron", "read_shape", "Part", "Composite", "PACKAGED", "packaged_shape",
-           "ROUND_OFF"]
+           "ROUND_OFF", "Source"]
 
 #: A mirror plane is recognised when every integral odd in its axis is below this fraction of
 #: mass × bounding_radius^(l+m+n) (module docstring, "Round-off"). The integrals of a closed
@@ -206,8 +206,23 @@ def Polyhedron(vertices, faces, *, density=None, mass=None, name="polyhedron",
     return body
 
 
+class Source(dict):
+    """A body's ``source`` (how a system file names its shape file): a dict that cannot be
+    changed (the body would no longer be what it says), and that pickles (Dask sends
+    systems to its workers)."""
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("a body's source cannot be changed: read the shape again instead")
+
+    __setitem__ = __delitem__ = clear = pop = popitem = setdefault = update = _refuse
+    __ior__ = _refuse
+
+    def __reduce__(self):
+        return (Source, (dict(self),))
+
+
 def _set_source(body, source):
-    object.__setattr__(body, "source", MappingProxyType(dict(source)))
+    object.__setattr__(body, "source", Source(source))
     return body
 
 

@@ -558,7 +558,7 @@ def _shape_body_from(b, label, mismatches, directory):
             object.__setattr__(body, "density", density)
             object.__setattr__(body, "volume", body.mass / density)
         _record_frame(body, b, label)
-        object.__setattr__(body, "source", _shapes.MappingProxyType(
+        object.__setattr__(body, "source", _shapes.Source(
             {**source, **({} if density is not None else {"mass_kg": body.mass})}))
         return body
     try:
