@@ -404,3 +404,41 @@ def test_mutual_potential_at_order_n_equals_the_reference():
             assert abs(V[k] - U) <= TOL * abs(U)
             assert relative(F[k], Fr) <= TOL
             assert relative(tA[k], tAr) <= TOL and relative(tB[k], tBr) <= TOL
+
+
+def test_chunks_of_an_order_n_table_integrate_as_the_whole():
+    """A member's order-N result depends on its own row only: chunks of the table (what the
+    Dask runner sends) give the whole table's crossings bit for bit."""
+    from ti_spinorbit.studies.section import section_of
+
+    system = _ellipsoid_system()
+    if not _holds(system, 6):
+        pytest.skip("these bodies hold their integrals only to degree 4")
+    table = Members.from_starts(system, [0.0, 30.0, 60.0, 90.0], [1.0, 1.2, 1.4, 1.6], order=6,
+                                degrees=(6, 4))
+    integrator = tso.Integrator(order=6, degrees=(6, 4), rtol=1e-10)
+    run = tso.Run(progress=False)
+    whole = section_of(table, 2, integrator=integrator, run=run)
+    parts = [section_of(part, 2, integrator=integrator, run=run) for _, _, part in table.chunks(3)]
+    rows = [(p, k) for p in parts for k in range(len(p.count))]
+    assert len(rows) == len(whole.count)
+    for i, (p, k) in enumerate(rows):
+        n = whole.count[i]
+        assert p.count[k] == n >= 1
+        np.testing.assert_array_equal(p.t[k, :n], whole.t[i, :n])
+        np.testing.assert_array_equal(p.thetadot_p[k, :n], whole.thetadot_p[i, :n])
+
+
+@pytest.mark.parametrize("text, ok", [("0", True), ("2", True), ("16", True), ("1", False),
+                                      ("17", False), ("-1", False)])
+def test_command_line_order_flag(text, ok):
+    import argparse
+
+    from ti_spinorbit.cli.options import ORDER
+
+    if ok:
+        assert ORDER(text) == int(text)
+    else:
+        with pytest.raises(argparse.ArgumentTypeError,
+                           match=rf"^must lie in \{{0\}} ∪ \[2, 16\] \(got {text}\)$"):
+            ORDER(text)
