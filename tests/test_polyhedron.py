@@ -505,7 +505,8 @@ def test_a_section_of_the_radar_system_runs_at_order_4(radar, tmp_path):
 
     assert Members.from_starts(radar, [0.0], [1.0]).model == "3d"
     result = tso.surface_of_section(radar, 0.0, [1.0, 1.1], orbits=2.0, rtol=1e-9)
-    assert result.order == 4 and set(result.status_names) == {"done"}
+    # order 4 runs, but its truncation error at pericentre is above the limit (tests/test_truncation.py)
+    assert result.order == 4 and set(result.status_names) == {"truncated"}
     assert np.all(result.count >= 1)
     assert np.nanmax(np.abs(result.energy_drift)) < 1e-7
     loaded = tso.load(tso.save(result, tmp_path / "radar.npz"))

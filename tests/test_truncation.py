@@ -1,10 +1,16 @@
-"""The truncation table (ti_spinorbit.model.truncation) against an independent route.
+"""The truncation error of the mutual potential: the table for choosing N before a run
+(ti_spinorbit.model.truncation) and every member's estimate and verdict after it.
 
-Its errors are differences to a higher-order reference. For post-DART Didymos ellipsoids in
-one configuration they must equal the true errors against the exact mutual force and torque,
-computed by quadrature of the ellipsoid's exterior potential over the secondary
-(tests/ellipsoid_exact.py); over its configuration set they must fall geometrically with
-order, faster at a larger separation; a sphere feels no torque; bad inputs are refused.
+The table's errors are differences to a higher-order reference. For post-DART Didymos
+ellipsoids in one configuration they must equal the true errors against the exact mutual
+force and torque, computed by quadrature of the ellipsoid's exterior potential over the
+secondary (tests/ellipsoid_exact.py); over its configuration set they must fall geometrically
+with order, faster at a larger separation; a sphere feels no torque; bad inputs are refused.
+
+The per-member estimates (engine.evaluation.truncation_estimates, through the kernels) must
+equal the same differences computed by the NumPy expansion (model.multipole) at the member's
+closest recorded approach; the radar shape of Didymos is "truncated" at order 4 and not at 8;
+the verdict is saved, loaded and reported by the command line.
 """
 
 import os
@@ -18,6 +24,12 @@ from ti_spinorbit.model import truncation as T
 
 sys.path.insert(0, os.path.dirname(__file__))
 import ellipsoid_exact as ex  # noqa: E402
+
+import ti_spinorbit as tso
+from ti_spinorbit import cli
+from ti_spinorbit.engine import accuracy, evaluation
+from ti_spinorbit.layout import spatial as _S
+from ti_spinorbit.model import multipole as mp
 
 G = 6.67430e-11
 DENSITY = 2400.0
@@ -60,7 +72,6 @@ def test_errors_equal_the_true_errors_against_exact_quadrature(monkeypatch):
     table = T.truncation(binary(1190.0), orders=(2, 4, 6, 8), reference=16)
     R = np.array([1190.0, 0.0, 0.0])
     _, F, tB, tA = ex.exact_mutual(G, mass(A_AXES), A_AXES, mass(B_AXES), B_AXES, R, C)
-    from ti_spinorbit.model import multipole as mp
     TA = ex.ellipsoid_integrals(mass(A_AXES), A_AXES, 8)
     TB = ex.ellipsoid_integrals(mass(B_AXES), B_AXES, 8)
     for k, n in enumerate(table.orders):
@@ -112,3 +123,78 @@ def test_a_body_of_too_low_an_order_is_refused():
     with pytest.raises(ValueError, match=r"holds integrals up to order 8, and the reference "
                                          r"order 10 needs them"):
         T.truncation(binary(1190.0, order=8), orders=(4, 6), reference=10)
+
+
+# ---- per member, after a run ---------------------------------------------------------------------
+def test_member_estimates_equal_the_numpy_expansion_at_the_closest_approach():
+    """1999 KW4 (an ellipsoidal, tilted start: a generic attitude), order 4: the estimate is
+    |F_6 − F_4| / |F_6| and |τ_6 − τ_4| / (|F_6| ρ_B) at the closest record, the larger of
+    the recorded attitude and the same turned by 45° about z; recomputed here with the NumPy
+    expansion from the recorded state."""
+    kw4 = tso.catalog.system("1999 KW4")
+    start = kw4.tilted_start(30.0, 1.2, roll=8.0, pitch=5.0)
+    ts = tso.time_series(kw4, initial_states=[start], orbits=2, samples_per_orbit=16,
+                         rtol=1e-10, states=True)
+    k = int(np.nanargmin(ts.r[0]))
+    y = ts.states[0, k]                                   # physical state row, inertial frame
+    # the closest approach in the primary frame, from the packed physical rows
+    from ti_spinorbit.system.initial import ROW_SLICES
+    R_in = y[ROW_SLICES["R"]]
+    A1 = y[ROW_SLICES["primary_attitude"]].reshape(3, 3)
+    A2 = y[ROW_SLICES["secondary_attitude"]].reshape(3, 3)
+    R, S = A1.T @ R_in, A1.T @ A2
+    TA = {tuple(map(int, e)): kw4.primary.integral(*map(int, e)) for e in mp.multi_indices(6)}
+    TB = {tuple(map(int, e)): kw4.secondary.integral(*map(int, e)) for e in mp.multi_indices(6)}
+    turn = np.array([[np.sqrt(0.5), -np.sqrt(0.5), 0], [np.sqrt(0.5), np.sqrt(0.5), 0], [0, 0, 1]])
+    force, torque = [], []
+    for C in (S, turn @ S):
+        _, F4, t4, _ = mp.mutual_force_torque(TA, TB, R, C, 4, G=G)
+        _, F6, t6, _ = mp.mutual_force_torque(TA, TB, R, C, 6, G=G)
+        force.append(np.linalg.norm(F6 - F4) / np.linalg.norm(F6))
+        torque.append(np.linalg.norm(t6 - t4) / (np.linalg.norm(F6) * kw4.secondary.bounding_radius))
+    assert ts.order == 4 and ts.status_names == ["done"]
+    assert ts.truncation_force[0] == pytest.approx(max(force), rel=1e-6)
+    assert ts.truncation_torque[0] == pytest.approx(max(torque), rel=1e-6)
+    assert 1e-9 < ts.truncation_force[0] < accuracy.TRUNCATION_LIMITS[0]
+
+
+def test_the_radar_shape_is_truncated_at_order_4_and_not_at_8(tmp_path):
+    radar = tso.catalog.system("Didymos (radar shape)")
+    low = tso.surface_of_section(radar, 0.0, [0.8, 1.2], orbits=2, rtol=1e-9)
+    high = tso.surface_of_section(radar, 0.0, [0.8, 1.2], orbits=2, rtol=1e-9,
+                                  integrator=tso.Integrator(order=8))
+    assert low.status_names == ["truncated"] * 2 and low.n_inaccurate == 0
+    assert np.all(low.truncation_force > accuracy.TRUNCATION_LIMITS[0])
+    assert high.status_names == ["done"] * 2
+    assert np.all(high.truncation_force < low.truncation_force / 10)     # 40x measured
+    assert np.all(high.truncation_torque < accuracy.TRUNCATION_LIMITS[1])
+    assert not accuracy.usable(low.status).any() and accuracy.usable(low.status, True).all()
+    back = tso.load(tso.save(low, tmp_path / "low.npz"))
+    np.testing.assert_array_equal(back.truncation_force, low.truncation_force)
+    assert back.status_names == ["truncated"] * 2
+
+
+def test_a_body_without_higher_integrals_is_not_estimated():
+    """A hand-given order-4 body holds nothing beyond the run's order: NaN, no verdict."""
+    vh = tso.catalog.system("1991 VH")
+    s = vh.secondary
+    plain = tso.Body(s.mass, {k: s.integral(*k) for k in s.integrals if sum(k) <= 4},
+                     s.bounding_radius, name="order-4 secondary")
+    assert plain.order == 4
+    system = tso.BinarySystem(vh.primary, plain, a=vh.a, e=vh.e)
+    r = tso.surface_of_section(system, 0.0, [1.0], orbits=1, rtol=1e-9)
+    assert r.status_names == ["done"] and np.isnan(r.truncation_force).all()
+    f, t = evaluation.truncation_estimates([(system, np.array([0]))], np.full((1, _S.NSTATE),
+                                           np.nan), 4)
+    assert np.isnan(f).all() and np.isnan(t).all()
+
+
+def test_the_command_line_says_so_and_exits_3(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    args = ["section", "--system", "Didymos (radar shape)", "--orbits", "2", "--thetadot",
+            "1.0", "--quiet"]
+    assert cli.main(args) == cli.EXIT_INACCURATE
+    err = capsys.readouterr().err
+    assert "1 of 1 members truncated: the mutual potential's next orders exceed 1e-05" in err
+    assert "raise --order, or --allow-inaccurate" in err and "tighten --rtol" not in err
+    assert cli.main(args + ["--order", "8", "--out", "o8.png"]) == cli.EXIT_OK

@@ -28,6 +28,7 @@ from .engine.options import Integrator, Run
 from .studies.section import SectionResult, TimeSeriesResult, surface_of_section, time_series
 from .system.systems import G, BinarySystem, ImplausibleInputWarning, NearCircularWarning
 from .model import analytic
+from .model.truncation import TruncationTable, truncation
 from .system import catalog
 from .studies.chaosmap import chaos_map, parameter_map
 from .studies.classify import classify_section
@@ -43,6 +44,7 @@ from .studies.warmup import warmup
 from ._version import __version__
 
 __all__ = ["Body", "Ellipsoid", "Sphere", "Polyhedron", "read_shape", "Composite", "Part",
+           "truncation", "TruncationTable",
            "BinarySystem", "G", "init", "mutual_potential",
            "Integrator", "Run",
            "ImplausibleInputWarning", "NearCircularWarning", "InitialState",

@@ -122,10 +122,12 @@ class perturbation:
 RECORD_WIDTH = 1 + spatial.NSTATE
 
 #: Status codes (``ti_spinorbit.engine.results.Status``): the kernels set RUNNING ... NONFINITE and
-#: STEP_BUDGET; the host's accuracy check sets INACCURATE.
-RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE, INACCURATE, STEP_BUDGET = range(8)
+#: STEP_BUDGET; the host's accuracy check sets INACCURATE and, for the mutual potential's
+#: truncation error, TRUNCATED (codes are only ever appended: files hold them).
+(RUNNING, DONE, COLLISION, ESCAPE, STEP_UNDERFLOW, NONFINITE, INACCURATE, STEP_BUDGET,
+ TRUNCATED) = range(9)
 STATUS_NAMES = ("running", "done", "collision", "escape", "step underflow", "non-finite",
-                "inaccurate", "step budget")
+                "inaccurate", "step budget", "truncated")
 
 #: Counter columns of every member: accepted steps, rejected steps, right-hand-side calls.
 C_ACCEPTED, C_REJECTED, C_RHS = 0, 1, 2

@@ -15,6 +15,7 @@ import numpy as np
 
 from .. import init
 from ..engine import progress as _progress
+from ..engine.accuracy import TRUNCATION_LIMITS
 from ..engine.checkpoint import check_target, holds_checkpoint, remove
 from ..engine.options import Integrator, Run
 from ..engine.results import STATUS_NAMES, Status
@@ -475,8 +476,9 @@ def write_outputs(result, data, extra, figure, out):
 def accuracy_status(args, status, energy_drift, max_drift, what="members", stop_status=None):
     """Exit status of a run by its accuracy verdict. Members whose numbers cannot be trusted,
     "inaccurate" (drift above the limit, also when the member stopped early: an escape or a
-    collision reached with the conservation laws broken) and "non-finite" (NaN/Inf), and
-    members stopped by their step budget, are counted on stderr (even with --quiet: it
+    collision reached with the conservation laws broken), "non-finite" (NaN/Inf),
+    "truncated" (the mutual potential's truncation error above its limit) and members
+    stopped by their step budget, are counted on stderr (even with --quiet: it
     qualifies the results); returns EXIT_INACCURATE when there are any, unless
     --allow-inaccurate. Collisions, escapes and step underflows within the drift limit are
     outcomes of a start, reported per member, and do not change the exit status.
@@ -487,7 +489,8 @@ def accuracy_status(args, status, energy_drift, max_drift, what="members", stop_
     inaccurate = int(np.count_nonzero(status == INACCURATE))
     nonfinite = int(np.count_nonzero(status == NONFINITE))
     budget = int(np.count_nonzero(status == BUDGET))
-    if not inaccurate and not nonfinite and not budget:
+    truncated = int(np.count_nonzero(status == Status.TRUNCATED))
+    if not inaccurate and not nonfinite and not budget and not truncated:
         return EXIT_OK
     allowed = getattr(args, "allow_inaccurate", False)
     parts = []
@@ -508,7 +511,14 @@ def accuracy_status(args, status, energy_drift, max_drift, what="members", stop_
                      "near-contact)")
     if nonfinite:
         parts.append(f"{nonfinite} of {status.size} {what} non-finite (NaN/Inf)")
+    if truncated:
+        force, torque = TRUNCATION_LIMITS
+        parts.append(f"{truncated} of {status.size} {what} truncated: the mutual potential's "
+                     f"next orders exceed {force:g} in force or {torque:g} in torque at their "
+                     "closest approach")
+    fix = " or ".join(([] if truncated == inaccurate + nonfinite + budget + truncated
+                       else ["tighten --rtol"]) + (["raise --order"] if truncated else []))
     print(f"ti-spinorbit {args.command}: {'; '.join(parts)}; kept in the data file with their "
-          "status" + ("" if allowed else f"; tighten --rtol, or --allow-inaccurate to accept "
+          "status" + ("" if allowed else f"; {fix}, or --allow-inaccurate to accept "
                                          f"(exit status {EXIT_INACCURATE})"), file=sys.stderr)
     return EXIT_OK if allowed else EXIT_INACCURATE

@@ -8,7 +8,9 @@ that is not an integration.
   the inertial frame and the rate ϖ̇ of the osculating line of apsides it gives, for the
   apsidal coordinates of docs/physics.md §6.7;
 * :func:`diagnostics`: energies, angular momenta and orthonormality errors of recorded
-  states (``layout.DIAG_FIELDS``), for time series and the accuracy verdict.
+  states (``layout.DIAG_FIELDS``), for time series and the accuracy verdict;
+* :func:`truncation_estimates`: the size of the next orders of the mutual potential at
+  recorded states, for the truncation verdict (``engine.accuracy``).
 
 Results are built from these functions and the member table's rows; they never call an
 :class:`~ti_spinorbit.engine.ensemble.Ensemble` back. Each call initialises Taichi when it is
@@ -143,6 +145,67 @@ def _mutual_potential_n(primary, secondary, Rf, Sf, order, degrees, batch):
             out[:, 7:10].reshape(batch + (3,)) * energy)
 
 
+#: Orders beyond a run's that its truncation estimate takes (the next two: N+1 and N+2,
+#: since symmetric bodies have no odd orders).
+TRUNCATION_STEP = 2
+
+
+def truncation_estimates(groups, states, order):
+    """The relative size of the orders above ``order`` in the mutual force and in the torque
+    on the secondary, at scaled 3-D states (M, 30) (docs/physics.md §3.9).
+
+    ``groups`` lists (system, indices into ``states``) for the distinct systems
+    (``engine.members.member_groups``). At each state the force F and the secondary's torque
+    τ are evaluated at ``order`` and at ``order + TRUNCATION_STEP`` (no degree caps: what the
+    run's caps drop counts too) through the kernels (:func:`mutual_potential`), in the
+    recorded attitude and with the secondary turned by 45° about z (the larger counts); returns
+    (|ΔF|/|F|, |Δτ|/(|F| ρ_B)) per state, ρ_B the secondary's bounding radius (a torque
+    itself can vanish by symmetry; |F| ρ_B is the torque scale of the force). NaN where not
+    estimated: a non-finite state, a state at or inside contact (the series diverges there),
+    or bodies that hold no integrals beyond the run's order (``Body.order``), or an order
+    beyond the kernels' highest."""
+    states = np.asarray(states, dtype=np.float64).reshape(-1, _S.NSTATE)
+    force = np.full(len(states), np.nan)
+    torque = np.full(len(states), np.nan)
+    higher = int(order) + TRUNCATION_STEP
+    if higher > layout.multipole.MAX_ORDER:
+        return force, torque
+    for system, idx in groups:
+        primary, secondary = system.primary, system.secondary
+        if min(getattr(primary, "order", 4), getattr(secondary, "order", 4)) < higher:
+            continue
+        y = states[idx]
+        R = y[:, _S.Y_R:_S.Y_R + 3] * system.a
+        S = y[:, _S.Y_S:_S.Y_S + 9].reshape(-1, 3, 3)
+        contact = primary.bounding_radius + secondary.bounding_radius
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(y).all(axis=1) & (np.linalg.norm(R, axis=1) > contact * (1 + 1e-9))
+        if not ok.any():
+            continue
+        R, k = R[ok], int(ok.sum())
+        # the nearest rotation (a loose-tolerance run drifts off orthonormality; the estimate
+        # needs the attitude, not its drift)
+        u, _, vt = np.linalg.svd(S[ok])
+        S = u @ vt
+        # the recorded attitude, and the same turned by 45° about z: an aligned body feels no
+        # torque at any order, and its estimate would say nothing of the attitudes to come
+        R2, S2 = np.concatenate([R, R]), np.concatenate([S, np.einsum("ij,mjk->mik", _TURN, S)])
+        _, F0, _, t0 = mutual_potential(primary, secondary, R2, S2, int(order))
+        _, F1, _, t1 = mutual_potential(primary, secondary, R2, S2, higher)
+        scale = np.linalg.norm(F1, axis=1)
+        f = np.linalg.norm(F1 - F0, axis=1) / scale
+        t = np.linalg.norm(t1 - t0, axis=1) / (scale * secondary.bounding_radius)
+        sel = np.asarray(idx)[ok]
+        force[sel] = np.fmax(f[:k], f[k:])
+        torque[sel] = np.fmax(t[:k], t[k:])
+    return force, torque
+
+
+#: A turn of 45° about the primary's z axis (the orbit normal of a planar start).
+_TURN = np.array([[np.sqrt(0.5), -np.sqrt(0.5), 0.0], [np.sqrt(0.5), np.sqrt(0.5), 0.0],
+                  [0.0, 0.0, 1.0]])
+
+
 def _check_degree(body, label, degree, order):
     """Refuse a body whose integrals stop below ``degree``: its missing ones would be taken
     as zero and the order-``order`` potential silently be a lower one."""
@@ -233,4 +296,5 @@ def _blocks(n):
     return [(lo, min(lo + ORDER_N_BLOCK, n)) for lo in range(0, n, ORDER_N_BLOCK)]
 
 
-__all__ = ["mutual_potential", "true_acceleration", "apsidal_rates", "diagnostics", "has_odd"]
+__all__ = ["mutual_potential", "true_acceleration", "apsidal_rates", "diagnostics", "has_odd",
+           "truncation_estimates"]

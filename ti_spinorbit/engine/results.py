@@ -36,7 +36,9 @@ class Status(enum.IntEnum):
     codes stored in every ``status`` array and archive. ``STEP_BUDGET``: the member took more
     steps than its budget (``ti_spinorbit.engine.cost``) and was stopped there, so that a member the
     integrator cannot carry never stalls the ensemble (a code after ``INACCURATE`` because
-    archives already hold codes 0-6)."""
+    archives already hold codes 0-6). ``TRUNCATED``: a member that ran to the end within the
+    drift limit, whose mutual potential's truncation error at its closest approach exceeds
+    the truncation limit (:mod:`ti_spinorbit.engine.accuracy`)."""
 
     RUNNING = layout.RUNNING
     DONE = layout.DONE
@@ -46,6 +48,7 @@ class Status(enum.IntEnum):
     NONFINITE = layout.NONFINITE
     INACCURATE = layout.INACCURATE
     STEP_BUDGET = layout.STEP_BUDGET
+    TRUNCATED = layout.TRUNCATED
 
     @property
     def label(self) -> str:

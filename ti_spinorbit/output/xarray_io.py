@@ -24,6 +24,7 @@ Every array field of a result is there (round trip: ``tests/test_files_safety.py
   docs/physics.md §6.8) and ``element_unit`` giving each column's unit;
 * ``max_tilt``, ``max_npa_angle`` (deg), ``attitude_class`` (code) with
   ``attitude_class_name`` (text), per member (or per map cell); ``stop_status`` where kept;
+  ``truncation_force``, ``truncation_torque`` (the mutual potential's truncation estimate);
 * the convergence evidence over run lengths, dimension ``length`` (orbits):
   ``fraction_by_length`` (chaos map; parameter map also per elongation and eccentricity,
   with ``fraction_monotone``), ``overlaps_by_length`` and ``megno_overlaps_by_length``
@@ -128,8 +129,10 @@ def _states(data, coords, r, dims):
 
 
 def _attitude(data, r, dims):
-    """Pole tilt, non-principal-axis angle and attitude class (code and name) where present."""
-    for k in ("max_tilt", "max_npa_angle", "stop_status"):
+    """Pole tilt, non-principal-axis angle, attitude class (code and name), stop status and
+    truncation estimates, where present."""
+    for k in ("max_tilt", "max_npa_angle", "stop_status", "truncation_force",
+              "truncation_torque"):
         if getattr(r, k, None) is not None:
             data[k] = (dims, getattr(r, k))
     if getattr(r, "attitude_class", None) is not None:

@@ -39,6 +39,9 @@ from ..system.systems import BinarySystem, NEAR_CIRCULAR_E, NearCircularWarning
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
+#: Unit text of the torque's truncation estimate (relative to the force times ρ_B).
+TRUNCATION_TORQUE = "1 (of |F| times the secondary's bounding radius)"
+
 #: Largest ``orbits`` accepted by surface_of_section and time_series (10 million orbits is
 #: days of CPU time even for one member; the command line's --orbits has the same bound).
 MAX_ORBITS = 1e7
@@ -127,7 +130,10 @@ class SectionResult(Result, _display.Readable, kind="section"):
     θ_p is the same in both (docs/physics.md §6.7); ``stop_status`` the integrator's own
     status codes before the accuracy verdict: why each member stopped ("done" when it ran to
     the end), kept for an "inaccurate" member that collided or escaped (None in files written
-    before it existed)."""
+    before it existed); ``truncation_force`` / ``truncation_torque`` the relative size of the
+    mutual potential's next two orders at each member's closest approach, in the force and in
+    the secondary's torque (over |F| ρ_B): "truncated" above ``accuracy.TRUNCATION_LIMITS``,
+    NaN where not estimated (docs/physics.md §3.9; None in files written before it existed)."""
 
     # what a loaded file's arrays must look like (Result.SHAPES; n members, w crossings)
     SHAPES = {
@@ -137,7 +143,8 @@ class SectionResult(Result, _display.Readable, kind="section"):
                                       "stop_status")},
         **{k: (("n",), _F) for k in ("energy_drift", "angmom_drift", "initial_theta_p",
                                       "initial_thetadot_p", "megno", "lyapunov", "max_tilt",
-                                      "max_npa_angle")},
+                                      "max_npa_angle", "truncation_force",
+                                      "truncation_torque")},
         "initial_states": (("n", 30), _F),
     }
 
@@ -174,6 +181,8 @@ class SectionResult(Result, _display.Readable, kind="section"):
     indicator_space: str = unit(INDICATOR_SPACE, default="planar")
     perturbations: tuple = unit(PERTURBATIONS, default=())
     stop_status: np.ndarray = unit(STATUS, default=None)
+    truncation_force: np.ndarray = unit(RELATIVE, default=None)
+    truncation_torque: np.ndarray = unit(TRUNCATION_TORQUE, default=None)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -321,6 +330,7 @@ def section_of(members: Members, orbits, *, integrator: Integrator, run: Run,
     energy_drift, angmom_drift = accuracy.drifts(out.diag_start, out.diag_end, out.exchange)
     limit = accuracy.drift_limit(ens.rtol, orbits, max_drift)
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
+    t_force, t_torque, status = _truncation(members, cols["closest_state"], status)
     rows, tilt, npa = _state_rows_and_tilt(systems, out.events, members.y0, out.y)
     return SectionResult(
         theta_p=np.mod(np.degrees(cols["alpha"]), 180.0), thetadot_p=thetadot,
@@ -334,7 +344,22 @@ def section_of(members: Members, orbits, *, integrator: Integrator, run: Run,
         max_drift=limit, coordinates=coordinates, apsidal_rate=rate, method=ens.method,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
         indicator_space=indicator_space, perturbations=members.perturbations,
-        stop_status=np.asarray(out.status, dtype=np.int32).copy())
+        stop_status=np.asarray(out.status, dtype=np.int32).copy(),
+        truncation_force=t_force, truncation_torque=t_torque)
+
+
+def _truncation(members: Members, closest, status):
+    """(force, torque, status): the truncation estimates at each member's closest approach
+    (the closest record, or the start when nearer) and the status after the truncation
+    verdict (``engine.accuracy``, "The truncation of the mutual potential")."""
+    start = np.asarray(members.y0, dtype=np.float64)
+    r_start = np.linalg.norm(start[:, _S.Y_R:_S.Y_R + 3], axis=1)
+    with np.errstate(invalid="ignore"):
+        nearer = ~(np.linalg.norm(closest[:, _S.Y_R:_S.Y_R + 3], axis=1) <= r_start)
+    states = np.where(nearer[:, None], start, closest)
+    force, torque = evaluation.truncation_estimates(member_groups(members.systems), states,
+                                                    members.order)
+    return force, torque, accuracy.truncation_verdict(status, force, torque)
 
 
 def _ensemble(members: Members, integrator: Integrator) -> Ensemble:
@@ -353,7 +378,8 @@ def _derived_columns(par, records, names, diagnostics=False, apsidal=False, orde
     split (scaled, ``engine.evaluation.diagnostics``); with ``apsidal`` also "apsidal_rate" (ϖ̇/n, model of ``order``) and
     "true_anomaly" (rad) of the osculating orbit (docs/physics.md §6.7). All records are
     derived together: one NumPy pass, one kernel launch. Above order 4 ``multipole`` holds
-    the members' order-N rows (``Members.multipole``)."""
+    the members' order-N rows (``Members.multipole``). Also "closest_state" (N, 30): each
+    member's record nearest the primary (NaN for a member without records)."""
 
     counts = np.array([len(r) for r in records])
     width = max(int(counts.max(initial=0)), 1)
@@ -375,6 +401,11 @@ def _derived_columns(par, records, names, diagnostics=False, apsidal=False, orde
             None if multipole is None else multipole.take(member)))
         cols["true_anomaly"] = padded(_coords.true_anomaly(states[:, _S.Y_R:_S.Y_R + 3],
                                                            states[:, _S.Y_V:_S.Y_V + 3]))
+    # each member's closest recorded approach (NaN rows without records), for the truncation
+    r = np.linalg.norm(flat[:, 1 + _S.Y_R:1 + _S.Y_R + 3], axis=1)
+    first = np.lexsort((r, member))[np.cumsum(counts)[counts > 0] - counts[counts > 0]]
+    cols["closest_state"] = np.full((len(records), _S.NSTATE), np.nan)
+    cols["closest_state"][member[first]] = flat[first, 1:]
     if diagnostics:
         diag = evaluation.diagnostics(par, flat[:, 1:], member, order, multipole=multipole)
         for c, k in enumerate(("energy_orbit", "energy_primary", "energy_secondary")):
@@ -405,7 +436,11 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     "inertial" (as above) or "apsidal": then ``theta`` is the long axis from the osculating
     line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
     e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7; ``stop_status`` the
-    integrator's status codes before the accuracy verdict (why each member stopped)."""
+    integrator's status codes before the accuracy verdict (why each member stopped);
+    ``order`` the truncation order of the mutual potential, and ``truncation_force`` /
+    ``truncation_torque`` the size of its next orders at each member's closest sampled
+    approach ("truncated" above ``accuracy.TRUNCATION_LIMITS``; NaN where not estimated;
+    docs/physics.md §3.9)."""
 
     # what a loaded file's arrays must look like (Result.SHAPES; n members, s samples)
     SHAPES = {
@@ -416,7 +451,8 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
                                              "angmom_secondary", "external_angmom")},
         **{k: (("n",), _I) for k in ("status", "attitude_class", "stop_status")},
         **{k: (("n",), _F) for k in ("initial_theta_p", "initial_thetadot_p", "energy_drift",
-                                      "angmom_drift", "max_tilt", "max_npa_angle")},
+                                      "angmom_drift", "max_tilt", "max_npa_angle",
+                                      "truncation_force", "truncation_torque")},
         "initial_states": (("n", 30), _F), "states": (("n", "s", 30), _F),
     }
 
@@ -453,6 +489,9 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     stop_status: np.ndarray = unit(STATUS, default=None)
     work: np.ndarray = unit('J', default=None)
     external_angmom: np.ndarray = unit('kg m^2 s^-1', default=None)
+    order: int = unit('potential truncation order', default=4)
+    truncation_force: np.ndarray = unit(RELATIVE, default=None)
+    truncation_torque: np.ndarray = unit(TRUNCATION_TORQUE, default=None)
 
     def _state(self, name, shape):
         if self.states is None:
@@ -600,6 +639,7 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     energy_drift, angmom_drift = _sampled_drifts(cols, out, exchange)
     limit = accuracy.drift_limit(ens.rtol, orbits) if limit is None else limit
     status = accuracy.verdict(out.status, energy_drift, angmom_drift, limit)
+    t_force, t_torque, status = _truncation(table, cols["closest_state"], status)
     rows, tilt, npa = _state_rows_and_tilt(members, out.samples, y0, out.y)
     return TimeSeriesResult(
         t=cols["t"] / n[:, None], alpha=np.degrees(cols["alpha"]), theta=np.degrees(cols["theta"]),
@@ -612,7 +652,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None,
         perturbations=perturbations, stop_status=np.asarray(out.status, dtype=np.int32).copy(),
         work=None if exchange is None else exchange[..., 0] * e_unit,
-        external_angmom=None if exchange is None else exchange[..., 1:4] * l_unit)
+        external_angmom=None if exchange is None else exchange[..., 1:4] * l_unit,
+        truncation_force=t_force, truncation_torque=t_torque, order=table.order)
 
 
 def _padded_exchange(out: RunOutput, shape):
