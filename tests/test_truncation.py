@@ -198,3 +198,17 @@ def test_the_command_line_says_so_and_exits_3(tmp_path, monkeypatch, capsys):
     assert "1 of 1 members truncated: the mutual potential's next orders exceed 1e-05" in err
     assert "raise --order, or --allow-inaccurate" in err and "tighten --rtol" not in err
     assert cli.main(args + ["--order", "8", "--out", "o8.png"]) == cli.EXIT_OK
+
+
+def test_order_and_degree_caps_are_recorded(tmp_path):
+    """An order-N run keeps its order and degree caps in the result, the file and xarray."""
+    vh = tso.catalog.system("1991 VH")
+    r = tso.surface_of_section(vh, 0.0, [1.0], orbits=1, rtol=1e-9,
+                               integrator=tso.Integrator(order=6, degrees=(6, 2)))
+    assert r.order == 6 and r.degrees.tolist() == [6, 2]
+    back = tso.load(tso.save(r, tmp_path / "r.npz"))
+    assert back.order == 6 and back.degrees.tolist() == [6, 2]
+    assert tso.time_series(vh, 0.0, [1.0], orbits=0.5, samples_per_orbit=4).degrees is None
+    pytest.importorskip("xarray")
+    ds = tso.to_xarray(back)
+    assert ds["degrees"].values.tolist() == [6, 2] and ds.attrs["order"] == 6

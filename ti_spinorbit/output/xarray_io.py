@@ -135,6 +135,8 @@ def _attitude(data, r, dims):
               "truncation_torque"):
         if getattr(r, k, None) is not None:
             data[k] = (dims, getattr(r, k))
+    if getattr(r, "degrees", None) is not None:       # an order-N run's caps
+        data["degrees"] = (("body",), np.asarray(r.degrees))
     if getattr(r, "attitude_class", None) is not None:
         codes = np.asarray(r.attitude_class)
         data["attitude_class"] = (dims, codes)

@@ -39,6 +39,8 @@ from ..system.systems import BinarySystem, NEAR_CIRCULAR_E, NearCircularWarning
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
+#: Unit text of the degree caps of an order-N run (None at orders up to 4).
+DEGREES = "1 (degree caps of the primary's and the secondary's integrals)"
 #: Unit text of the torque's truncation estimate (relative to the force times ρ_B).
 TRUNCATION_TORQUE = "1 (of |F| times the secondary's bounding radius)"
 
@@ -145,7 +147,7 @@ class SectionResult(Result, _display.Readable, kind="section"):
                                       "initial_thetadot_p", "megno", "lyapunov", "max_tilt",
                                       "max_npa_angle", "truncation_force",
                                       "truncation_torque")},
-        "initial_states": (("n", 30), _F),
+        "initial_states": (("n", 30), _F), "degrees": ((2,), _I),
     }
 
     theta_p: np.ndarray = unit('deg')
@@ -183,6 +185,7 @@ class SectionResult(Result, _display.Readable, kind="section"):
     stop_status: np.ndarray = unit(STATUS, default=None)
     truncation_force: np.ndarray = unit(RELATIVE, default=None)
     truncation_torque: np.ndarray = unit(TRUNCATION_TORQUE, default=None)
+    degrees: np.ndarray = unit(DEGREES, default=None)
 
     @property
     def member_orbits_per_second(self) -> float:
@@ -345,7 +348,14 @@ def section_of(members: Members, orbits, *, integrator: Integrator, run: Run,
         initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
         indicator_space=indicator_space, perturbations=members.perturbations,
         stop_status=np.asarray(out.status, dtype=np.int32).copy(),
-        truncation_force=t_force, truncation_torque=t_torque)
+        truncation_force=t_force, truncation_torque=t_torque,
+        degrees=_degrees(members))
+
+
+def _degrees(members: Members):
+    """The degree caps (primary, secondary) of an order-N table as an int array, None at
+    orders up to 4 (the hand-written kernels take every integral to the order)."""
+    return None if members.degrees is None else np.array(members.degrees, dtype=np.int64)
 
 
 def _truncation(members: Members, closest, status):
@@ -454,6 +464,7 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
                                       "angmom_drift", "max_tilt", "max_npa_angle",
                                       "truncation_force", "truncation_torque")},
         "initial_states": (("n", 30), _F), "states": (("n", "s", 30), _F),
+        "degrees": ((2,), _I),
     }
 
     t: np.ndarray = unit('s')
@@ -492,6 +503,7 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     order: int = unit('potential truncation order', default=4)
     truncation_force: np.ndarray = unit(RELATIVE, default=None)
     truncation_torque: np.ndarray = unit(TRUNCATION_TORQUE, default=None)
+    degrees: np.ndarray = unit(DEGREES, default=None)
 
     def _state(self, name, shape):
         if self.states is None:
@@ -653,7 +665,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         perturbations=perturbations, stop_status=np.asarray(out.status, dtype=np.int32).copy(),
         work=None if exchange is None else exchange[..., 0] * e_unit,
         external_angmom=None if exchange is None else exchange[..., 1:4] * l_unit,
-        truncation_force=t_force, truncation_torque=t_torque, order=table.order)
+        truncation_force=t_force, truncation_torque=t_torque, order=table.order,
+        degrees=_degrees(table))
 
 
 def _padded_exchange(out: RunOutput, shape):
