@@ -53,20 +53,11 @@ def binary(a, e=0.0, primary=A_AXES, secondary=B_AXES, order=16):
                                  secondary=body(secondary, "B", order), a=a, e=e, name="pair")
 
 
-def rot(axis, deg):
-    c, s = np.cos(np.radians(deg)), np.sin(np.radians(deg))
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    m = np.eye(3)
-    m[i, i] = m[j, j] = c
-    m[i, j], m[j, i] = -s, s
-    return m
-
-
 def test_errors_equal_the_true_errors_against_exact_quadrature(monkeypatch):
     """One configuration (R = 1190 m along x, C = R_z(25°) R_x(10°)): the table's errors at
     orders 2-8, measured against order 16, are the errors against the exact force and torque
     to 1 % (the reference's own error, ~1e-12 in force, is negligible there)."""
-    C = rot(2, 25.0) @ rot(0, 10.0)
+    C = T._rotation(2, 25.0) @ T._rotation(0, 10.0)
     monkeypatch.setattr(T, "DIRECTIONS", (np.array([1.0, 0.0, 0.0]),))
     monkeypatch.setattr(T, "ATTITUDES", (C,))
     table = T.truncation(binary(1190.0), orders=(2, 4, 6, 8), reference=16)
