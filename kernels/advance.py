@@ -100,11 +100,19 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
     # the order-N arguments (integral rows, scratch, tables) ride along; order <= 4 never
     # reads them and compiles the code it always did
     rhs = model.rhs_perturbed_mp if perturbed else model.rhs_mp
+    rhs_at_stage = rhs       # the perturbed RHS takes the stage's time last (the Sun moves)
+    if perturbed:
+        @ti.func
+        def rhs(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
+                mpr: ti.template(), mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
+            return rhs_at_stage(p, i, y, order, odd, mpr, mps, mpi, mpf, 0.0)   # at t = 0
     stage_point, combine, put_stage = make_primitives(tableau, NK, unroll_components)
     kmat = stage_matrix_type(tableau, NK)
     error_norm = make_error_norm(tableau, unroll_components)
     ctl = controller.funcs()
     _STAGES = tableau.stages
+    # the stage nodes c_s, then 1.0 for the end point (the perturbed RHS's stage times)
+    _NODES = tuple(float(c) for c in tableau.c) + (1.0,)
     _EXPONENT = tableau.error_exponent   # 1/5 Cash-Karp (error O(h^5)), 1/8 DOP853, 1/9 Verner
 
     @ti.func
@@ -249,6 +257,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
         """Advance every running member (see the module docstring)."""
         cap = events.shape[1]
         scap = samples.shape[1]
+        _nodes = ti.Vector(_NODES, ti.f64)
         for i in range(y_nd.shape[0]):
             if status[i] == RUNNING:
                 y = _load(y_nd, i)
@@ -333,7 +342,14 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                                 pt = y_s
                             elif stage < _STAGES:
                                 pt = stage_point(y_s, K2, hs, stage)
-                        fc = rhs(par, i, pt, order, odd, mpr, mps, mpi, mpf)  # the only RHS call site
+                        fc = state(0.0)
+                        if ti.static(perturbed):   # time-dependent fields (the Sun) need
+                            # the stage's time: t (Kahan: true t = t - tc) + c_s h, and t + h
+                            # at the end point (stage == _STAGES)
+                            t_stage = (t - tc) + _nodes[stage] * hs
+                            fc = rhs_at_stage(par, i, pt, order, odd, mpr, mps, mpi, mpf, t_stage)
+                        else:
+                            fc = rhs(par, i, pt, order, odd, mpr, mps, mpi, mpf)  # the only RHS call site
                         if stage > 0 or copy == 0:    # (the shadow's start is not counted)
                             calls += 1
                         if copy == 0:

@@ -34,6 +34,19 @@ computed by the host in the chosen convention (``perturbations.YORP_CONVENTIONS`
 docs/physics.md §13.2); the kernels take its value as given.
 BYORP: an acceleration a_B of the relative motion along V/|V| (a force on the secondary
 F_B = m_s a_B; positive expands the orbit).
+
+Solar tide (docs/physics.md §13.11): the Sun at D from the barycentre (the barycentre on a
+heliocentric Kepler orbit, solved per stage), the primary at −νR and the secondary at
+(1 − ν)R, ν = m2/(m1 + m2). The relative acceleration μ_⊙ [g((1 − ν)R) − g(−νR)] with
+g(x) = (D − x)/|D − x|³ is written as the sum of Battin's cancellation-free differences
+
+    g(x) − g(0) = −(x + f(q) D) / |D − x|³,   q = x·(x − 2D)/D²,
+    f(q) = (1 + q)^{3/2} − 1 = q (3 + 3q + q²) / (1 + (1 + q)^{3/2}),
+
+whose two terms add (never subtract) at a far Sun. Each body b at d_b from the Sun's
+position (d = Sun − body) takes the quadrupole gravity-gradient torque
+τ_b = 3 μ_⊙ (J_b d) × d / |d|⁵ = 3 μ_⊙ d × (I_b d) / |d|⁵, J_b = ∫ r rᵀ dm the body's
+second moments (the body row's T^200, T^020, T^002 in its principal frame).
 """
 
 import taichi as ti
@@ -43,6 +56,10 @@ from ti_spinorbit.layout import perturbation as _L
 # The block's columns (relative to its start, the model's NPAR), the accumulators after the
 # state and the constant-Q rate floor are ti_spinorbit.layout's, shared with the host.
 Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = _L.Q_TIDE1, _L.Q_TIDE2, _L.Q_YORP1, _L.Q_YORP2, _L.Q_BYORP
+Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0 = _L.Q_SUN, _L.Q_SUN_A, _L.Q_SUN_E, _L.Q_SUN_N, _L.Q_SUN_M0
+Q_SUN_P, Q_SUN_Q, Q_SUN_NU = _L.Q_SUN_P, _L.Q_SUN_Q, _L.Q_SUN_NU
+#: Newton iterations on Kepler's equation at most (they stop at round-off, in a few)
+KEPLER_ITERATIONS = 50
 NPERT, NACC, Q_RATE_FLOOR = _L.NPERT, _L.NACC, _L.Q_RATE_FLOOR
 
 
@@ -94,3 +111,60 @@ def tide_polar_of(p: ti.template(), i, col: ti.template(), r, vr, ell, omega):
     if p[i, col] != 0.0:
         fr, ft = tide_polar(p[i, col], p[i, col + 1], p[i, col + 2], r, vr, ell, omega)
     return fr, ft
+
+
+@ti.func
+def sun_position(p: ti.template(), i, q: ti.template(), t):
+    """The Sun's position relative to the barycentre at scaled time t, inertial frame, for
+    the block starting at column ``q`` of member i's row: minus the barycentre's
+    heliocentric Kepler position, E from Kepler's equation by Newton's method from Danby's
+    start E = M + 0.85 e sign(sin M), stopped at round-off (at most KEPLER_ITERATIONS)."""
+    a = p[i, q + Q_SUN_A]
+    e = p[i, q + Q_SUN_E]
+    M = p[i, q + Q_SUN_M0] + p[i, q + Q_SUN_N] * t
+    two_pi = 6.283185307179586
+    M = M - two_pi * ti.floor(M / two_pi + 0.5)          # in [−π, π)
+    E = M + ti.select(M < 0.0, -0.85, 0.85) * e
+    for _ in range(KEPLER_ITERATIONS):
+        dE = (E - e * ti.sin(E) - M) / (1.0 - e * ti.cos(E))
+        E -= dE
+        if ti.abs(dE) <= 1e-15 * (1.0 + ti.abs(E)):   # the next would be below round-off
+            break
+    x = a * (ti.cos(E) - e)
+    y = a * ti.sqrt((1.0 - e) * (1.0 + e)) * ti.sin(E)
+    P = ti.Vector([p[i, q + Q_SUN_P], p[i, q + Q_SUN_P + 1], p[i, q + Q_SUN_P + 2]], ti.f64)
+    Q = ti.Vector([p[i, q + Q_SUN_Q], p[i, q + Q_SUN_Q + 1], p[i, q + Q_SUN_Q + 2]], ti.f64)
+    return -(x * P + y * Q)
+
+
+@ti.func
+def battin_f(q):
+    """f(q) = (1 + q)^{3/2} − 1 without cancellation at small q (Battin 1999, §8.4)."""
+    s = 1.0 + q
+    return q * (3.0 + 3.0 * q + q * q) / (1.0 + s * ti.sqrt(s))
+
+
+@ti.func
+def point_mass_difference(D, x):
+    """g(x) − g(0) for g(x) = (D − x)/|D − x|³ (a unit point mass at D seen from x),
+    cancellation-free: −(x + f(q) D)/|D − x|³, q = x·(x − 2D)/D²."""
+    q = x.dot(x - 2.0 * D) / D.dot(D)
+    d = D - x
+    r = d.norm()
+    return -(x + battin_f(q) * D) / (r * r * r)
+
+
+@ti.func
+def solar_acceleration(mu, D, R, nu):
+    """The Sun's tidal acceleration of the relative motion (secondary minus primary): μ [g(x2)
+    − g(x1)] with x2 = (1 − ν) R, x1 = −ν R, as the sum of the two Battin differences."""
+    return mu * (point_mass_difference(D, (1.0 - nu) * R) - point_mass_difference(D, -nu * R))
+
+
+@ti.func
+def gravity_gradient_torque(mu, d, J):
+    """3 μ (J d) × d / |d|⁵: the quadrupole torque of a point mass μ at d from a body whose
+    second moments are diag(J) in the same frame."""
+    d2 = d.dot(d)
+    Jd = ti.Vector([J[0] * d[0], J[1] * d[1], J[2] * d[2]], ti.f64)
+    return (3.0 * mu / (d2 * d2 * ti.sqrt(d2))) * Jd.cross(d)

@@ -236,16 +236,17 @@ def rhs_member_mp(pv, y, order: ti.template(), odd: ti.template(), mpr: ti.templ
 @ti.func
 def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template()):
     """:func:`rhs_perturbed_mp` at order <= 4."""
-    return rhs_perturbed_mp(p, i, y, order, odd, p, p, p, p)
+    return rhs_perturbed_mp(p, i, y, order, odd, p, p, p, p, 0.0)
 
 
 @ti.func
 def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
                      mpr: ti.template(), mps: ti.template(), mpi: ti.template(),
-                     mpf: ti.template()):
+                     mpf: ti.template(), t):
     """dy/dt with member i's tides, YORP and BYORP (``kernels/perturb.py``; the block starts
     at column NPAR) in the plane, and the accumulators' rates (work, external torque along
-    z; the x and y components stay zero)."""
+    z; the x and y components stay zero). ``t`` (the stage's time) is not read: the Sun's
+    tide is carried by the 3-D model only (``models.choose`` sends its members there)."""
     pv = member(p, i)
     base = rhs_member_mp(pv, y, order, odd, mpr, i, mps, mpi, mpf)
     q = NPAR

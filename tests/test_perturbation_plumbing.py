@@ -174,7 +174,7 @@ def test_libration_with_perturbations(vh):
 
 
 def test_bad_perturbations_are_named_before_any_work(vh):
-    with pytest.raises(TypeError, match=r"perturbations\[1\] must be a Tides, YORP or BYORP"):
+    with pytest.raises(TypeError, match=r"perturbations\[1\] must be a Tides, YORP, BYORP or SolarTide"):
         tso.chaos_map(vh, [0.0], [1.0], orbits=2, perturbations=[TIDE, "tides"])
     with pytest.raises(ValueError, match=r"a second tides on the secondary"):
         tso.overlap_threshold("1991 VH", elongations=[1.05], orbits=2,

@@ -8,6 +8,8 @@ L_SUN = 3.828e26
 C_LIGHT = 299792458.0
 #: Astronomical unit, m (IAU 2012 Resolution B2).
 AU = 1.495978707e11
+#: Heliocentric gravitational constant G M_⊙, m³ s⁻² (IAU 2015 nominal value).
+GM_SUN = 1.3271244e20
 
 #: Default tidal quality factor (Naidu & Margot 2015; docs/physics.md §9.4).
 DEFAULT_Q = 100.0

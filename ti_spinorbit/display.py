@@ -285,7 +285,7 @@ def summary(obj):
 
 def _perturbations(items):
     """"tides on the secondary ×1e+06, byorp ×1e+06": kind, body, strength."""
-    return ", ".join(f"{p.kind}" + ("" if p.kind == "byorp" else f" on the {p.body}")
+    return ", ".join(f"{p.kind}" + ("" if p.kind in ("byorp", "solar_tide") else f" on the {p.body}")
                      + ("" if p.strength == 1 else f" ×{p.strength:g}") for p in items)
 
 

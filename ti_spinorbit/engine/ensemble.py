@@ -214,7 +214,10 @@ class Ensemble:
         self.controller = None if controller is None or controller == DEFAULT_CONTROLLER \
             else controller
         #: the model object (``ti_spinorbit.model.models``); ``model`` is its name
-        self.equations = models.choose(model, self.par, self.y, self._planar_symmetric())
+        self.equations = models.choose(
+            model, self.par, self.y, self._planar_symmetric(),
+            spatial_forces=perturbation_rows is not None and bool(
+                np.any(np.asarray(perturbation_rows)[:, layout.perturbation.Q_SUN] != 0.0)))
         self._model_request = model      # "auto" may still turn 3-D for full-space indicators
         self.model = self.equations.name
         self.prows = None

@@ -29,7 +29,7 @@ from .. import layout as _layout
 from .._validate import _as_floats, require_count, require_finite, require_spin, show
 from ..model import coordinates as _coords, models
 from ..model.observables import derive
-from ..model.perturbations import NACC, check_perturbations, perturbation_rows
+from ..model.perturbations import NACC, check_perturbations, needs_3d, perturbation_rows
 from ..system import catalog
 from ..system.initial import InitialState, as_scaled_states
 from ..system.systems import BinarySystem, ESCAPE_DISTANCE
@@ -200,8 +200,9 @@ class Members:
             model = "3d"
         symmetric = None if block is None else \
             ~np.any(block[:, _mp.odd_mask(degrees, axis=2)] != 0.0, axis=1)
-        decided = models.choose(model, par, y0, symmetric).name
         perturbations = check_perturbations(perturbations)
+        decided = models.choose(model, par, y0, symmetric,
+                                spatial_forces=needs_3d(perturbations)).name
         return cls(members, par, y0, theta_p, thetadot_p, decided, coordinates, int(order),
                    float(escape_distance), perturbations,
                    perturbation_rows(members, perturbations), degrees, block)
@@ -225,7 +226,8 @@ class Members:
                 raise TypeError(f"{what}: give the starts as theta_p and thetadot_p, or as "
                                 "initial_states=[InitialState, ...]")
             check_size(what, system, theta_p, thetadot_p, orbits, samples_per_orbit,
-                       "3d" if full_indicators else model, perturbed, states)
+                       "3d" if full_indicators or needs_3d(perturbations) else model, perturbed,
+                       states)
             return cls.from_starts(system, theta_p, thetadot_p, coordinates=coordinates,
                                    **common)
         if theta_p is not None or thetadot_p is not None:

@@ -166,15 +166,21 @@ MODELS = {"planar": PLANAR, "3d": SPATIAL}
 REQUESTS = ("auto", *MODELS)
 
 
-def choose(model, par, y0, symmetric=None):
+def choose(model, par, y0, symmetric=None, spatial_forces=False):
     """The model object for ``model`` in {"auto", "planar", "3d"}: "auto" takes the planar
     model when every member qualifies (decided over the whole ensemble, never per chunk).
     ``symmetric`` (per member, optional) must hold too: at orders above 4 it says that no
     integral of a member's order-N row is odd in z (the parameter rows hold degrees 2..4
-    only)."""
+    only). ``spatial_forces`` (a perturbation the planar model does not carry: the Sun's
+    tide) sends "auto" to the 3-D model and refuses "planar"."""
     if model not in REQUESTS:
         raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
     if model == "3d":
+        return SPATIAL
+    if spatial_forces:
+        if model == "planar":
+            raise ValueError("model='planar' does not carry the Sun's tide (SolarTide): use "
+                             "model='auto' or '3d'")
         return SPATIAL
     ok = PLANAR.qualifies(par, y0)
     if symmetric is not None:

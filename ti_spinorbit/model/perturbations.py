@@ -40,7 +40,7 @@ from typing import Optional
 
 import numpy as np
 
-from ..constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, K2_MODELS, L_SUN
+from ..constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, GM_SUN, K2_MODELS, L_SUN
 from .._validate import HELIOCENTRIC_A_RANGE as _HELIOCENTRIC_A_RANGE
 from .._validate import (check_heliocentric, require_positive_scalar, require_range, require_real,
                          show)
@@ -54,6 +54,9 @@ Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = (_layout.Q_TIDE1, _layout.Q_TIDE2,
                                                _layout.Q_YORP1, _layout.Q_YORP2,
                                                _layout.Q_BYORP)
 NPERT, NACC, Q_RATE_FLOOR = _layout.NPERT, _layout.NACC, _layout.Q_RATE_FLOOR
+Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0, Q_SUN_P, Q_SUN_Q, Q_SUN_NU = (
+    _layout.Q_SUN, _layout.Q_SUN_A, _layout.Q_SUN_E, _layout.Q_SUN_N, _layout.Q_SUN_M0,
+    _layout.Q_SUN_P, _layout.Q_SUN_Q, _layout.Q_SUN_NU)
 BODIES = ("primary", "secondary")
 #: Allowed ranges (closed), shared with the command line's flags.
 K2_RANGE = (1e-12, 10.0)
@@ -71,6 +74,12 @@ COEFFICIENT_LIMIT = 1.0               # |f_Y|, |B|
 SPIN_CHANGE_LIMIT = 10.0              # n per orbit
 ORBIT_CHANGE_LIMIT = 0.1              # relative change of a per orbit
 TIDE_FORCE_LIMIT = 0.1                # conservative tide / mutual gravity at pericentre
+#: The Sun's tide over the mutual gravity (at apoapsis and perihelion) beyond which it is
+#: the dynamics, not a perturbation: (a/r_Hill)³ = 3 × this, a ≈ 0.3 of the Hill radius.
+SOLAR_TIDE_LIMIT = 0.01
+#: Angles of the heliocentric orbit, degrees (closed): i in [0, 180], the others [-360, 360].
+INCLINATION_RANGE = (0.0, 180.0)
+ANGLE_RANGE = (-360.0, 360.0)
 HELIOCENTRIC_A_RANGE = _HELIOCENTRIC_A_RANGE   # AU (ti_spinorbit._validate)
 #: YORP torque conventions: name -> (k, turns). The torque is T = f_Y R³ L_⊙ /
 #: (k c d² sqrt(1 − e_⊙²)) and ``turns`` the rotations of the body per mutual orbit whose
@@ -81,7 +90,7 @@ YORP_CONVENTION = "paper"
 #: The convention of a saved YORP that records none (written before the choice existed).
 YORP_LEGACY_CONVENTION = "one-turn"
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
-UNIT = "objects: Tides / YORP / BYORP with SI parameters (ti_spinorbit.model.perturbations)"
+UNIT = "objects: Tides / YORP / BYORP / SolarTide with SI parameters (ti_spinorbit.model.perturbations)"
 
 
 def solar_radiation_constant():
@@ -388,7 +397,128 @@ class BYORP:
         return ("byorp", "secondary")
 
 
-KINDS = {"tides": Tides, "yorp": YORP, "byorp": BYORP}
+@dataclass(frozen=True)
+class SolarTide:
+    """The Sun's tide: its differential (tidal) acceleration of the mutual orbit, exact (not
+    only the quadrupole) and in a cancellation-free form, and its quadrupole
+    gravity-gradient torque on both bodies (docs/physics.md §13.11). The Sun moves on the
+    barycentre's heliocentric Kepler orbit, solved in the kernels at every stage.
+
+    The orbit's angles are relative to the package's inertial frame, which for the standard
+    start (docs/physics.md §6.4) is the mutual orbit's initial frame: x to the initial
+    pericentre (the line of centres), z the initial orbit normal (a start given as an
+    ``InitialState`` uses its own inertial frame). The defaults put the Sun in the mutual
+    orbit plane (i = 0, Ω = ω = 0) with the barycentre at perihelion at t = 0 (M = 0), the
+    Sun then on the −x axis.
+
+    Parameters
+    ----------
+    heliocentric_a_au, heliocentric_e : float, optional
+        The barycentre's heliocentric semimajor axis (AU) and eccentricity; default the
+        system's ``heliocentric_orbit``.
+    inclination_deg : float
+        i, degrees in [0, 180] (default 0: the Sun in the mutual orbit plane).
+    node_deg, periapsis_deg, mean_anomaly_deg : float
+        Ω, ω and the mean anomaly at t = 0, degrees in [−360, 360] (default 0).
+    strength : float
+        Factor on the Sun's mass in the force and torques (default 1); the Sun's motion
+        keeps the real mass.
+    """
+
+    heliocentric_a_au: Optional[float] = None
+    heliocentric_e: Optional[float] = None
+    inclination_deg: float = 0.0
+    node_deg: float = 0.0
+    periapsis_deg: float = 0.0
+    mean_anomaly_deg: float = 0.0
+    strength: float = 1.0
+
+    kind = "solar_tide"
+    body = "both"
+    radius = None
+
+    def __post_init__(self):
+        _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
+        if self.heliocentric_e is not None and not self.heliocentric_e < 1.0:
+            raise ValueError(f"heliocentric_e must be in [0, 1) (got {show(self.heliocentric_e)})")
+        require_real("inclination_deg", self.inclination_deg)
+        require_range("inclination_deg", self.inclination_deg, *INCLINATION_RANGE,
+                      high_open=False)
+        for name in ("node_deg", "periapsis_deg", "mean_anomaly_deg"):
+            require_real(name, getattr(self, name))
+            require_range(name, getattr(self, name), *ANGLE_RANGE, high_open=False)
+        require_positive_scalar("strength", self.strength, *STRENGTH_RANGE)
+
+    def orbit(self, system):
+        """(a in m, e) of the barycentre's heliocentric orbit: given, else the system's."""
+        a, e = _heliocentric(system, self.heliocentric_a_au, self.heliocentric_e)
+        if not e < 1.0:
+            raise ValueError(f"SolarTide needs a bound heliocentric orbit, e < 1 (got {e!r})")
+        return a, e
+
+    def directions(self):
+        """(P, Q): unit vectors to the heliocentric perihelion and 90° ahead of it in the
+        orbit's plane, in the inertial frame (rotation Rz(Ω) Rx(i) Rz(ω))."""
+        i, O, w = (math.radians(x) for x in (self.inclination_deg, self.node_deg,
+                                             self.periapsis_deg))
+        cO, sO, ci, si, cw, sw = (math.cos(O), math.sin(O), math.cos(i), math.sin(i),
+                                  math.cos(w), math.sin(w))
+        P = np.array([cO * cw - sO * sw * ci, sO * cw + cO * sw * ci, sw * si])
+        Q = np.array([-cO * sw - sO * cw * ci, -sO * sw + cO * cw * ci, cw * si])
+        return P, Q
+
+    def mean_motion(self, system):
+        """The heliocentric mean motion sqrt(G (M_⊙ + m1 + m2) / a³), rad s⁻¹."""
+        a, _ = self.orbit(system)
+        return math.sqrt((GM_SUN + G * system.total_mass) / a ** 3)
+
+    def sun_position(self, system, t):
+        """The Sun's position relative to the barycentre at time t (s), m, inertial frame
+        (NumPy; the kernels solve the same Kepler equation)."""
+        a, e = self.orbit(system)
+        M = math.radians(self.mean_anomaly_deg) + self.mean_motion(system) * t
+        E = M
+        for _ in range(100):
+            dE = (E - e * math.sin(E) - M) / (1.0 - e * math.cos(E))
+            E -= dE
+            if abs(dE) < 1e-15:
+                break
+        P, Q = self.directions()
+        return -(a * (math.cos(E) - e) * P + a * math.sqrt(1.0 - e * e) * math.sin(E) * Q)
+
+    def tide_ratio(self, system):
+        """The Sun's tide over the mutual gravity, G M_⊙ r / d³ over G (m1 + m2) / r², at the
+        mutual apoapsis r = a (1 + e) and the heliocentric perihelion d = a_⊙ (1 − e_⊙)."""
+        a, e = self.orbit(system)
+        r = system.a * (1.0 + system.e)
+        return self.strength * GM_SUN * r ** 3 / (G * system.total_mass * (a * (1.0 - e)) ** 3)
+
+    def block(self, system):
+        M, L, T = _scales(system)
+        a, e = self.orbit(system)
+        P, Q = self.directions()
+        out = np.zeros(NPERT)
+        out[Q_SUN] = self.strength * GM_SUN / (L ** 3 / T ** 2)
+        out[Q_SUN_A] = a / L
+        out[Q_SUN_E] = e
+        out[Q_SUN_N] = self.mean_motion(system) * T
+        out[Q_SUN_M0] = math.radians(self.mean_anomaly_deg)
+        out[Q_SUN_P:Q_SUN_P + 3] = P
+        out[Q_SUN_Q:Q_SUN_Q + 3] = Q
+        out[Q_SUN_NU] = system.secondary.mass / system.total_mass
+        return out
+
+    @property
+    def in_plane(self):
+        """Whether the Sun stays in the start's orbit plane (i = 0 or 180)."""
+        return self.inclination_deg in (0.0, 180.0)
+
+    @property
+    def slot(self):
+        return ("solar_tide", "both")
+
+
+KINDS = {"tides": Tides, "yorp": YORP, "byorp": BYORP, "solar_tide": SolarTide}
 
 
 def _check_signed(name, value, limit):
@@ -401,7 +531,7 @@ def _check_heliocentric(a_au, e):
 
 
 def check_perturbations(perturbations):
-    """``perturbations`` (None, one object, or a sequence of Tides / YORP / BYORP) as a
+    """``perturbations`` (None, one object, or a sequence of Tides / YORP / BYORP / SolarTide) as a
     tuple; a TypeError names anything else, a ValueError a repeated kind on one body."""
     if perturbations is None:
         return ()
@@ -410,15 +540,16 @@ def check_perturbations(perturbations):
     try:
         items = tuple(perturbations)
     except TypeError:
-        raise TypeError("perturbations must be a list of ti_spinorbit.Tides, YORP or BYORP "
+        raise TypeError("perturbations must be a list of ti_spinorbit.Tides, YORP, BYORP or SolarTide "
                         f"objects (got {show(perturbations)})") from None
     seen = set()
     for k, p in enumerate(items):
         if not isinstance(p, tuple(KINDS.values())):
-            raise TypeError(f"perturbations[{k}] must be a Tides, YORP or BYORP object "
+            raise TypeError(f"perturbations[{k}] must be a Tides, YORP, BYORP or SolarTide object "
                             f"(got {show(p)})")
         if p.slot in seen:
-            raise ValueError(f"perturbations[{k}]: a second {p.kind} on the {p.body}; combine "
+            raise ValueError(f"perturbations[{k}]: a second {p.kind}"
+                             f"{'' if p.body == 'both' else ' on the ' + p.body}; combine "
                              "them into one (coefficients add)")
         seen.add(p.slot)
     return items
@@ -445,6 +576,9 @@ def change_per_orbit(p, system):
         return [(f"the {p.body}'s spin", spin, SPIN_CHANGE_LIMIT, "n per orbit"),
                 ("the tide's force over the mutual gravity at pericentre", force,
                  TIDE_FORCE_LIMIT, "")]
+    if isinstance(p, SolarTide):
+        return [("the Sun's tide over the mutual gravity at apoapsis and perihelion",
+                 p.tide_ratio(system), SOLAR_TIDE_LIMIT, "")]
     if isinstance(p, YORP):
         spin = 2.0 * math.pi * abs(p.torque(system)) / (_largest_moment(system, p.body) * n ** 2)
         return [(f"the {p.body}'s spin", spin, SPIN_CHANGE_LIMIT, "n per orbit")]
@@ -464,7 +598,8 @@ def _check_strength(k, p, system):
             what = f"make {quantity} {amount}" if not unit_text else \
                 f"change {quantity} by {amount}"
             raise ValueError(
-                f"perturbations[{k}] ({p.kind} on the {p.body}, strength {p.strength:g}) would "
+                f"perturbations[{k}] ({p.kind}{'' if p.body == 'both' else ' on the ' + p.body}"
+                f", strength {p.strength:g}) would "
                 f"{what} for {system.name!r}, above the limit {limit:g}: it would no longer be "
                 f"a perturbation; use a strength of at most {largest:.3g}")
 
@@ -509,3 +644,9 @@ def from_description(items):
             d.setdefault("convention", YORP_LEGACY_CONVENTION)
         out.append(KINDS[kind](**d))
     return tuple(out)
+
+
+def needs_3d(perturbations):
+    """Whether ``perturbations`` hold a force the planar model does not carry: the Sun's
+    tide (``models.choose`` then takes the 3-D model)."""
+    return any(isinstance(p, SolarTide) for p in check_perturbations(perturbations))

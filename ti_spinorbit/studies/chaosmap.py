@@ -32,7 +32,7 @@ from ..model import analytic
 from ..model.attitude import CLASS_UNIT as ATTITUDE_CLASS, CLASSES, classify_crossings
 from ..model.coordinates import check_coordinates
 from ..model.models import check_indicator_space
-from ..model.perturbations import UNIT as PERTURBATIONS, check_perturbations
+from ..model.perturbations import UNIT as PERTURBATIONS, check_perturbations, needs_3d
 from ..engine import accuracy, compiling, resources
 from ..engine import options as _options
 from ..engine import progress as _progress
@@ -285,7 +285,8 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
     resources.check_memory("chaos_map", theta_p.size * thetadot_p.size, orbits,
                            advice="use a coarser grid or fewer orbits",
                            width=resources.record_width(system, "3d" if (
-                               indicator_space == "full" or tilt is not None) else model,
+                               indicator_space == "full" or tilt is not None
+                               or needs_3d(perturbations)) else model,
                                bool(perturbations)))
     tp, td = np.meshgrid(theta_p, thetadot_p, indexing="ij")
     states = None
