@@ -58,6 +58,7 @@ from ti_spinorbit.layout import perturbation as _L
 Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = _L.Q_TIDE1, _L.Q_TIDE2, _L.Q_YORP1, _L.Q_YORP2, _L.Q_BYORP
 Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0 = _L.Q_SUN, _L.Q_SUN_A, _L.Q_SUN_E, _L.Q_SUN_N, _L.Q_SUN_M0
 Q_SUN_P, Q_SUN_Q, Q_SUN_NU = _L.Q_SUN_P, _L.Q_SUN_Q, _L.Q_SUN_NU
+Q_SUN_J1, Q_SUN_J2 = _L.Q_SUN_J1, _L.Q_SUN_J2
 #: Newton iterations on Kepler's equation at most (they stop at round-off, in a few)
 KEPLER_ITERATIONS = 50
 NPERT, NACC, Q_RATE_FLOOR = _L.NPERT, _L.NACC, _L.Q_RATE_FLOOR
@@ -168,3 +169,16 @@ def gravity_gradient_torque(mu, d, J):
     d2 = d.dot(d)
     Jd = ti.Vector([J[0] * d[0], J[1] * d[1], J[2] * d[2]], ti.f64)
     return (3.0 * mu / (d2 * d2 * ti.sqrt(d2))) * Jd.cross(d)
+
+
+@ti.func
+def gravity_gradient_torque_z(mu, d, cl, sl, c, s, dJ):
+    """The z component of :func:`gravity_gradient_torque` in the planar model: 3 μ (J_xx −
+    J_yy) d_x d_y / |d|⁵ in the frame of a body whose long axis is at θ = λ − ψ (cos λ,
+    sin λ = ``cl``, ``sl``; cos ψ, sin ψ = ``c``, ``s``), ``dJ`` = J_xx − J_yy."""
+    ct = cl * c + sl * s
+    st = sl * c - cl * s
+    dx = ct * d[0] + st * d[1]
+    dy = ct * d[1] - st * d[0]
+    d2 = d.dot(d)
+    return 3.0 * mu * dJ * dx * dy / (d2 * d2 * ti.sqrt(d2))

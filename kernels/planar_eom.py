@@ -245,8 +245,8 @@ def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.templ
                      mpf: ti.template(), t):
     """dy/dt with member i's tides, YORP and BYORP (``kernels/perturb.py``; the block starts
     at column NPAR) in the plane, and the accumulators' rates (work, external torque along
-    z; the x and y components stay zero). ``t`` (the stage's time) is not read: the Sun's
-    tide is carried by the 3-D model only (``models.choose`` sends its members there)."""
+    z; the x and y components stay zero), at the stage's time ``t`` (the Sun moves; a Sun
+    out of the orbit plane is the 3-D model's: ``models.choose`` sends its members there)."""
     pv = member(p, i)
     base = rhs_member_mp(pv, y, order, odd, mpr, i, mps, mpi, mpf)
     q = NPAR
@@ -266,6 +266,21 @@ def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.templ
     fb = p[i, q + perturb.Q_BYORP] / (pv[P_INV_M] * speed)   # m a_B / |V|
     Fr += fb * vr
     Ft += fb * vt
+    mu_sun = p[i, q + perturb.Q_SUN]
+    if mu_sun != 0.0:    # the Sun's tide in the plane (its orbit's z components are 0)
+        nu = p[i, q + perturb.Q_SUN_NU]
+        D = perturb.sun_position(p, i, q, t)
+        cl = ti.cos(y[Y_LAM])
+        sl = ti.sin(y[Y_LAM])
+        R3 = ti.Vector([r * cl, r * sl, 0.0], ti.f64)
+        a = perturb.solar_acceleration(mu_sun, D, R3, nu)
+        m = 1.0 / pv[P_INV_M]
+        Fr += m * (a[0] * cl + a[1] * sl)
+        Ft += m * (a[1] * cl - a[0] * sl)
+        N1 += perturb.gravity_gradient_torque_z(mu_sun, D + nu * R3, cl, sl, y[Y_CA], y[Y_SA],
+                                                p[i, q + perturb.Q_SUN_J1])
+        N2 += perturb.gravity_gradient_torque_z(mu_sun, D - (1.0 - nu) * R3, cl, sl, y[Y_CB],
+                                                y[Y_SB], p[i, q + perturb.Q_SUN_J2])
     dy = state_perturbed(0.0)
     for k in ti.static(range(NSTATE)):
         dy[k] = base[k]

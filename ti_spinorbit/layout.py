@@ -115,10 +115,11 @@ class perturbation:
     # the Sun's tide (SolarTide): μ_⊙ = G M_⊙ × strength (0: none), then the barycentre's
     # heliocentric Kepler orbit a, e, mean motion, mean anomaly at t = 0, the unit vectors
     # P (to perihelion) and Q (P rotated 90° in the motion's sense) in the inertial frame,
-    # and ν = m2 / (m1 + m2)
+    # ν = m2 / (m1 + m2), and each body's J_xx − J_yy = B − A (the planar model's torques)
     Q_SUN = 9
     Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0, Q_SUN_P, Q_SUN_Q, Q_SUN_NU = 10, 11, 12, 13, 14, 17, 20
-    NPERT = 21
+    Q_SUN_J1, Q_SUN_J2 = 21, 22
+    NPERT = 23
     NACC = 4           # accumulators after the state: W, then L_ext (x, y, z)
     #: Floor of the bulge's relative angular rate in the constant-Q lag (units of n).
     Q_RATE_FLOOR = 1e-3

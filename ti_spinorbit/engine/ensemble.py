@@ -28,7 +28,7 @@ from .._validate import (require_count, require_memory, require_order, require_p
 from ..kernels.controller import DEFAULT_CONTROLLER
 from ..layout import ROW_LENGTH
 from ..model import models
-from ..model.perturbations import NACC, NPERT
+from ..model.perturbations import NACC, NPERT, out_of_plane_rows
 from ..system.bodies import row_columns
 from . import checkpoint as ckpt, compiling, cost, evaluation, resources
 from . import multipole_tables as _mp
@@ -217,7 +217,7 @@ class Ensemble:
         self.equations = models.choose(
             model, self.par, self.y, self._planar_symmetric(),
             spatial_forces=perturbation_rows is not None and bool(
-                np.any(np.asarray(perturbation_rows)[:, layout.perturbation.Q_SUN] != 0.0)))
+                np.any(out_of_plane_rows(perturbation_rows))))
         self._model_request = model      # "auto" may still turn 3-D for full-space indicators
         self.model = self.equations.name
         self.prows = None

@@ -172,14 +172,15 @@ def choose(model, par, y0, symmetric=None, spatial_forces=False):
     ``symmetric`` (per member, optional) must hold too: at orders above 4 it says that no
     integral of a member's order-N row is odd in z (the parameter rows hold degrees 2..4
     only). ``spatial_forces`` (a perturbation the planar model does not carry: the Sun's
-    tide) sends "auto" to the 3-D model and refuses "planar"."""
+    tide out of the orbit plane) sends "auto" to the 3-D model and refuses "planar"."""
     if model not in REQUESTS:
         raise ValueError(f"model must be 'auto', 'planar' or '3d' (got {model!r})")
     if model == "3d":
         return SPATIAL
     if spatial_forces:
         if model == "planar":
-            raise ValueError("model='planar' does not carry the Sun's tide (SolarTide): use "
+            raise ValueError("model='planar' does not carry the Sun's tide out of the orbit "
+                             "plane (SolarTide with inclination_deg not 0 or 180): use "
                              "model='auto' or '3d'")
         return SPATIAL
     ok = PLANAR.qualifies(par, y0)

@@ -57,6 +57,7 @@ NPERT, NACC, Q_RATE_FLOOR = _layout.NPERT, _layout.NACC, _layout.Q_RATE_FLOOR
 Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0, Q_SUN_P, Q_SUN_Q, Q_SUN_NU = (
     _layout.Q_SUN, _layout.Q_SUN_A, _layout.Q_SUN_E, _layout.Q_SUN_N, _layout.Q_SUN_M0,
     _layout.Q_SUN_P, _layout.Q_SUN_Q, _layout.Q_SUN_NU)
+Q_SUN_J1, Q_SUN_J2 = _layout.Q_SUN_J1, _layout.Q_SUN_J2
 BODIES = ("primary", "secondary")
 #: Allowed ranges (closed), shared with the command line's flags.
 K2_RANGE = (1e-12, 10.0)
@@ -463,6 +464,8 @@ class SolarTide:
                                              self.periapsis_deg))
         cO, sO, ci, si, cw, sw = (math.cos(O), math.sin(O), math.cos(i), math.sin(i),
                                   math.cos(w), math.sin(w))
+        if self.inclination_deg == 180.0:          # exactly in the plane, retrograde
+            ci, si = -1.0, 0.0
         P = np.array([cO * cw - sO * sw * ci, sO * cw + cO * sw * ci, sw * si])
         Q = np.array([-cO * sw - sO * cw * ci, -sO * sw + cO * cw * ci, cw * si])
         return P, Q
@@ -506,6 +509,9 @@ class SolarTide:
         out[Q_SUN_P:Q_SUN_P + 3] = P
         out[Q_SUN_Q:Q_SUN_Q + 3] = Q
         out[Q_SUN_NU] = system.secondary.mass / system.total_mass
+        for col, body in ((Q_SUN_J1, system.primary), (Q_SUN_J2, system.secondary)):
+            A, B, _ = body.moments         # J_xx − J_yy = I_yy − I_xx (principal frame)
+            out[col] = (B - A) / (M * L ** 2)
         return out
 
     @property
@@ -648,5 +654,15 @@ def from_description(items):
 
 def needs_3d(perturbations):
     """Whether ``perturbations`` hold a force the planar model does not carry: the Sun's
-    tide (``models.choose`` then takes the 3-D model)."""
-    return any(isinstance(p, SolarTide) for p in check_perturbations(perturbations))
+    tide out of the start's orbit plane (``models.choose`` then takes the 3-D model)."""
+    return any(isinstance(p, SolarTide) and not p.in_plane
+               for p in check_perturbations(perturbations))
+
+
+def out_of_plane_rows(rows):
+    """Per member of the (N, NPERT) ``rows`` (or None): a Sun out of the orbit plane (its
+    orbit's P or Q with a z component), which the planar model cannot carry."""
+    if rows is None:
+        return None
+    rows = np.asarray(rows)
+    return (rows[:, Q_SUN] != 0.0) & ((rows[:, Q_SUN_P + 2] != 0.0) | (rows[:, Q_SUN_Q + 2] != 0.0))
