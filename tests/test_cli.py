@@ -384,6 +384,8 @@ def test_warmup_refuses_an_unknown_method(capsys):
     (["libration", "--tide", "secondary", "--strength", "1"], "libration_Didymos_tide-secondary"),
     (["section", "--tide", "secondary", "--tide-radius", "150"],
      "sos_1991VH_tide-secondary_Rtide150"),
+    (["section", "--sun", "--sun-inclination", "30", "--sun-mean-anomaly", "90"],
+     "sos_1991VH_sun_suni30_sunM90"),
 ])
 def test_default_names_carry_the_perturbations(argv, stem):
     args = cli._parser().parse_args(argv)
@@ -416,6 +418,12 @@ def test_default_names_carry_the_perturbations(argv, stem):
     (["--tide-radius", "150"], "--tide-radius needs --tide primary|secondary"),
     (["--yorp-radius", "150"], "--yorp-radius needs --yorp (the YORP coefficient)"),
     (["--byorp", "1e-3", "--byorp-radius", "0"], "--byorp-radius must lie in [0.001, 1e+10]"),
+    (["--sun-inclination", "10"], "--sun-inclination needs --sun (the Sun's tide)"),
+    (["--sun-node", "10"], "--sun-node needs --sun"),
+    (["--sun", "--sun-inclination", "181"], "--sun-inclination must lie in [0, 180] (got 181)"),
+    (["--sun", "--sun-periapsis", "400"], "--sun-periapsis must lie in [-360, 360] (got 400)"),
+    (["--system", "test", "--sun"],
+     "--sun: 'test' has no heliocentric orbit: pass --heliocentric A_AU E"),
 ])
 def test_bad_perturbation_flags_one_line_exit_2(flags, message, tmp_path, capsys):
     out = str(tmp_path / "x.png")
@@ -460,6 +468,19 @@ def test_section_with_a_tide_prints_and_saves_it(tmp_path, capsys):
     saved = tso.load(tmp_path / "s.npz")
     assert saved.perturbations == (tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6),
                                    tso.BYORP(coefficient=1e-3, strength=1e6))
+
+
+def test_section_with_the_sun_prints_and_saves_it(tmp_path, capsys):
+    out = str(tmp_path / "s.png")
+    assert cli.main(["section", "--thetadot", "0.83", "--orbits", "2", "--rtol", "1e-10",
+                     "--sun", "--heliocentric", "1.1", "0.2", "--sun-inclination", "20",
+                     "--strength", "100", "--out", out]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == ("perturbations: the Sun's tide (i 20°, node 0°, perihelion 0°, M0 0°); "
+                        "strength 100 (docs/physics.md §13; drifts are those of E - W and "
+                        "L - L_ext)")
+    assert tso.load(tmp_path / "s.npz").perturbations == (tso.SolarTide(
+        heliocentric_a_au=1.1, heliocentric_e=0.2, inclination_deg=20.0, strength=100.0),)
 
 
 def test_energy_with_a_tide_prints_the_work(tmp_path, capsys):

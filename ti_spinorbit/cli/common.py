@@ -281,7 +281,9 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("Q", "Q"), ("yorp", "yorp"), ("yorp_body", "yorp-"),
              ("yorp_convention", "yorp-"), ("byorp", "byorp"),
              ("strength", "str"), ("heliocentric", "helio"), ("tide_radius", "Rtide"),
-             ("yorp_radius", "Ryorp"), ("byorp_radius", "Rbyorp"))
+             ("yorp_radius", "Ryorp"), ("byorp_radius", "Rbyorp"), ("sun", "sun"),
+             ("sun_inclination", "suni"), ("sun_node", "sunO"), ("sun_periapsis", "sunw"),
+             ("sun_mean_anomaly", "sunM"))
 
 
 #: The whole command line's parser factory, [ti_spinorbit.cli._parser], set by the cli package
@@ -310,6 +312,8 @@ def default_stem(args, prefix, system_name):
                 text = f"{items[0]}-{items[-1]}n{len(items)}"
             else:
                 text = "-".join(items)
+        elif isinstance(value, bool):                # a switch: its tag alone
+            text = ""
         elif dest in ("rtol", "xtol"):               # tolerances always as powers: 1e-4
             mantissa, exponent = f"{value:.15e}".split("e")
             text = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"

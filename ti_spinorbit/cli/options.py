@@ -14,7 +14,7 @@ from .._validate import MAX_DENSITY, MAX_ORDER, MAX_SPIN, MIN_DENSITY  # the lib
 from ..engine.compiling import METHODS
 from ..model import models as _models  # the model requests (one registry)
 from ..model import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
-from ..model.perturbations import BYORP, YORP, Tides
+from ..model.perturbations import BYORP, YORP, SolarTide, Tides
 from ..runtime import _KNOWN_ARCHS
 from ..studies.section import MAX_ORBITS  # orbits limit shared with the library
 from ..system import catalog
@@ -110,6 +110,7 @@ ELONGATION = Bounded(float, 1.0, MAX_ELONGATION)
 DENSITY = Bounded(float, MIN_DENSITY, MAX_DENSITY)
 ECCENTRICITY = Bounded(float, 0.0, 1.0, high_open=True)
 ANGLE = Bounded(float, -360.0, 360.0)                  # deg: --theta-p, --tilt, --inclination
+SUN_INCLINATION = Bounded(float, *_pert.INCLINATION_RANGE)   # deg: --sun-inclination
 SPIN = Bounded(float, -MAX_SPIN, MAX_SPIN)             # units of n: --thetadot, --spin-xy, ...
 MAX_DRIFT = Bounded(float, 0.0, 1.0, low_open=True)
 # tides, YORP, BYORP (the bounds of ti_spinorbit.model.perturbations)
@@ -260,7 +261,8 @@ def check_max_orbits(args):
 # ---- tides, YORP and BYORP --------------------------------------------------------------
 
 def perturbation_flags(s):
-    g = s.add_argument_group("tides, YORP and BYORP in the equations (docs/physics.md §13)")
+    g = s.add_argument_group("tides, YORP, BYORP and the Sun in the equations "
+                             "(docs/physics.md §13)")
     g.add_argument("--tide", choices=("primary", "secondary"), default=None,
                    help="constant-time-lag (--time-lag) or constant-Q (--Q, default Q = "
                         "100) tide raised on this body by the other")
@@ -296,8 +298,19 @@ def perturbation_flags(s):
     # two values with two ranges: checked after parsing (check_perturbation_flags)
     g.add_argument("--heliocentric", type=float, nargs=2, default=None,
                    metavar=("A_AU", "E"),
-                   help="the binary's heliocentric orbit for --yorp/--byorp: a in AU in "
+                   help="the binary's heliocentric orbit for --yorp/--byorp/--sun: a in AU in "
                         "[0.05, 1e4] and e in [0, 1) (default: the catalogued one)")
+    g.add_argument("--sun", action="store_true",
+                   help="the Sun's tide and torques (SolarTide, docs/physics.md §13.11), the "
+                        "barycentre on the --heliocentric orbit")
+    g.add_argument("--sun-inclination", type=SUN_INCLINATION, default=None, metavar="DEG",
+                   help="inclination of the --sun orbit to the mutual orbit's initial plane, "
+                        "degrees in [0, 180] (default 0: the Sun in the plane)")
+    for dest, what in (("node", "longitude of the ascending node"),
+                       ("periapsis", "argument of perihelion"),
+                       ("mean-anomaly", "mean anomaly at t = 0")):
+        g.add_argument(f"--sun-{dest}", type=ANGLE, default=None, metavar="DEG",
+                       help=f"{what} of the --sun orbit, degrees in [-360, 360] (default 0)")
 
 
 def perturbations(args):
@@ -317,6 +330,11 @@ def perturbations(args):
     if args.byorp is not None:
         out.append(BYORP(coefficient=args.byorp, radius=args.byorp_radius,
                          strength=args.strength, **sun))
+    if args.sun:
+        angles = {f"{name}_deg": 0.0 if value is None else value for name, value in (
+            ("inclination", args.sun_inclination), ("node", args.sun_node),
+            ("periapsis", args.sun_periapsis), ("mean_anomaly", args.sun_mean_anomaly))}
+        out.append(SolarTide(strength=args.strength, **angles, **sun))
     return out
 
 
@@ -341,24 +359,30 @@ def check_perturbation_flags(args):
         raise ValueError("--yorp-body needs --yorp F_Y (the YORP coefficient, in [-1, 1])")
     if args.yorp is None and args.yorp_convention != _pert.YORP_CONVENTION:
         raise ValueError("--yorp-convention needs --yorp F_Y (the YORP coefficient, in [-1, 1])")
+    if not args.sun:
+        for dest in ("sun_inclination", "sun_node", "sun_periapsis", "sun_mean_anomaly"):
+            if getattr(args, dest) is not None:
+                raise ValueError(f"--{dest.replace('_', '-')} needs --sun (the Sun's tide)")
     if args.heliocentric is not None:
         a_au, e = args.heliocentric
         HELIOCENTRIC_A.check("--heliocentric A_AU", a_au)
         HELIOCENTRIC_E.check("--heliocentric E", e)
-        if args.yorp is None and args.byorp is None:
-            raise ValueError("--heliocentric needs --yorp or --byorp (only they use the "
-                             "heliocentric orbit)")
+        if args.yorp is None and args.byorp is None and not args.sun:
+            raise ValueError("--heliocentric needs --yorp or --byorp, or --sun (only they use "
+                             "the heliocentric orbit)")
     items = perturbations(args)
     if not items:
         if args.strength != 1.0:
-            raise ValueError("--strength needs --tide, --yorp or --byorp (it scales them)")
+            raise ValueError("--strength needs --tide, --yorp or --byorp, or --sun (it scales "
+                             "them)")
         return
     if args.command == "overlap":
         system = catalog.system(args.system, eccentricity=args.eccentricity)
     else:
         system = build_system(args)
     for p in items:
-        flag = {"tides": "--tide", "yorp": "--yorp", "byorp": "--byorp"}[p.kind]
+        flag = {"tides": "--tide", "yorp": "--yorp", "byorp": "--byorp",
+                "solar_tide": "--sun"}[p.kind]
         try:
             p.block(system)
         except ValueError as exc:
@@ -384,6 +408,9 @@ def perturbation_summary(items, system=None):
             parts.append(f"tide on the {p.body} (k2 {k2:.3g}{rubble}, {lag})")
         elif p.kind == "yorp":
             parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g}, {p.convention} torque)")
+        elif p.kind == "solar_tide":
+            parts.append(f"the Sun's tide (i {p.inclination_deg:g}°, node {p.node_deg:g}°, "
+                         f"perihelion {p.periapsis_deg:g}°, M0 {p.mean_anomaly_deg:g}°)")
         else:
             parts.append(f"BYORP (B {p.coefficient:g})")
     if not parts:
