@@ -21,6 +21,7 @@ import ti_spinorbit as tso
 from ti_spinorbit.engine import accuracy
 from ti_spinorbit.model import analytic
 from ti_spinorbit.system.bodies import Sphere
+from ti_spinorbit.constants import AU, GM_SUN
 from ti_spinorbit.system.systems import G
 
 SPO = 64                      # samples per orbit
@@ -377,10 +378,13 @@ def _spheres_oracle(system, perturbations, row0, t):
     """An independent integration (scipy DOP853, SI, inertial frame) of two spheres under
     point-mass gravity and the perturbations of docs/physics.md §13: relative motion
     dV/dt = −G M R/r³ + (F1 + F2)/m_red + a_B V/|V|, spins dω_b/dt = (−R × F_b + T_b ẑ_b)/C_b,
-    attitudes dS_b/dt = [ω_b]× S_b. Returns (R, V, S1, S2, ω1, ω2) at ``t``."""
+    attitudes dS_b/dt = [ω_b]× S_b, and (a sixth perturbation, a SolarTide) the Sun's point-mass
+    attraction of each body differenced, the Sun on its own Kepler solution (Newton's method on
+    E − e sin E = M, scipy-free). Returns (R, V, S1, S2, ω1, ω2) at ``t``."""
     from scipy.integrate import solve_ivp
 
-    tide2, tide1, yorp2, yorp1, byorp = perturbations
+    tide2, tide1, yorp2, yorp1, byorp = perturbations[:5]
+    sun = perturbations[5] if len(perturbations) > 5 else None
     m1, m2 = system.primary.mass, system.secondary.mass
     M, m_red = m1 + m2, m1 * m2 / (m1 + m2)
     C1, C2 = system.primary.moments[2], system.secondary.moments[2]
@@ -396,7 +400,22 @@ def _spheres_oracle(system, perturbations, row0, t):
     def hat(v):
         return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
-    def rhs(_, y):
+    def sun_from_barycentre(tnow):
+        a_s, e_s = sun.heliocentric_a_au * AU, sun.heliocentric_e
+        n_s = math.sqrt((GM_SUN + G * M) / a_s ** 3)
+        E = Mean = math.radians(sun.mean_anomaly_deg) + n_s * tnow
+        for _ in range(60):
+            E -= (E - e_s * math.sin(E) - Mean) / (1.0 - e_s * math.cos(E))
+        i, O, w = (math.radians(x) for x in (sun.inclination_deg, sun.node_deg,
+                                             sun.periapsis_deg))
+        rz = lambda a: np.array([[math.cos(a), -math.sin(a), 0.0],      # noqa: E731
+                                 [math.sin(a), math.cos(a), 0.0], [0.0, 0.0, 1.0]])
+        rx = np.array([[1.0, 0.0, 0.0], [0.0, math.cos(i), -math.sin(i)],
+                       [0.0, math.sin(i), math.cos(i)]])
+        return -(rz(O) @ rx @ rz(w) @ np.array([a_s * (math.cos(E) - e_s), a_s * math.sqrt(
+            1.0 - e_s ** 2) * math.sin(E), 0.0]))
+
+    def rhs(tnow, y):
         R, V, S1, S2 = y[0:3], y[3:6], y[6:15].reshape(3, 3), y[15:24].reshape(3, 3)
         w1, w2 = y[24:27], y[27:30]
         r = np.linalg.norm(R)
@@ -404,6 +423,10 @@ def _spheres_oracle(system, perturbations, row0, t):
         F1 = force(k1, lag_q / math.sqrt(w @ w + floor ** 2), R, V, w1)
         F2 = force(k2, tide2.time_lag, R, V, w2)
         dV = -G * M * R / r ** 3 + (F1 + F2) / m_red + a_B * V / np.linalg.norm(V)
+        if sun is not None:
+            D = sun_from_barycentre(tnow)
+            g = lambda x: (D - x) / np.linalg.norm(D - x) ** 3      # noqa: E731
+            dV = dV + sun.strength * GM_SUN * (g(m1 / M * R) - g(-m2 / M * R))
         return np.concatenate([V, dV, (hat(w1) @ S1).ravel(), (hat(w2) @ S2).ravel(),
                                (-np.cross(R, F1) + T1 * S1[:, 2]) / C1,
                                (-np.cross(R, F2) + T2 * S2[:, 2]) / C2])
@@ -424,7 +447,9 @@ def test_3d_kernel_matches_an_independent_integration_with_tilted_spins():
                      tso.Tides("primary", k2=1e-4, Q=3.0, strength=3e3),
                      tso.YORP("secondary", coefficient=1e-3, strength=1e6, **HELIO),
                      tso.YORP("primary", coefficient=-1e-3, strength=1e7, **HELIO),
-                     tso.BYORP(coefficient=1e-3, strength=1e3, **HELIO)]
+                     tso.BYORP(coefficient=1e-3, strength=1e3, **HELIO),
+                     tso.SolarTide(inclination_deg=35.0, node_deg=10.0, periapsis_deg=60.0,
+                                   mean_anomaly_deg=120.0, strength=100.0, **HELIO)]
     start = system.tilted_start(20.0, 2.5, pitch=30.0, roll=10.0, spin_x=0.4, inclination=10.0,
                                 primary_tilt=25.0)
     ts = tso.time_series(system, initial_states=[start], orbits=3, samples_per_orbit=8,
