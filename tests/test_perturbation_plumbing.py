@@ -16,7 +16,10 @@ from test_checkpoint import killed_run   # the same kill-and-resume harness
 #: A tide 1e6 times its real strength and YORP 1e6 times on the secondary of 1991 VH, BYORP:
 #: effects visible in a few orbits (1991 VH's heliocentric orbit is catalogued).
 TIDE = tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6)
-ALL = (TIDE, tso.YORP(coefficient=1e-3, strength=1e6), tso.BYORP(coefficient=1e-3, strength=1e6))
+#: and the Sun's tide ×300 in the orbit plane (the planar model carries it), 1e-5 of the
+#: mutual gravity
+ALL = (TIDE, tso.YORP(coefficient=1e-3, strength=1e6), tso.BYORP(coefficient=1e-3, strength=1e6),
+       tso.SolarTide(strength=300.0))
 STARTS = [0.83, 1.63]
 ARGS = dict(orbits=6, rtol=1e-10)
 
@@ -77,7 +80,8 @@ def test_saved_and_loaded_with_the_perturbations(fixture, request, tmp_path):
     back = tso.load(path)
     assert type(back) is type(result)
     assert back.perturbations == result.perturbations and back.perturbations
-    assert all(type(p) in (tso.Tides, tso.YORP, tso.BYORP) for p in back.perturbations)
+    assert all(type(p) in (tso.Tides, tso.YORP, tso.BYORP, tso.SolarTide)
+               for p in back.perturbations)
     assert_same(back, result)
     meta = tso.output.io.read_metadata(path)
     assert meta["units"]["perturbations"] == tsp.UNIT
@@ -88,7 +92,8 @@ def test_saved_and_loaded_with_the_perturbations(fixture, request, tmp_path):
 
 def test_results_show_their_perturbations(section, cmap):
     assert repr(section).splitlines()[-1] == ("  perturbations tides on the secondary ×1e+06, "
-                                              "yorp on the secondary ×1e+06, byorp ×1e+06")
+                                              "yorp on the secondary ×1e+06, byorp ×1e+06, "
+                                              "solar_tide ×300")
     assert "perturbations" in cmap._repr_html_()
     assert "perturbations" not in repr(cmap.section.__class__(**{
         **{f.name: getattr(cmap.section, f.name) for f in dataclasses.fields(cmap.section)},

@@ -371,3 +371,22 @@ def test_kernel_kepler_solution_matches_a_bracketing_root_finder(e):
         E = brentq(lambda E: E - e * math.sin(E) - M, -math.pi, math.pi, xtol=1e-16, rtol=1e-15)
         ref = -(a * (math.cos(E) - e) * P + a * math.sqrt(1 - e * e) * math.sin(E) * Q)
         assert np.abs(out[k] - ref).max() < 1e-14 * a, (k, np.abs(out[k] - ref).max() / a)
+
+
+def test_resumed_run_under_the_sun_equals_an_uninterrupted_one(tmp_path):
+    """The Sun depends on time: a run killed after two windows and resumed from its
+    checkpoint (the clock restored from it) equals the uninterrupted run bit for bit."""
+    from test_checkpoint import killed_run
+    from test_perturbation_plumbing import assert_same
+
+    vh = tso.catalog.system("1991 VH")
+    ckpt = tmp_path / "ts.ckpt"
+    kw = dict(orbits=12, rtol=1e-10, samples_per_orbit=8)
+    killed_run(tmp_path, ckpt, kill_after=2, kind="series", starts=[0.83], args=kw,
+               extra="perturbations=[tso.SolarTide(inclination_deg=20.0, strength=300.0)],")
+    kw["perturbations"] = [tso.SolarTide(inclination_deg=20.0, strength=300.0)]
+    resumed = tso.time_series(vh, 0.0, [0.83], **kw,
+                              run=tso.Run(checkpoint=ckpt, resume=True, window_orbits=4))
+    whole = tso.time_series(vh, 0.0, [0.83], **kw, run=tso.Run(window_orbits=4))
+    assert_same(resumed, whole)
+    assert np.all(whole.work[:, -1] != 0)
