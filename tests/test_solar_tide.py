@@ -390,3 +390,52 @@ def test_resumed_run_under_the_sun_equals_an_uninterrupted_one(tmp_path):
     whole = tso.time_series(vh, 0.0, [0.83], **kw, run=tso.Run(window_orbits=4))
     assert_same(resumed, whole)
     assert np.all(whole.work[:, -1] != 0)
+
+
+def test_kozai_cycles_of_a_wide_inclined_binary():
+    """Kozai–Lidov cycles of a wide binary of point masses (100 km, e = 0.05) 65° inclined to
+    a circular heliocentric orbit at 1 AU, over 2500 mutual orbits: e_max against
+    sqrt(1 − (5/3) cos² i) (0.838; 0.843 integrated) within 0.015, and the times of the two
+    maxima against the doubly averaged quadrupole equations of the test-particle limit
+    (Tremaine, Touma & Kazandjian 2009, vector form; timescale τ = n_in a⊙³ / (G M⊙)) from
+    the same start, within 2 % of the cycle (0.8 % observed: the short-period terms, of
+    order P_in/P_⊙ = 0.02)."""
+    from scipy.integrate import solve_ivp
+
+    system = tso.BinarySystem(Sphere(5000.0, 2000.0), Sphere(2000.0, 2000.0), a=1e5, e=0.05,
+                              name="wide binary")
+    inc = 65.0
+    sun = tso.SolarTide(heliocentric_a_au=1.0, heliocentric_e=0.0, inclination_deg=inc)
+    ts = tso.time_series(system, 0.0, [1.0], orbits=2500, samples_per_orbit=2,
+                         perturbations=[sun], rtol=1e-11, states=True)
+    assert accuracy.usable(ts.status).all()
+    R, V = ts.states[0][:, 0:3], ts.states[0][:, 3:6]
+    mu = G * system.total_mass
+    r, v2 = np.linalg.norm(R, axis=1), np.sum(V * V, axis=1)
+    ecc = ((v2 - mu / r)[:, None] * R - np.sum(R * V, axis=1)[:, None] * V) / mu
+    e = np.linalg.norm(ecc, axis=1)
+    assert abs(e.max() - math.sqrt(1 - 5 / 3 * math.cos(math.radians(inc)) ** 2)) < 0.015
+
+    P, Q = sun.directions()
+    nh = np.cross(P, Q)                                  # the heliocentric orbit's normal
+    a0 = 1.0 / (2.0 / r[0] - v2[0] / mu)
+    j0 = np.cross(R[0], V[0]) / math.sqrt(mu * a0)
+    inv_tau = GM_SUN / (math.sqrt(mu / a0 ** 3) * AU ** 3)
+
+    def secular(_, y):
+        j, ev = y[:3], y[3:]
+        dj = (j @ nh) * np.cross(j, nh) - 5 * (ev @ nh) * np.cross(ev, nh)
+        de = (j @ nh) * np.cross(ev, nh) + 2 * np.cross(j, ev) - 5 * (ev @ nh) * np.cross(j, nh)
+        return 0.75 * inv_tau * np.concatenate([dj, de])
+
+    t = ts.t[0]
+    sol = solve_ivp(secular, (0.0, t[-1]), np.concatenate([j0, ecc[0]]), t_eval=t,
+                    rtol=1e-10, atol=1e-12)
+    es = np.linalg.norm(sol.y[3:], axis=0)
+    half = np.searchsorted(t, 1500 * system.orbital_period)
+    peaks = [t[np.argmax(x[:half])] for x in (e, es)], \
+        [t[half + np.argmax(x[half:])] for x in (e, es)]
+    cycle = peaks[1][1] - peaks[0][1]
+    for ours, theirs in peaks:
+        assert abs(ours - theirs) < 0.02 * cycle
+    assert abs(es.max() - e.max()) < 0.01
