@@ -1,4 +1,5 @@
-"""Tides, YORP and BYORP as objects: SI parameters in, the kernels' scaled block out.
+"""Tides, YORP, BYORP and the Sun's tide as objects: SI parameters in, the kernels' scaled
+block out.
 
 ``perturbations=[...]`` on every entry point takes a list of these objects; each member of
 an ensemble gets the sum of their contributions, converted with its own system's units
@@ -20,6 +21,11 @@ Decisions:
   catalogued body is); BYORP along the relative velocity. Both need the binary's
   heliocentric orbit: catalogued where known (``catalog.heliocentric_orbit``), else give
   ``heliocentric_a_au`` and ``heliocentric_e``.
+* The Sun's tide (:class:`SolarTide`, docs/physics.md §13.11) takes the same (a, e) and the
+  orbit's angles relative to the inertial frame (the mutual orbit's initial frame for the
+  standard start), by default the Sun in the mutual orbit's plane (i = Ω = ω = 0) and the
+  barycentre at perihelion at t = 0; its ``strength`` scales the Sun's mass in the force and
+  torques, not in the Sun's motion. It is one per run (no body to choose).
 * The YORP torque has two conventions (:data:`YORP_CONVENTIONS`, docs/physics.md §13.2).
   Naidu & Margot (2015) give the YORP energy per orbit δE_YORP = 2π R³ L_⊙ f_Y /
   (3 c d² sqrt(1 − e_⊙²)) as the torque's work over TWO rotations of the secondary per
