@@ -1,6 +1,6 @@
 """Shared plumbing for the experiment scripts: arguments, output folder, saving.
 
-The study scripts keep their file names study01 … study13 (stable names for the CLI's
+The study scripts keep their file names study01 … study15 (stable names for the CLI's
 ``figures --only``, the saved files and the gallery's images) but are NAMED BY WHAT THEY
 REPRODUCE of Naidu & Margot 2015: :data:`PAPER` maps each to the paper's figure or section;
 its docstring's first line starts with that label, :func:`save` prints it, stores it in the
@@ -33,6 +33,7 @@ PAPER = {
     "study12": "§7.1–7.3",        # 2:1 capture, 2003 YT1 libration, no 2004 DC island (text)
     "study13": "§3",              # energy and angular-momentum drift per year (text)
     "study14": "§8",              # does chaos delay synchronisation? tides in the equations
+    "study15": "§2",              # beyond the paper: its order-4 model against order and shape
 }
 
 
