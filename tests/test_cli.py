@@ -257,6 +257,7 @@ def test_map_resume_after_interrupt_equals_the_full_run(tmp_path):
     (["section", "--orbits", "1e6", "--rtol", "1e-9"], "sos_1991VH_o1e6_rtol1e-9"),
     (["map", "--rtol", "1e-4", "--model", "planar"], "map_1991VH_rtol1e-4_planar"),
     (["map", "--rtol", "2.5e-11"], "map_1991VH_rtol2.5e-11"),
+    (["section", "--rtol", "1e-11"], "sos_1991VH_rtol1e-11"),     # 9.999...e-12 in binary
     # defaults given explicitly and flags that change no physics are not named
     (["section", "--orbits", "500", "--max-drift", "1e-6", "--arch", "cpu", "--quiet"],
      "sos_1991VH"),

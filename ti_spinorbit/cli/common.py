@@ -315,7 +315,8 @@ def default_stem(args, prefix, system_name):
         elif isinstance(value, bool):                # a switch: its tag alone
             text = ""
         elif dest in ("rtol", "xtol"):               # tolerances always as powers: 1e-4
-            mantissa, exponent = f"{value:.15e}".split("e")
+            # 12 digits: 1e-11 is 9.99999999999999939e-12 in binary, and 15 digits showed it
+            mantissa, exponent = f"{value:.12e}".split("e")
             text = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
         else:
             text = fmt(value) if isinstance(value, (int, float)) else str(value)
