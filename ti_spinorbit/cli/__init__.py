@@ -90,7 +90,7 @@ def _parser():
     return p
 
 
-common.PARSER[0] = _parser      # default_stem reads the flags' defaults through it
+common.PARSER = _parser         # default_stem reads the flags' defaults through it
 
 
 def check_args(args):

@@ -286,17 +286,17 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("sun_mean_anomaly", "sunM"))
 
 
-#: The whole command line's parser factory, [ti_spinorbit.cli._parser], set by the cli package
-#: when it is imported: the package assembles the subcommands, which sit above this module.
-PARSER = [None]
+#: The whole command line's parser factory (``ti_spinorbit.cli._parser``), set by the cli
+#: package when it is imported: the package assembles the subcommands, which sit above this
+#: module.
+PARSER = None
 
 
 def default_stem(args, prefix, system_name):
     """Default output name without extension: ``<prefix>_<system>`` and one ``_<tag><value>``
     per physics flag that differs from its default (:data:`NAME_TAGS`), so that runs with
     other parameters never share a file: ``sos_1991VH_ab1.06_o1000``."""
-
-    defaults = vars(PARSER[0]().parse_args([args.command]))
+    defaults = vars(PARSER().parse_args([args.command]))
     # a system's name (a system file's included) is made safe for a file name: no folder
     # separators, control characters or newlines ("sub/evil" -> "sub-evil")
     parts = [prefix, safe_part(system_name)]
@@ -521,8 +521,8 @@ def accuracy_status(args, status, energy_drift, max_drift, what="members", stop_
         parts.append(f"{truncated} of {status.size} {what} truncated: the mutual potential's "
                      f"next orders exceed {force:g} in force or {torque:g} in torque at their "
                      "closest approach")
-    fix = " or ".join(([] if truncated == inaccurate + nonfinite + budget + truncated
-                       else ["tighten --rtol"]) + (["raise --order"] if truncated else []))
+    fix = " or ".join((["tighten --rtol"] if inaccurate or nonfinite or budget else [])
+                      + (["raise --order"] if truncated else []))
     print(f"ti-spinorbit {args.command}: {'; '.join(parts)}; kept in the data file with their "
           "status" + ("" if allowed else f"; {fix}, or --allow-inaccurate to accept "
                                          f"(exit status {EXIT_INACCURATE})"), file=sys.stderr)

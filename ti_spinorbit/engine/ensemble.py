@@ -26,10 +26,8 @@ from .. import layout, runtime
 from .._validate import (require_count, require_memory, require_order, require_positive,
                          require_range, require_real)
 from ..kernels.controller import DEFAULT_CONTROLLER
-from ..layout import ROW_LENGTH
 from ..model import models
 from ..model.perturbations import NACC, NPERT, out_of_plane_rows
-from ..system.bodies import row_columns
 from . import checkpoint as ckpt, compiling, cost, evaluation, resources
 from . import multipole_tables as _mp
 
@@ -206,7 +204,7 @@ class Ensemble:
         if self.multipole is not None:
             odd = self.multipole.tables.odd
         elif odd is None:  # any non-zero odd-index integral in either body row?
-            odd = bool(np.any(self.par[:, _odd_columns(ROW_LENGTH)] != 0.0))
+            odd = evaluation.has_odd(self.par)
         self.odd = bool(odd)
         self.min_step = float(min_step)
         self.method = check_method(method)
@@ -602,10 +600,3 @@ def _multipole(order, rows, degrees, n, odd=None):
     if odd is None:
         odd = _mp.odd_present(rows, (dA, dB))
     return _mp.Multipole(_mp.tables(order, dA, dB, bool(odd)), rows)
-
-
-def _odd_columns(row_length):
-    """Parameter columns holding integrals with an odd index, for both body rows."""
-
-    cols = row_columns(lambda e: any(x % 2 for x in e))
-    return cols + [row_length + c for c in cols]

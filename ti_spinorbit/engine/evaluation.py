@@ -172,7 +172,7 @@ def truncation_estimates(groups, states, order):
         return force, torque
     for system, idx in groups:
         primary, secondary = system.primary, system.secondary
-        if min(getattr(primary, "order", 4), getattr(secondary, "order", 4)) < higher:
+        if min(_mp.degrees_provided(primary), _mp.degrees_provided(secondary)) < higher:
             continue
         y = states[idx]
         R = y[:, _S.Y_R:_S.Y_R + 3] * system.a

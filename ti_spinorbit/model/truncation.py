@@ -119,7 +119,7 @@ class TruncationTable:
 
 
 def _integrals(body, order, label):
-    body_order = getattr(body, "order", 4)
+    body_order = body.order
     if body_order < order:
         raise ValueError(f"truncation: the {label} ({body.name!r}) holds integrals up to order "
                          f"{body_order}, and the reference order {order} needs them up to "
@@ -163,7 +163,7 @@ def truncation(system, orders=DEFAULT_ORDERS, separation=None, *, reference=None
     if separation <= contact:
         raise ValueError(f"separation must exceed the sum of the bounding radii ({contact:.6g} m), "
                          f"where the series converges (got {separation:.6g} m)")
-    available = min(getattr(primary, "order", 4), getattr(secondary, "order", 4),
+    available = min(primary.order, secondary.order,
                     multipole.MAX_ORDER)
     if reference is None:
         reference = min(int(orders[-1]) + REFERENCE_MARGIN, available)
