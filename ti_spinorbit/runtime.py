@@ -21,14 +21,38 @@ Decisions (docs/design.md, "Kernel design"):
 * Taichi 1.7's front end formats a source-position string for every AST node it visits,
   cached kernel or not; ``_taichi_frontend`` memoises it (a third of the warm start).
 * ``TI_SKIP_VERSION_CHECK=ON`` is set before Taichi is imported (no network in CI).
-* In the ``ti-spinorbit`` command only, ``ENABLE_TAICHI_HEADER_PRINT=0`` is set too: ``import
-  taichi`` prints a "[Taichi] version ..." line on stdout, and the command's stdout is its
-  own (``--quiet`` prints nothing). Library users still see the banner. Both are defaults
-  (``setdefault``): a value already in the environment wins. This module is imported before
-  anything in the package imports taichi (``ti_spinorbit/__init__.py``).
+* **Quiet console, library and command alike** (docs/design.md "Console"): Taichi prints
+  nothing unless asked. Three sources, three remedies:
+
+  - the "[Taichi] version ..." banner that ``import taichi`` prints on stdout:
+    ``ENABLE_TAICHI_HEADER_PRINT=0`` is set when this module is imported, with the package
+    and so before anything in it imports taichi (the kernels and :func:`init` import taichi
+    on first use; a process that imported taichi itself first has seen its banner already);
+  - the "[Taichi] Starting on arch=..." line: a plain ``print`` in ``ti.init`` (not the
+    logger), so :func:`init` runs ``ti.init`` with stdout redirected (after ``import
+    taichi``: Taichi decides at import whether stdout is "a graphical shell") and passes
+    ``log_level=WARN``; what ti.init printed is replayed on stderr if it fails;
+  - the "[shell.py:_shell_pop_print@23] Graphical python shell detected" line in Jupyter,
+    IDLE or any process whose ``sys.stdout`` is not ``sys.__stdout__``: an *info* log line
+    that ``taichi.lang.shell`` emits at import (Taichi then wraps printing so that ``print``
+    inside kernels reaches the notebook; that behaviour is kept). Taichi's log level before
+    ``ti.init`` can only be set by ``TI_LOG_LEVEL``, read at import, so ``TI_LOG_LEVEL=warn``
+    is set with the banner's variable. :func:`init` removes both once Taichi is imported
+    (child processes do not inherit them, and ``ti.init`` would otherwise warn that its
+    ``log_level`` argument overrides ``TI_LOG_LEVEL``).
+
+  All are defaults: a value already in the environment wins (``ENABLE_TAICHI_HEADER_PRINT``
+  or ``TI_LOG_LEVEL`` set by the user are left alone, and a user's ``TI_LOG_LEVEL`` is then
+  Taichi's log level: ``log_level`` is not passed). **Opt in** to Taichi's messages with
+  ``TI_SPINORBIT_VERBOSE=1`` in the environment (banner, start line and info logs, library
+  and command), or ``init(verbose=True)`` (the start line and info logs; the banner too if
+  Taichi is not imported yet). Tests use the variable to see whether Taichi started
+  (tests/test_robustness_accuracy.py).
 """
 
 import atexit
+import contextlib
+import io
 import os
 import shutil
 import sys
@@ -39,27 +63,39 @@ import platformdirs
 from . import _taichi_frontend
 
 
-def _is_command_line():
-    """True when this process is the ti-spinorbit command: the console script, or
-    ``python -m ti_spinorbit`` (while runpy imports the package, sys.argv[0] is "-m" and the
-    module name is in sys.orig_argv)."""
-    argv0 = sys.argv[0] if sys.argv else ""
-    if os.path.splitext(os.path.basename(argv0))[0] in ("ti-spinorbit", "ti-spinorbit-script"):
-        return True
-    if argv0 != "-m":
-        return False
-    orig = getattr(sys, "orig_argv", [])
-    for k, token in enumerate(orig[1:], 1):
-        if token == "-m":
-            return orig[k + 1:k + 2] == ["ti_spinorbit"]
-        if token.startswith("-m"):
-            return token[2:] == "ti_spinorbit"
-    return False
+#: Environment variable: a true value (1, true, yes, on) lets Taichi print its banner, its
+#: "Starting on arch" line and its info logs.
+VERBOSE_ENV = "TI_SPINORBIT_VERBOSE"
+#: The environment variables this module set for the import of Taichi (removed later).
+_QUIET_ENV = {"ENABLE_TAICHI_HEADER_PRINT": "0", "TI_LOG_LEVEL": "warn"}
+
+
+def verbose_requested():
+    """True when ``TI_SPINORBIT_VERBOSE`` asks for Taichi's own messages."""
+    return os.environ.get(VERBOSE_ENV, "").strip().lower() in ("1", "true", "yes", "on")
+
+
+def _quiet_import_of_taichi():
+    """Set the variables that silence ``import taichi`` unless the user set them, asked for
+    Taichi's messages, or Taichi is already imported; remember which ones were set here."""
+    set_here = {}
+    if not verbose_requested() and "taichi" not in sys.modules:
+        for key, value in _QUIET_ENV.items():
+            if key not in os.environ:
+                os.environ[key] = set_here[key] = value
+    return set_here
+
+
+def _unset_quiet_env(*keys):
+    """Remove variables set by :func:`_quiet_import_of_taichi` (if nobody changed them)."""
+    for key in keys:
+        value = _SET_HERE.pop(key, None)
+        if value is not None and os.environ.get(key) == value:
+            del os.environ[key]
 
 
 os.environ.setdefault("TI_SKIP_VERSION_CHECK", "ON")
-if _is_command_line():
-    os.environ.setdefault("ENABLE_TAICHI_HEADER_PRINT", "0")
+_SET_HERE = _quiet_import_of_taichi()
 
 _STATE = {"arch": None}
 ARCH_ENV = "TI_SPINORBIT_ARCH"
@@ -70,7 +106,8 @@ CACHE_ENV = "TI_OFFLINE_CACHE_FILE_PATH"
 _KNOWN_ARCHS = ("cpu", "x64", "arm64", "cuda", "vulkan", "metal", "opengl", "gpu")
 
 
-def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None):
+def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None,
+         verbose=None):
     """Initialise Taichi for ti_spinorbit (idempotent).
 
     Parameters
@@ -87,6 +124,10 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         in memory instead, with a one-line notice on stderr.
     cpu_max_num_threads : int, optional
         Threads for the CPU backend (default: all cores).
+    verbose : bool, optional
+        True shows Taichi's own "[Taichi] Starting on arch=..." line and info logs (and its
+        banner if Taichi is not imported yet); default: ``TI_SPINORBIT_VERBOSE`` in the
+        environment, else quiet. Taichi's warnings and errors are shown either way.
 
     Returns the arch name in use. Calling again with the same arch is a no-op; calling with
     a different arch re-initialises Taichi, which invalidates existing ensembles.
@@ -96,8 +137,15 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
         label = "arch" if arch is not None else f"the environment variable {ARCH_ENV}"
         raise ValueError(f"{label} must be one of {', '.join(_KNOWN_ARCHS)} (got {name!r})")
     name = name.lower()
+    verbose = verbose_requested() if verbose is None else bool(verbose)
+    if verbose and "taichi" not in sys.modules:
+        _unset_quiet_env("ENABLE_TAICHI_HEADER_PRINT", "TI_LOG_LEVEL")   # the banner too
 
     import taichi as ti      # Taichi: imported on first use, the package import stays quiet
+
+    # Taichi has read both at import: not inherited by child processes, and ti.init would
+    # warn that its log_level argument overrides TI_LOG_LEVEL
+    _unset_quiet_env("ENABLE_TAICHI_HEADER_PRINT", "TI_LOG_LEVEL")
 
     if _STATE["arch"] == name:
         return name
@@ -105,8 +153,10 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
     ti_arch = {"cpu": ti.cpu, "x64": ti.x64, "arm64": ti.arm64, "cuda": ti.cuda,
                "vulkan": ti.vulkan, "metal": ti.metal, "opengl": ti.opengl, "gpu": ti.gpu}[name]
     kwargs = dict(arch=ti_arch, default_fp=ti.f64, default_ip=ti.i32, offline_cache=offline_cache,
-                  fast_math=False, debug=debug, log_level=ti.WARN, enable_fallback=False,
-                  unrolling_limit=0, cfg_optimization=False, opt_level=0)
+                  fast_math=False, debug=debug, log_level=ti.INFO if verbose else ti.WARN,
+                  enable_fallback=False, unrolling_limit=0, cfg_optimization=False, opt_level=0)
+    if os.environ.get("TI_LOG_LEVEL"):
+        del kwargs["log_level"]          # the user's own Taichi log level (set before import)
     if cpu_max_num_threads:
         kwargs["cpu_max_num_threads"] = int(cpu_max_num_threads)
     if name in ("cpu", "x64", "arm64"):
@@ -140,10 +190,15 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
     if kwargs.get("offline_cache_file_path") and \
             kwargs["offline_cache_file_path"] == _STATE.get("temporary_cache"):
         saved = os.environ.pop(CACHE_ENV, None)   # unwritable; Taichi would warn about it
+    printed = io.StringIO()
     try:
-        ti.init(**kwargs)
+        # ti.init prints "[Taichi] Starting on arch=..." with a plain print: hidden unless
+        # verbose (Taichi's warnings go through its logger, to the process's stderr)
+        with contextlib.nullcontext() if verbose else contextlib.redirect_stdout(printed):
+            ti.init(**kwargs)
     except Exception as exc:  # Taichi raises a bare RuntimeError with little context
         _STATE["arch"] = None
+        sys.stderr.write(printed.getvalue())
         raise RuntimeError(f"Taichi could not start on arch {name!r}: {exc}") from exc
     finally:
         if saved is not None:

@@ -3,9 +3,7 @@ output checks and paths (claimed for the run, never overwritten unless --overwri
 Matplotlib backend, Taichi start-up, the system a command runs on (catalogued or a --system
 file), default file names, progress, checkpoints, writing results and the accuracy verdict."""
 
-import contextlib
 import dataclasses
-import io
 import os
 import re
 import sys
@@ -122,16 +120,9 @@ def check_figure_outputs(args):
 # ---- Taichi -----------------------------------------------------------------------------
 
 def init_taichi(args):
-    """Start Taichi on --arch; with --quiet, Taichi's own "Starting on arch" line is hidden."""
-
-    if not args.quiet:
-        return init(arch=args.arch)
-    # Taichi decides at import whether stdout is "a graphical shell" (sys.stdout is not
-    # sys.__stdout__) and then logs a line and wraps printing: import it before redirecting
-    import taichi  # noqa: F401  (its banner is off in the command, see runtime.py)
-
-    with contextlib.redirect_stdout(io.StringIO()):
-        return init(arch=args.arch)
+    """Start Taichi on --arch. Taichi's banner and "Starting on arch" line are hidden by the
+    runtime, --quiet or not (TI_SPINORBIT_VERBOSE=1 shows them; ti_spinorbit/runtime.py)."""
+    return init(arch=args.arch)
 
 
 # ---- the system a command runs on -------------------------------------------------------
