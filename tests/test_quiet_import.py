@@ -6,8 +6,13 @@ the host reads its method names from.
 
 Each check runs in a fresh interpreter (``sys.executable``, this environment passed through so
 PYTHONPATH keeps working): the test session itself has long since imported Taichi. The
-variable that silences Taichi's banner is removed, so the banner would show if Taichi were
-imported."""
+variables that silence Taichi (or ask for its messages) are removed from that environment, so
+what the package does is what is checked.
+
+Taichi's own messages are hidden everywhere, library and command (ti_spinorbit/runtime.py):
+the banner at ``import taichi``, the "Starting on arch" line of ``ti.init`` and the "Graphical
+python shell detected" info line of a Jupyter-like process. ``TI_SPINORBIT_VERBOSE=1`` shows
+them, which is also the proof that these checks can fail."""
 
 import os
 import subprocess
@@ -22,9 +27,21 @@ LOADED = ("import sys; print(sorted(m for m in sys.modules if m.split('.')[0] ==
           f"or m.startswith('ti_spinorbit.kernels') and m not in {PURE!r}))")
 
 
-def run_python(code):
-    env = dict(os.environ)
-    env.pop("ENABLE_TAICHI_HEADER_PRINT", None)
+#: Environment variables that decide what Taichi prints (the user's, or the package's opt-in).
+TAICHI_CONSOLE_ENV = ("ENABLE_TAICHI_HEADER_PRINT", "TI_LOG_LEVEL", "TI_SPINORBIT_VERBOSE")
+#: A tiny computation: Taichi imported, initialised, kernels compiled (or loaded) and run.
+COMPUTE = ("import ti_spinorbit as tso; s = tso.catalog.system('1991 VH'); "
+           "r = tso.surface_of_section(s, 0.0, [0.83], orbits=1); "
+           "assert r.count[0] >= 1")
+#: What Jupyter, IDLE and other graphical shells do: their own sys.stdout (Taichi's test for
+#: "a graphical shell" is ``sys.stdout is not sys.__stdout__``, made at its import).
+WRAPPED_STDOUT = ("import io, sys; sys.stdout = io.TextIOWrapper(sys.__stdout__.buffer, "
+                  "write_through=True); ")
+
+
+def run_python(code, **env_vars):
+    env = {k: v for k, v in os.environ.items() if k not in TAICHI_CONSOLE_ENV}
+    env.update(env_vars)
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           env=env, timeout=300)
 
@@ -50,10 +67,48 @@ def test_no_taichi_until_the_first_computation(code):
     assert "[Taichi]" not in done.stderr
 
 
-def test_the_first_computation_brings_taichi_in():
+def test_the_first_computation_brings_taichi_in_silently():
     """The other side of the lazy import (so the checks above can fail): initialising the
-    runtime imports Taichi, banner and all."""
+    runtime imports Taichi, and Taichi prints nothing, neither its banner nor its start line."""
     done = run_python(f"import ti_spinorbit as tso; tso.init(); {LOADED}")
     assert done.returncode == 0, done.stderr
     assert "'taichi'" in done.stdout
-    assert "[Taichi] version" in done.stdout + done.stderr
+    assert "[Taichi]" not in done.stdout + done.stderr
+    assert done.stdout.count("\n") == 1 and done.stderr == ""     # the module list only
+
+
+@pytest.mark.parametrize("shell", ["terminal", "graphical"])
+def test_a_computation_prints_nothing(shell):
+    """A computation (import, init, compile or load, run) writes nothing: no banner, no
+    "Starting on arch", and in a Jupyter-like process (its own sys.stdout) no
+    "[shell.py:_shell_pop_print@23] Graphical python shell detected" log line."""
+    done = run_python((WRAPPED_STDOUT if shell == "graphical" else "") + COMPUTE)
+    assert done.returncode == 0, done.stderr
+    assert (done.stdout, done.stderr) == ("", "")
+
+
+def test_verbose_shows_what_taichi_prints():
+    """TI_SPINORBIT_VERBOSE=1 is the opt-in: banner, start line and the graphical-shell line
+    (the same process as above, so that test would see them if they were not hidden)."""
+    done = run_python(WRAPPED_STDOUT + COMPUTE, TI_SPINORBIT_VERBOSE="1")
+    assert done.returncode == 0, done.stderr
+    out = done.stdout + done.stderr
+    assert "[Taichi] version" in out and "[Taichi] Starting on arch=" in out
+    assert "Graphical python shell detected" in out
+
+
+def test_init_verbose_and_the_users_own_settings_win():
+    """init(verbose=True) shows the start line (and the banner: Taichi is not imported yet);
+    a user's ENABLE_TAICHI_HEADER_PRINT=1 shows the banner only; the package's variables do
+    not leak into the environment of child processes once Taichi is in."""
+    done = run_python("import ti_spinorbit as tso; tso.init(verbose=True)")
+    assert done.returncode == 0, done.stderr
+    assert "[Taichi] version" in done.stdout and "[Taichi] Starting on arch=" in done.stdout
+    done = run_python("import ti_spinorbit as tso; tso.init()", ENABLE_TAICHI_HEADER_PRINT="1")
+    assert done.returncode == 0, done.stderr
+    assert "[Taichi] version" in done.stdout and "Starting on arch" not in done.stdout
+    done = run_python("import os, ti_spinorbit as tso; tso.init(); "
+                      "print([k for k in os.environ if k in ('ENABLE_TAICHI_HEADER_PRINT', "
+                      "'TI_LOG_LEVEL')])")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "[]\n"
