@@ -5,6 +5,7 @@ bar can be drawn; compile time announced once and kept out of elapsed time, ETA 
 The bar is tested with a fake clock and an in-memory stream; the compile step is stood in for
 (``compiling._launch``), never compiled cold."""
 
+import contextlib
 import io
 import math
 import sys
@@ -118,6 +119,49 @@ def test_terminal_bar_waits_for_its_delay():
     bar(0.9)
     assert "map:  90%|" in stream.getvalue()
     bar.close()
+
+
+def test_a_short_run_with_announcements_draws_no_bar_and_ends_every_line():
+    """The CLI's case (delay 2 s): compile announcements, then a sub-second run. tqdm redraws
+    every existing bar at each write, its delay or not, and then never ends that line (the
+    next print ran on: ``ETA 00:001991 VH: ...``): here no bar is drawn at all."""
+    bar, clock, stream = make(tty=True, delay=progress.DELAY_S)
+    with bar:
+        bar.compiling("compiling kernels for the planar model (first use only, about 1 s)")
+        clock.now += 1.4
+        bar.compiled(1.4)
+        for k in range(1, 5):
+            clock.now += 0.2
+            bar(k / 4)
+    assert stream.getvalue() == (
+        "map: compiling kernels for the planar model (first use only, about 1 s)\n"
+        "map: kernels ready after 1.4 s (not counted in elapsed time, ETA or rates)\n")
+    assert "%" not in stream.getvalue() and "\r" not in stream.getvalue()
+
+
+@pytest.mark.parametrize("fail", [False, True])
+def test_a_long_run_shows_the_bar_and_ends_its_line(fail):
+    """Past the delay the bar shows (announcements before it are plain lines, those during
+    it are written above it), and closing ends the bar's line, also when the run fails."""
+    bar, clock, stream = make(tty=True, delay=progress.DELAY_S)
+    with pytest.raises(RuntimeError) if fail else contextlib.nullcontext():
+        with bar:
+            bar.compiling("compiling kernels for the planar model (first use only, about 1 s)")
+            for k in range(1, 11):
+                clock.now += 1.0
+                bar(k / 10)
+                if k == 5:
+                    bar.compiling("compiling kernels for the 3-D model (first use only)")
+                if fail and k == 7:
+                    raise RuntimeError("a failing run")
+    text = stream.getvalue()
+    assert text.startswith("map: compiling kernels for the planar model (first use only, "
+                           "about 1 s)\n")
+    assert "map:  20%|" in text and "map:  10%|" not in text   # shown once 2 s had passed
+    assert "\nmap: compiling kernels for the 3-D model (first use only)\n" in text \
+        or "\rmap: compiling kernels for the 3-D model (first use only)\n" in text
+    assert ("map:  70%|" if fail else "map: 100%|") in text.rsplit("\r", 1)[-1]
+    assert text.endswith("\n")                   # the next print starts on its own line
 
 
 @pytest.mark.parametrize("tty", [True, False])
@@ -343,3 +387,35 @@ def test_warmup_compiles_each_variant_and_says_how(cold):
 def test_warmup_refuses_unknown_variants(kwargs, message):
     with pytest.raises(ValueError, match=message):
         tso.warmup(**kwargs)
+
+
+def test_the_command_in_a_terminal_draws_no_bar_for_a_short_run(tmp_path):
+    """End to end in a pseudo-terminal (stderr a tty, so the bar would be drawn): a short
+    section run prints its compile notices and summary, each on its own line, and no bar."""
+    import os
+    import pty
+    import subprocess
+
+    master, slave = pty.openpty()
+    env = {**os.environ, "MPLBACKEND": "Agg", "COLUMNS": "100"}
+    p = subprocess.Popen([sys.executable, "-m", "ti_spinorbit", "section", "--orbits", "2",
+                          "--thetadot", "0.83", "--out", "s.png"], cwd=tmp_path, env=env,
+                         stdin=slave, stdout=slave, stderr=slave)
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            chunk = os.read(master, 65536)
+        except OSError:            # the child closed the terminal
+            break
+        if not chunk:
+            break
+        chunks.append(chunk)
+    os.close(master)
+    assert p.wait(timeout=600) == 0
+    text = b"".join(chunks).decode(errors="replace")
+    assert "1991 VH: mass ratio" in text and "wrote s.png" in text
+    assert "%|" not in text and "ETA" not in text, text          # no bar for a short run
+    assert all(line.startswith(("1991 VH:", "  thetadot", "wrote", "section:"))
+               or "Warning" in line or line.startswith("  ") for line in text.splitlines()
+               if line.strip()), text

@@ -5,7 +5,7 @@ Every long-running entry point (``surface_of_section``, ``time_series``, ``chaos
 takes ``progress``:
 
 * ``None`` (default): **on in a terminal or in Jupyter, for runs longer than** ``DELAY_S``
-  **(2 s)**: the bar appears only once the run has lasted that long (tqdm's ``delay=``), so
+  **(2 s)**: the bar appears only once the run has lasted that long (the bar is made then), so
   quick calls stay silent. Anywhere else (a log file, CI, a pipe, pytest's capture) nothing
   is written: a library call in a script does not fill its log.
 * ``False``: off, nothing written (compile announcements included).
@@ -36,6 +36,11 @@ Decisions:
   with the same elapsed/ETA arithmetic (:func:`eta_seconds`).
 * The ETA in plain lines assumes the rate so far continues, elapsed · (1 − f)/f; the bar's
   is tqdm's (smoothed rate of recent updates). Members finish at different times: a guide.
+* The bar (``tty``) is made only once the run has lasted ``delay`` (the first update after
+  it): a tqdm bar that exists is redrawn by every ``tqdm.write``, its own ``delay=`` or not,
+  and one drawn that way is not ended by ``tqdm.close`` (which believes it was never shown),
+  so the next line printed ran on after the bar (``ETA 00:001991 VH: ...``). A bar that is
+  shown is always closed with a line end (``leave=True``), also when the run fails.
 * The clock is injectable (``clock=``) for tests.
 """
 
@@ -123,7 +128,7 @@ class Progress:
     tty : bool, optional
         Force bar (True) or plain-line (False) mode; default: :func:`interactive`.
     delay : float
-        Seconds before the bar (tqdm's ``delay``) or the first plain line appears: a run
+        Seconds before the bar or the first plain line appears: a run
         shorter than that shows no progress at all.
     bar : bool
         False: no bar and no lines, only the compile announcements (CLI ``--no-progress``).
@@ -150,9 +155,7 @@ class Progress:
         self._next_plain = 1
         self._plain_finished = False
         self._announced = False
-        self._bar = None
-        if self.enabled and self.show_bar and self.tty:
-            self._bar = self._make_bar()
+        self._bar = None        # the tqdm bar: made once the run has lasted ``delay``
 
     @property
     def stream(self):
@@ -165,13 +168,29 @@ class Progress:
             from tqdm.auto import tqdm
         else:
             from tqdm.std import tqdm
-        bar = tqdm(total=1.0, desc=self.label, file=self.stream, delay=self.delay,
+        # made only once the run has lasted ``delay`` (tqdm's own delay would not do: a tqdm
+        # bar that exists is drawn by every ``tqdm.write``, our compile announcements, and
+        # ``close`` then thinks it was never shown and leaves its line unended). A tiny delay
+        # keeps tqdm from drawing in its constructor, before it has our clock.
+        bar = tqdm(total=1.0, desc=self.label, file=self.stream, delay=1e-9,
                    bar_format=BAR_FORMAT, leave=True, dynamic_ncols=self._stream is None,
                    ncols=None if self._stream is None else 80)
-        # tqdm reads its clock from this attribute; the shift below moves its start
+        # tqdm reads its clock from this attribute; elapsed time counts from our start
         bar._time = self._clock
         bar.start_t = bar.last_print_t = self.start
         return bar
+
+    def _update_bar(self):
+        """Move the bar to ``self.fraction``; the first time, draw it whatever tqdm's minimum
+        interval says, and mark it drawn as tqdm's update does (so ``close`` ends its line)."""
+        first = self._bar is None
+        if first:
+            self._bar = self._make_bar()
+        bar = self._bar
+        bar.update(self.fraction - bar.n)
+        if self.fraction >= 1.0 or (first and bar.last_print_t < bar.start_t + bar.delay):
+            bar.refresh()
+            bar.last_print_n, bar.last_print_t = bar.n, self._clock()
 
     def elapsed(self):
         """Seconds since the start, compile time excluded."""
@@ -185,15 +204,13 @@ class Progress:
         self.fraction = min(max(fraction, 0.0), 1.0)
         if not self.show_bar:
             return
-        if self._bar is not None:
-            self._bar.update(self.fraction - self._bar.n)
-            if self.fraction >= 1.0:
-                self._bar.refresh()
+        # nothing before ``delay``: a short run stays quiet, bar or plain lines
+        if self._bar is None and self.elapsed() < self.delay:
             return
-        # plain lines: one each time the fraction crosses the next step, one at 100 %; none
-        # before ``delay`` (a short run in a log stays quiet)
-        if self.elapsed() < self.delay:
+        if self.tty:
+            self._update_bar()
             return
+        # plain lines: one each time the fraction crosses the next step, one at 100 %
         if self.fraction >= 1.0:
             if self._plain_finished:
                 return
@@ -237,12 +254,12 @@ class Progress:
         return _Child(self)
 
     def close(self):
-        """End the bar (further updates are ignored)."""
+        """End the bar and its line (further updates are ignored)."""
         if self.closed:
             return
         self.closed = True
         if self._bar is not None:
-            self._bar.close()
+            self._bar.close()      # leave=True: the bar's last state and a line end
 
     def __enter__(self):
         return self
