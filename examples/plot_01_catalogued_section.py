@@ -35,6 +35,6 @@ print("largest energy drift:", float(np.max(sos.energy_drift)))
 # %%
 # The paper's convention: θ_p on [0°, 180°), θ̇_p in units of the mean motion n.
 
-fig, ax = plt.subplots(figsize=(6, 4.5))
+fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
 sos.plot(ax=ax)
 plt.show()

@@ -34,6 +34,6 @@ sos = tso.surface_of_section(didymos, theta_p=0.0, thetadot_p=np.linspace(0.6, 1
                              orbits=100, rtol=1e-10)
 print("statuses:", sos.status_counts)
 
-fig, ax = plt.subplots(figsize=(6, 4.5))
+fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
 sos.plot(ax=ax)
 plt.show()

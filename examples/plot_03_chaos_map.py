@@ -25,6 +25,6 @@ print(f"chaotic fraction: {cmap.chaotic_fraction:.2f}")
 print("MEGNO <Y> from", round(float(np.nanmin(cmap.megno)), 2),
       "to", round(float(np.nanmax(cmap.megno)), 1))
 
-fig, ax = plt.subplots(figsize=(6, 4.5))
+fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
 cmap.plot(ax=ax)
 plt.show()

@@ -27,6 +27,6 @@ print("first overlap at a/b =", scan.first_overlap)
 print("analytic estimate   a/b =", round(float(scan.elongation_ro), 3))
 print(scan.message)
 
-fig, ax = plt.subplots(figsize=(6, 4.5))
+fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
 scan.plot(ax=ax)
 plt.show()

@@ -42,7 +42,7 @@ print("system:", system["name"], "| a =", system["a_m"], "m | e =", system["e"],
 # The section arrays are (members, crossings), padded with NaN after each member's last
 # crossing.
 
-fig, ax = plt.subplots(figsize=(6, 4.5))
+fig, ax = plt.subplots(figsize=(6, 4.5), layout="constrained")
 for k in range(theta_p.shape[0]):
     ax.plot(theta_p[k], thetadot_p[k], ".", ms=3, label=f"member {k}")
 ax.set_xlabel(r"$\theta_p$ (deg)")

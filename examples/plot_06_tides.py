@@ -29,7 +29,7 @@ print(ts)
 # libration that the tide then damps.
 
 t_orbits = ts.t / vh.orbital_period
-fig, ax = plt.subplots(figsize=(6.4, 4))
+fig, ax = plt.subplots(figsize=(6.4, 4), layout="constrained")
 for k, start in enumerate(ts.initial_thetadot_p):
     mean = np.convolve(ts.thetadot[k], np.ones(8) / 8, mode="valid")
     ax.plot(t_orbits[k, :len(mean)], mean, label=rf"$\dot\theta_p/n$ = {start:g}")
@@ -46,7 +46,7 @@ plt.show()
 # accuracy verdict holds (``energy_drift``).
 
 e0 = ts.energy[:, :1]
-fig, ax = plt.subplots(figsize=(6.4, 4))
+fig, ax = plt.subplots(figsize=(6.4, 4), layout="constrained")
 for k, start in enumerate(ts.initial_thetadot_p):
     ax.semilogy(t_orbits[k], np.abs(ts.work[k]) / np.abs(e0[k]), label=rf"$|W|/|E_0|$, {start:g}")
     ax.semilogy(t_orbits[k], np.abs(ts.energy[k] - ts.work[k] - e0[k]) / np.abs(e0[k]) + 1e-16,

@@ -59,7 +59,7 @@ def largest(body, odd_only=False):
     return out
 
 
-fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
+fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
 near = np.abs(body_frame[:, 1]) < 40.0                   # vertices near the plane y = 0
 left.plot(body_frame[near, 0], body_frame[near, 2], ".", ms=3, color="0.3",
           label="shape model, |y| < 40 m")
@@ -78,7 +78,6 @@ right.semilogy(degrees[even], np.array(largest(twin))[even], "^:",
 right.set(xlabel="degree l + m + n", ylabel="max |T^lmn| / (M ρ^n)",
           title="integrals by degree")
 right.legend(fontsize=8)
-fig.tight_layout()
 plt.show()
 
 # %%

@@ -2,7 +2,21 @@
 
 Surface of section: θ_p (deg) in [0°, 180°) horizontally, θ̇_p/n vertically, one colour per
 trajectory unless a classification gives the paper's colours (resonant red, chaotic blue,
-quasi-periodic green)."""
+quasi-periodic green).
+
+How the figures are laid out, wherever they are shown or saved:
+
+* The backend is the session's. Nothing here calls ``matplotlib.use``: in a notebook the
+  figures are the inline ones, a headless script gets Matplotlib's own fallback (Agg), and
+  only the command line picks a file backend for itself.
+* A figure this module creates (no ``ax=`` given) uses Matplotlib's constrained layout
+  (``layout="constrained"``), which makes room for legends outside the axes, colourbars and
+  titles, so a plain ``fig.savefig(path)`` keeps every legend and no panel overlaps another.
+  With your own ``ax``, create its figure with ``layout="constrained"`` as well (or ask for a
+  legend inside the axes, ``legend_loc="inside"``, where a function offers it).
+* Legend texts and legend titles are ``LEGEND_FONTSIZE`` (8 pt), titles ``TITLE_FONTSIZE``
+  (9 pt); a title longer than its axes is broken after a comma.
+"""
 
 import os
 import re
@@ -18,6 +32,14 @@ from ..engine import results as _results
 
 # matplotlib is imported inside the functions that draw (pyplot through _pyplot), so that
 # importing the package, or this module, does not load it.
+
+#: Font size (pt) of legend texts and legend titles.
+LEGEND_FONTSIZE = 8
+#: Font size (pt) of axes titles (the run's identity, broken into lines to fit the axes).
+TITLE_FONTSIZE = 9
+#: Where ``legend_loc`` may put a legend: right of the axes, below them (under the x label),
+#: or inside them (Matplotlib's ``loc="best"``).
+LEGEND_PLACES = ("right", "below", "inside")
 
 #: MEGNO colour scale of maps: 2 (regular) to 8 and beyond (chaotic; the colourbar says ≥ 8).
 MEGNO_COLOR_RANGE = (0.0, 8.0)
@@ -69,42 +91,121 @@ def run_title(systems, orbits=None, rtol=None, what=None):
     return f"{title}: {what}" if what else title
 
 
+def _figure(nrows=1, ncols=1, size=(6.4, 4.8), **kwargs):
+    """A new figure with its Axes, in constrained layout (room for legends outside the axes,
+    colourbars and titles: a plain ``savefig`` clips nothing)."""
+    return _pyplot().subplots(nrows, ncols, figsize=size, dpi=150, layout="constrained",
+                              **kwargs)
+
+
 def _axes(ax, size=(6.4, 4.8)):
     if ax is None:
-        _, ax = _pyplot().subplots(figsize=size, dpi=150)
+        _, ax = _figure(size=size)
     return ax
 
 
+def _text_width_points(text, fontsize):
+    """Width (pt) of ``text`` at ``fontsize`` as Matplotlib draws it (mathtext included),
+    measured with the Agg renderer whatever the session's backend."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.text import Text
+
+    _, ismath = Text(text=text)._preprocess_math(text)
+    width, _, _ = RendererAgg(1, 1, 72).get_text_width_height_descent(
+        text, FontProperties(size=fontsize), ismath=ismath)
+    return width
+
+
+def _title(ax, title, fontsize=TITLE_FONTSIZE):
+    """Set ``title`` on ``ax``, broken after a comma or colon (never inside mathtext) into
+    lines no wider than the axes as first placed, so that a long run title is never cut at
+    the figure's edge (layout engines give a title no room sideways)."""
+    if not title:
+        return
+    fig = ax.figure
+    width = fig.get_figwidth() * 72.0 * ax.get_position().width
+    pieces, piece = [], ""
+    for part in re.split(r"(?<=[,:]) ", title):
+        piece = f"{piece} {part}" if piece else part
+        if piece.count("$") % 2 == 0:            # not inside $...$
+            pieces.append(piece)
+            piece = ""
+    if piece:
+        pieces.append(piece)
+    lines, line = [], ""
+    for part in pieces:
+        longer = f"{line} {part}" if line else part
+        if line and _text_width_points(longer, fontsize) > width:
+            lines.append(line)
+            line = part
+        else:
+            line = longer
+    lines.append(line)
+    ax.set_title("\n".join(lines), fontsize=fontsize)
+
+
+def _below_offset_points():
+    """Points from the bottom of an axes to below its x tick labels and x label, from the
+    rcParams (mathtext labels are a little taller than plain text: 1.5 line heights)."""
+    from matplotlib import rcParams
+    from matplotlib.font_manager import FontProperties
+
+    def points(size):
+        return FontProperties(size=size).get_size_in_points()
+
+    ticks = (max(rcParams["xtick.major.size"], 0.0) + rcParams["xtick.major.pad"]
+             + 1.3 * points(rcParams["xtick.labelsize"]))
+    label = rcParams["axes.labelpad"] + 1.5 * points(rcParams["axes.labelsize"])
+    return ticks + label + 2.0
+
+
 def _legend_outside(ax, where="right", **kwargs):
-    """A legend outside the axes (``where`` "right" or "below"), so it never covers the
-    data."""
-    if where not in ("right", "below"):
-        raise ValueError(f"legend_loc must be 'right' or 'below' (got {where!r})")
-    place = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0)) if where == "right" else \
-        dict(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4)
-    return ax.legend(borderaxespad=0.0, **place,
-                     **{"fontsize": 6, "framealpha": 0.8, **kwargs})
+    """A legend of ``ax`` placed by ``where``: "right" (outside, top-aligned with the axes),
+    "below" (outside, under the x label, centred) or "inside" (``loc="best"``). Texts and the
+    title at ``LEGEND_FONTSIZE``. Outside legends never cover the data; in a figure with
+    constrained layout (the package's own) the layout makes room for them."""
+    if where not in LEGEND_PLACES:
+        raise ValueError(f"legend_loc must be 'right', 'below' or 'inside' (got {where!r})")
+    if where == "right":
+        place = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    elif where == "below":
+        from matplotlib.transforms import ScaledTranslation
+
+        down = ScaledTranslation(0.0, -_below_offset_points() / 72.0, ax.figure.dpi_scale_trans)
+        place = dict(loc="upper center", bbox_to_anchor=(0.5, 0.0), borderaxespad=0.0,
+                     bbox_transform=ax.transAxes + down, ncol=kwargs.pop("ncol", 4))
+    else:
+        place = dict(loc="best")
+    options = {"fontsize": LEGEND_FONTSIZE, "title_fontsize": LEGEND_FONTSIZE,
+               "framealpha": 0.8, **kwargs}
+    return ax.legend(**place, **options)
 
 
 def class_legend(ax, classes, where="right", **kwargs):
-    """A legend of the classes present (the paper's colours), outside the axes."""
+    """A legend of the classes present (the paper's colours), titled "class", placed by
+    ``where`` as :func:`_legend_outside` does (outside the axes unless "inside")."""
     from matplotlib.lines import Line2D      # matplotlib: when a figure is drawn
 
     present = [c for c in CLASS_ORDER if c in set(map(str, classes))]
     handles = [Line2D([], [], ls="", marker="o", ms=4, color=_class_color(c), label=c)
                for c in present]
-    return _legend_outside(ax, where, handles=handles, title="class", title_fontsize=6,
-                           **kwargs)
+    return _legend_outside(ax, where, handles=handles, title="class", **kwargs)
 
 
 def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legend=True,
                  classes=None, colorbar=True, legend_loc="right"):
-    """Scatter a SectionResult: θ_p (deg) against θ̇_p/n. Colours: ``classes`` (one class name
-    per member, e.g. ``classify_section(result).classification``) in the paper's colours
-    with a legend of the classes; else ``colors`` (one per member, colours or class names);
-    else one per member with a legend for up to ``MAX_LEGEND`` members and, above that, a
-    colourbar of the start θ̇_p(0)/n. Legends sit outside the axes (``legend_loc`` "right"
-    or "below"). Returns the Axes."""
+    """Scatter a SectionResult: θ_p (deg, 0-180) horizontally against θ̇_p/n (units of the
+    mean motion, in the result's coordinates) vertically, one dot per pericentre passage.
+    Colours: ``classes`` (one class name per member, e.g.
+    ``classify_section(result).classification``) in the paper's colours with a legend of the
+    classes; else ``colors`` (one per member, colours or class names); else one per member
+    with a legend for up to ``MAX_LEGEND`` members (labelled by the start θ̇_p(0)/n, and the
+    status where it is not "done") and, above that, a colourbar of the start θ̇_p(0)/n.
+    ``legend_loc`` puts the legend "right" of the axes (default), "below" them or "inside";
+    without ``ax`` the figure is 6.4 × 4.8 in, 150 dpi, in constrained layout, so an outside
+    legend is kept by a plain ``savefig``. The title is the run
+    (:func:`run_title`; ``title=""`` for none). Returns the Axes."""
     plt = _pyplot()
     ax = _axes(ax)
     n = len(result.count)
@@ -143,8 +244,7 @@ def plot_section(result, ax=None, colors=None, markersize=1.5, title=None, legen
     ax.set_ylabel(THETADOT_LABEL[getattr(result, "coordinates", "inertial")])
     if title is None:
         title = run_title(result.systems, result.orbits, result.rtol)
-    if title:
-        ax.set_title(title, fontsize=9)
+    _title(ax, title)
     if by_start is not None and colorbar:
         ax.figure.colorbar(by_start, ax=ax, pad=0.01).set_label(START_LABEL)
     elif legend and classes is not None:
@@ -176,7 +276,9 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
     (``"max_tilt"``, deg, log colours over ``TILT_COLOR_RANGE``) over θ_p (x, deg) and θ̇_p/n
     (y).
     ``overlay=True`` adds the section points of up to ``overlay_members`` evenly spaced members
-    as small black dots. Returns the Axes."""
+    as small black dots. The class legend sits right of the axes; without ``ax`` the figure
+    is 6.4 × 4.8 in in constrained layout (colourbar and legend inside the saved image). The
+    title is the run with its chaotic fraction. Returns the Axes."""
     from matplotlib.colors import ListedColormap      # matplotlib: when a figure is drawn
 
     ax = _axes(ax)
@@ -234,8 +336,7 @@ def plot_chaos_map(cmap, ax=None, quantity="megno", overlay=False, overlay_membe
             what += (f" ({cmap.n_inaccurate} inaccurate members "
                      f"{'included' if cmap.include_inaccurate else 'excluded'})")
         title = run_title(systems, cmap.orbits, cmap.rtol, what)
-    if title:
-        ax.set_title(title, fontsize=9)
+    _title(ax, title)
     return ax
 
 
@@ -243,7 +344,8 @@ def plot_parameter_map(pmap, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=
                        title=None):
     """pcolormesh of a ParameterMap's chaotic fraction over (e, a/b), with the analytic
     overlap line a/b(ω0^RO(e)) and contours of the chaotic-layer half-width ΔE/E0(ω0(a/b), e)
-    (14π form as quoted). Returns the Axes."""
+    (14π form as quoted), with the line's legend inside the axes (lower right). Without
+    ``ax`` the figure is 6.4 × 4.8 in in constrained layout. Returns the Axes."""
     ax = _axes(ax)
     x = np.clip(_edges(pmap.eccentricities), 0.0, 0.999)  # physical ranges only
     y = np.maximum(_edges(pmap.elongations), 1.0)
@@ -266,7 +368,7 @@ def plot_parameter_map(pmap, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=
     ax.set_ylim(y[0], y[-1])
     ax.set_xlabel(r"$e$")
     ax.set_ylabel(r"$a/b$")
-    ax.legend(fontsize=7, loc="lower right", framealpha=0.5)
+    ax.legend(fontsize=LEGEND_FONTSIZE, loc="lower right", framealpha=0.5)
     if title is None:
         what = f"chaotic fraction of {pmap.megno.shape[-1]} starts"
         if pmap.n_inaccurate:
@@ -274,7 +376,7 @@ def plot_parameter_map(pmap, ax=None, contours=(1e-3, 1e-2, 0.1, 1.0), colorbar=
                      f"{'included' if pmap.include_inaccurate else 'excluded'})")
         title = (f"{pmap.name}, a/b = {span(pmap.elongations)}, e = {span(pmap.eccentricities)}, "
                  f"{pmap.orbits:g} orbits, rtol {pmap.rtol:.0e}: {what}")
-    ax.set_title(title, fontsize=9)
+    _title(ax, title)
     return ax
 
 
@@ -297,8 +399,9 @@ def overlap_megno(scan):
 def plot_overlap(scan, ax=None, title=None):
     """Decision per elongation (overlap blue, separate green) with the numerical and the
     analytic thresholds, and on a second axis the largest MEGNO ⟨Y⟩ of each elongation's
-    trajectories (chaos shows there before a trajectory connects the islands). Returns the
-    Axes of the decisions."""
+    trajectories (chaos shows there before a trajectory connects the islands; the twin axes
+    is ``ax.megno_axes``). One legend for both axes, inside (centre left). Without ``ax`` the
+    figure is 6.4 × 3.6 in in constrained layout. Returns the Axes of the decisions."""
     ax = _axes(ax, (6.4, 3.6))
     ax.scatter(scan.elongations, scan.overlaps.astype(int),
                c=["tab:blue" if o else "tab:green" for o in scan.overlaps], s=25, zorder=3)
@@ -321,7 +424,7 @@ def plot_overlap(scan, ax=None, title=None):
         handles.append(line)
         labels.append(line.get_label())
         ax.megno_axes = twin           # for callers (and tests) that want the ⟨Y⟩ axis
-    ax.legend(handles, labels, fontsize=7, loc="center left")
+    ax.legend(handles, labels, fontsize=LEGEND_FONTSIZE, loc="center left")
     if title is None:
         verdict = "" if scan.lengths is None else \
             (f", converged at {scan.converged_orbits:g} orbits" if scan.converged
@@ -332,15 +435,18 @@ def plot_overlap(scan, ax=None, title=None):
                  f"e = {scan.eccentricity:.3g}, {scan.orbits:g} orbits"
                  + (f", rtol {rtol:.0e}" if rtol is not None else "")
                  + f": 1:1 / 3:2 overlap{verdict}")
-    ax.set_title(title, fontsize=9)
+    _title(ax, title)
     return ax
 
 
 def plot_time_series(ts, ax=None, quantity="thetadot", members=None, title=None):
     """One line per member against time (orbital periods of the first system): the spin rate
     θ̇/n (``quantity="thetadot"``), α (``"alpha"``, deg), θ (``"theta"``, deg) or r
-    (``"r"``, units of a). Members labelled by their start (legend right of the axes, up to
-    ``MAX_LEGEND``; a colourbar of the start beyond). Returns the Axes."""
+    (``"r"``, units of a); time in orbital periods of each member's system. Members labelled
+    by their start θ̇_p(0)/n (legend right of the axes, up to ``MAX_LEGEND``; a colourbar of
+    the start beyond). Without ``ax`` the figure is 7 × 3.6 in, 150 dpi, in constrained
+    layout, so a plain ``savefig`` keeps the legend; with your own ``ax``, give its figure
+    ``layout="constrained"`` too. Returns the Axes."""
     labels = {"thetadot": r"$\dot\theta/n$" + f" ({ts.coordinates})", "alpha": r"$\alpha$ (deg)",
               "theta": r"$\theta$ (deg)", "r": r"$r/a$"}
     if quantity not in labels:
@@ -375,40 +481,42 @@ def plot_time_series(ts, ax=None, quantity="thetadot", members=None, title=None)
         _legend_outside(ax)
     if title is None:
         title = run_title(ts.systems, ts.orbits, ts.rtol)
-    if title:
-        ax.set_title(title, fontsize=9)
+    _title(ax, title)
     return ax
 
 
 def plot_conservation(ts, member=0, title=None):
     """Two panels for one member of a TimeSeriesResult: relative drift of the total energy
     and angular momentum, and the energy exchanged between orbit and spins, against time
-    (:meth:`~ti_spinorbit.studies.section.TimeSeriesResult.conservation`). Returns the top Axes."""
-    plt = _pyplot()
+    (:meth:`~ti_spinorbit.studies.section.TimeSeriesResult.conservation`), time in initial
+    orbital periods; legends inside each panel. A new 7 × 6.5 in figure in constrained
+    layout. Returns the top Axes."""
     numbers, (t, de, dl, parts) = ts.conservation(member)
     t_orbits = t / ts.systems[member].orbital_period
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True, dpi=150)
+    fig, (top, bottom) = _figure(2, 1, size=(7, 6.5), sharex=True)
     top.plot(t_orbits, de, "k", lw=0.8, label=r"energy $\Delta E/|E_0|$")
     top.plot(t_orbits, dl, "C3", lw=0.8, label=r"angular momentum $|\Delta \mathbf{L}|/|L_0|$")
     top.set_ylabel("relative drift")
-    top.legend(fontsize=7)
+    top.legend(fontsize=LEGEND_FONTSIZE)
     if title is None:
         title = run_title([ts.systems[member]], ts.orbits, ts.rtol, "conservation")
-    top.set_title(title, fontsize=9)
+    _title(top, title)
     for name, v in parts.items():
         bottom.plot(t_orbits, v, lw=0.8, label=f"{name}" + (" spin" if name != "orbit" else ""))
     bottom.set_ylabel(r"energy exchange $\Delta E_i/|E_0|$")
     bottom.set_xlabel("time (initial orbital periods)")
-    bottom.legend(fontsize=7)
+    bottom.legend(fontsize=LEGEND_FONTSIZE)
     return top
 
 
 def plot_libration_search(result, axes=None):
     """Two panels of the centre search of a RelaxedLibration: every launch's section extent
     against the start θ̇_p(0)/n (the V whose tip is the centre), and the last window around
-    the centre. Returns the left Axes."""
+    the centre (start minus the centre, units of n); the left legend inside its panel. Without
+    ``axes`` (two Axes) a new 9.6 × 4.2 in figure in constrained layout. Returns the left
+    Axes."""
     if axes is None:
-        _, axes = _pyplot().subplots(1, 2, figsize=(9.6, 4.2), dpi=150)
+        _, axes = _figure(1, 2, size=(9.6, 4.2))
     left, right = axes
     for k, (x, extent) in enumerate(zip(result.candidates, result.extents)):
         style = dict(marker="o", ms=3, lw=0.8) if k == 0 else dict(marker=".", ms=2, lw=0.6)
@@ -417,7 +525,7 @@ def plot_libration_search(result, axes=None):
     left.axvline(result.centre_thetadot_p, color="k", lw=0.6, ls="--", label="centre")
     left.set_xlabel(START_LABEL + f" ({result.coordinates})")
     left.set_ylabel(r"section extent max $|\theta_p|$ (deg)")
-    left.legend(fontsize=7)
+    left.legend(fontsize=LEGEND_FONTSIZE)
     x, extent = result.candidates[-1], result.extents[-1]
     right.plot(x - result.centre_thetadot_p, extent, ".-", ms=3, lw=0.6)
     right.axvline(0.0, color="k", lw=0.6, ls="--")
@@ -429,17 +537,19 @@ def plot_libration_search(result, axes=None):
     return left
 
 
-def plot_libration(result, ax=None, title=None, search=None):
-    """α(t) of the trajectory at the island centre with its amplitude max |α| (dashed) and the
-    decoupled forced amplitude |ψ_A| as a band (ψ_A with ω0, and with ω0,eff dotted).
+def plot_libration(result, ax=None, title=None, search=None, legend_loc="below"):
+    """α(t) (deg) of the trajectory at the island centre against time (orbital periods), with
+    its amplitude max |α| (dashed) and the decoupled forced amplitude |ψ_A| as a band (ψ_A
+    with ω0, and with ω0,eff dotted). The legend goes below the axes (``legend_loc``: or
+    "right", "inside"), in two columns, so that it never reaches a neighbouring panel.
     Without ``ax`` (or with ``search=True``) the figure also gets the search's two panels
-    (:func:`plot_libration_search`). The trajectory is the stored ``result.series`` (computed
-    again for files written without it). Returns the Axes of α(t)."""
-    plt = _pyplot()
+    (:func:`plot_libration_search`): a new 14.4 × 4.6 in figure (6.4 × 4.6 in alone) in
+    constrained layout. The trajectory is the stored ``result.series`` (computed again for
+    files written without it). Returns the Axes of α(t)."""
     search = ax is None if search is None else search
     if ax is None:
-        fig, axes = plt.subplots(1, 3 if search else 1, figsize=(14.4 if search else 6.4, 4.2),
-                                 dpi=150, squeeze=False)
+        fig, axes = _figure(1, 3 if search else 1, size=(14.4 if search else 6.4, 4.6),
+                            squeeze=False)
         ax = axes[0, 0]
         if search:
             plot_libration_search(result, axes[0, 1:])
@@ -461,13 +571,13 @@ def plot_libration(result, ax=None, title=None, search=None):
                    label=rf"amplitude max $|\alpha|$ = {result.amplitude:.3g}°" if sign > 0 else None)
     ax.set_xlabel("time (orbital periods)")
     ax.set_ylabel(r"$\alpha$ (deg)")
-    _legend_outside(ax)
+    _legend_outside(ax, legend_loc, ncol=2)
     if title is None:
         system = [result.system] if result.system is not None else ()
         title = run_title(system, result.orbits, result.rtol,
                           rf"centre {START_LABEL} = {result.centre_thetadot_p:.6g}"
                           + ("" if result.converged else " (NOT converged)"))
-    ax.set_title(title, fontsize=9)
+    _title(ax, title)
     return ax
 
 
@@ -487,16 +597,20 @@ def raw_markup(fig):
 
 def save_figure(ax, path):
     """Write the figure of ``ax`` to ``path`` (PNG, PDF or SVG by extension; PNG without
-    one) and close it. The write is atomic (:func:`ti_spinorbit.files.atomic_write`): the
+    one) and close it. A figure with a layout engine (the package's own: constrained layout)
+    is saved as it is laid out, at its size; one without (an Axes of yours) is tightened
+    first and cropped to its contents, so an outside legend stays. The write is atomic (:func:`ti_spinorbit.files.atomic_write`): the
     image goes to a temporary file in the same folder, fsync-ed, then replaces ``path``, so a
     failed or killed write never leaves a partial figure and never harms an existing one."""
     plt = _pyplot()
     fig = ax.figure
     try:
-        fig.tight_layout()
+        laid_out = fig.get_layout_engine() is not None
+        if not laid_out:
+            fig.tight_layout()
         fmt = os.path.splitext(os.fspath(path))[1][1:].lower() or "png"
         with atomic_write(path) as fh:       # a file object: the format is given by name
-            fig.savefig(fh, format=fmt, bbox_inches="tight")   # legends outside the axes stay
+            fig.savefig(fh, format=fmt, **({} if laid_out else {"bbox_inches": "tight"}))
     finally:
         plt.close(fig)
     return path
