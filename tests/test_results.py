@@ -281,7 +281,8 @@ def test_classes_get_a_legend_of_the_classes(section):
     assert colours == [plotting.CLASS_COLORS["resonant"], plotting.CLASS_COLORS["chaotic"]]
     ax.figure.canvas.draw()
     assert legend.get_window_extent().y1 <= ax.get_window_extent().y0   # below the axes
-    with pytest.raises(ValueError, match=r"^legend_loc must be 'right' or 'below' \(got 'top'\)$"):
+    with pytest.raises(ValueError, match=r"^legend_loc must be 'right', 'below' or 'inside' "
+                                         r"\(got 'top'\)$"):
         section.plot(classes=["resonant", "chaotic"], legend_loc="top")
 
 
