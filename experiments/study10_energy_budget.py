@@ -53,7 +53,8 @@ def main():
 
     budgets, measured, separations, diverged_at, dE_series = [], [], [], [], []
     for k, (name, system) in enumerate(zip(names, systems)):
-        budget = analytic.energy_budget(system, *tso.catalog.heliocentric_orbit(name))
+        orbit = tso.catalog.heliocentric_orbit(name)
+        budget = analytic.energy_budget(system, orbit.a_au, orbit.e)
         budgets.append(budget)
         pair = sec.thetadot_p[2 * k:2 * k + 2]
         m = int(min(sec.count[2 * k:2 * k + 2]))

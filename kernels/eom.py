@@ -137,7 +137,7 @@ def rhs_perturbed(p: ti.template(), i, y, order: ti.template(), odd: ti.template
 def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.template(),
                      mpr: ti.template(), mps: ti.template(), mpi: ti.template(),
                      mpf: ti.template(), t):
-    """dy/dt with the tides, YORP, BYORP and the Sun's tide of member i's perturbation block
+    """dy/dt with the tides, YORP, BYORP and the third bodies' tides of member i's perturbation block
     (columns from NPAR, ``kernels/perturb.py``) at the scaled time ``t`` (the Sun moves), and
     the accumulators' rates: work and external torque."""
     base, om1, om2 = _rhs_and_rates(p, i, y, order, odd, mpr, mps, mpi, mpf)
@@ -153,16 +153,17 @@ def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.templ
     N2 = p[i, q + perturb.Q_YORP2] * vec3(S[0, 2], S[1, 2], S[2, 2]) - R.cross(f2)
     m = p[i, P_MRED]
     F += (m * p[i, q + perturb.Q_BYORP] / V.norm()) * V
-    mu_sun = p[i, q + perturb.Q_SUN]
-    if mu_sun != 0.0:    # the Sun's tide and its torques on both bodies (frame A)
-        nu = p[i, q + perturb.Q_SUN_NU]
-        D = mat_t_vec(get33(y, Y_S1), perturb.sun_position(p, i, q, t))
-        F += m * perturb.solar_acceleration(mu_sun, D, R, nu)
-        N1 += perturb.gravity_gradient_torque(
-            mu_sun, D + nu * R, vec3(p[i, BODY_A + 1], p[i, BODY_A + 2], p[i, BODY_A + 3]))
-        N2 += mat_vec(S, perturb.gravity_gradient_torque(
-            mu_sun, mat_t_vec(S, D - (1.0 - nu) * R),
-            vec3(p[i, BODY_B + 1], p[i, BODY_B + 2], p[i, BODY_B + 3])))
+    for c in ti.static(perturb.THIRD_BODIES):   # the Sun, a passing planet
+        mu3 = p[i, q + c + perturb.T_MU]
+        if mu3 != 0.0:    # its tide and its torques on both bodies (frame A)
+            nu = p[i, q + c + perturb.T_NU]
+            D = mat_t_vec(get33(y, Y_S1), perturb.third_body_position(p, i, q + c, t))
+            F += m * perturb.solar_acceleration(mu3, D, R, nu)
+            N1 += perturb.gravity_gradient_torque(
+                mu3, D + nu * R, vec3(p[i, BODY_A + 1], p[i, BODY_A + 2], p[i, BODY_A + 3]))
+            N2 += mat_vec(S, perturb.gravity_gradient_torque(
+                mu3, mat_t_vec(S, D - (1.0 - nu) * R),
+                vec3(p[i, BODY_B + 1], p[i, BODY_B + 2], p[i, BODY_B + 3])))
     dy = state_perturbed(0.0)
     for k in ti.static(range(NSTATE)):
         dy[k] = base[k]

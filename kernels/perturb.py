@@ -35,8 +35,10 @@ docs/physics.md §13.2); the kernels take its value as given.
 BYORP: an acceleration a_B of the relative motion along V/|V| (a force on the secondary
 F_B = m_s a_B; positive expands the orbit).
 
-Solar tide (docs/physics.md §13.11): the Sun at D from the barycentre (the barycentre on a
-heliocentric Kepler orbit, solved per stage), the primary at −νR and the secondary at
+Third bodies (docs/physics.md §13.11, §13.12): the Sun and a passing planet, one slot each
+(``THIRD_BODIES``), with the same terms. The body at D from the barycentre (on a conic
+relative to it, solved per stage: the Sun on minus the barycentre's heliocentric ellipse, a
+planet on its hyperbola), the primary at −νR and the secondary at
 (1 − ν)R, ν = m2/(m1 + m2). The relative acceleration μ_⊙ [g((1 − ν)R) − g(−νR)] with
 g(x) = (D − x)/|D − x|³ is written as the sum of Battin's cancellation-free differences
 
@@ -59,6 +61,9 @@ Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = _L.Q_TIDE1, _L.Q_TIDE2, _L.Q_YORP1
 Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0 = _L.Q_SUN, _L.Q_SUN_A, _L.Q_SUN_E, _L.Q_SUN_N, _L.Q_SUN_M0
 Q_SUN_P, Q_SUN_Q, Q_SUN_NU = _L.Q_SUN_P, _L.Q_SUN_Q, _L.Q_SUN_NU
 Q_SUN_J1, Q_SUN_J2 = _L.Q_SUN_J1, _L.Q_SUN_J2
+Q_FLYBY, THIRD_BODIES = _L.Q_FLYBY, _L.THIRD_BODIES
+T_MU, T_A, T_E, T_N, T_M0, T_P, T_Q, T_NU, T_J1, T_J2 = (_L.T_MU, _L.T_A, _L.T_E, _L.T_N, _L.T_M0,
+                                                         _L.T_P, _L.T_Q, _L.T_NU, _L.T_J1, _L.T_J2)
 #: Newton iterations on Kepler's equation at most (they stop at round-off, in a few)
 KEPLER_ITERATIONS = 50
 NPERT, NACC, Q_RATE_FLOOR = _L.NPERT, _L.NACC, _L.Q_RATE_FLOOR
@@ -115,27 +120,49 @@ def tide_polar_of(p: ti.template(), i, col: ti.template(), r, vr, ell, omega):
 
 
 @ti.func
+def third_body_position(p: ti.template(), i, c: ti.template(), t):
+    """A third body's position relative to the barycentre at scaled time t, inertial frame:
+    x P + y Q on the conic of the slot at absolute column ``c`` of member i's row. Kepler's
+    equation by Newton's method to round-off (at most KEPLER_ITERATIONS) from Danby's starts:
+    E = M + 0.85 e sign(M) for an ellipse (e < 1, M reduced to [−π, π)), H = sign(M)
+    ln(2|M|/e + 1.8) for a hyperbola (M = e sinh H − H)."""
+    a = p[i, c + T_A]
+    e = p[i, c + T_E]
+    M = p[i, c + T_M0] + p[i, c + T_N] * t
+    x = 0.0
+    y = 0.0
+    if e < 1.0:
+        two_pi = 6.283185307179586
+        M = M - two_pi * ti.floor(M / two_pi + 0.5)          # in [−π, π)
+        E = M + ti.select(M < 0.0, -0.85, 0.85) * e
+        for _ in range(KEPLER_ITERATIONS):
+            dE = (E - e * ti.sin(E) - M) / (1.0 - e * ti.cos(E))
+            E -= dE
+            if ti.abs(dE) <= 1e-15 * (1.0 + ti.abs(E)):   # the next would be below round-off
+                break
+        x = a * (ti.cos(E) - e)
+        y = a * ti.sqrt((1.0 - e) * (1.0 + e)) * ti.sin(E)
+    else:
+        H = ti.select(M < 0.0, -1.0, 1.0) * ti.log(2.0 * ti.abs(M) / e + 1.8)
+        for _ in range(KEPLER_ITERATIONS):
+            u = ti.exp(H)
+            dH = (0.5 * e * (u - 1.0 / u) - H - M) / (0.5 * e * (u + 1.0 / u) - 1.0)
+            H -= dH
+            if ti.abs(dH) <= 1e-15 * (1.0 + ti.abs(H)):
+                break
+        u = ti.exp(H)
+        x = a * (e - 0.5 * (u + 1.0 / u))
+        y = a * ti.sqrt((e - 1.0) * (e + 1.0)) * 0.5 * (u - 1.0 / u)
+    P = ti.Vector([p[i, c + T_P], p[i, c + T_P + 1], p[i, c + T_P + 2]], ti.f64)
+    Q = ti.Vector([p[i, c + T_Q], p[i, c + T_Q + 1], p[i, c + T_Q + 2]], ti.f64)
+    return x * P + y * Q
+
+
+@ti.func
 def sun_position(p: ti.template(), i, q: ti.template(), t):
-    """The Sun's position relative to the barycentre at scaled time t, inertial frame, for
-    the block starting at column ``q`` of member i's row: minus the barycentre's
-    heliocentric Kepler position, E from Kepler's equation by Newton's method from Danby's
-    start E = M + 0.85 e sign(sin M), stopped at round-off (at most KEPLER_ITERATIONS)."""
-    a = p[i, q + Q_SUN_A]
-    e = p[i, q + Q_SUN_E]
-    M = p[i, q + Q_SUN_M0] + p[i, q + Q_SUN_N] * t
-    two_pi = 6.283185307179586
-    M = M - two_pi * ti.floor(M / two_pi + 0.5)          # in [−π, π)
-    E = M + ti.select(M < 0.0, -0.85, 0.85) * e
-    for _ in range(KEPLER_ITERATIONS):
-        dE = (E - e * ti.sin(E) - M) / (1.0 - e * ti.cos(E))
-        E -= dE
-        if ti.abs(dE) <= 1e-15 * (1.0 + ti.abs(E)):   # the next would be below round-off
-            break
-    x = a * (ti.cos(E) - e)
-    y = a * ti.sqrt((1.0 - e) * (1.0 + e)) * ti.sin(E)
-    P = ti.Vector([p[i, q + Q_SUN_P], p[i, q + Q_SUN_P + 1], p[i, q + Q_SUN_P + 2]], ti.f64)
-    Q = ti.Vector([p[i, q + Q_SUN_Q], p[i, q + Q_SUN_Q + 1], p[i, q + Q_SUN_Q + 2]], ti.f64)
-    return -(x * P + y * Q)
+    """The Sun's position relative to the barycentre (the Sun slot of the block starting at
+    column ``q``): minus the barycentre's heliocentric position, stored as −P, −Q."""
+    return third_body_position(p, i, q + Q_SUN, t)
 
 
 @ti.func

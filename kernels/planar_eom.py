@@ -266,21 +266,22 @@ def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.templ
     fb = p[i, q + perturb.Q_BYORP] / (pv[P_INV_M] * speed)   # m a_B / |V|
     Fr += fb * vr
     Ft += fb * vt
-    mu_sun = p[i, q + perturb.Q_SUN]
-    if mu_sun != 0.0:    # the Sun's tide in the plane (its orbit's z components are 0)
-        nu = p[i, q + perturb.Q_SUN_NU]
-        D = perturb.sun_position(p, i, q, t)
-        cl = ti.cos(y[Y_LAM])
-        sl = ti.sin(y[Y_LAM])
-        R3 = ti.Vector([r * cl, r * sl, 0.0], ti.f64)
-        a = perturb.solar_acceleration(mu_sun, D, R3, nu)
-        m = 1.0 / pv[P_INV_M]
-        Fr += m * (a[0] * cl + a[1] * sl)
-        Ft += m * (a[1] * cl - a[0] * sl)
-        N1 += perturb.gravity_gradient_torque_z(mu_sun, D + nu * R3, cl, sl, y[Y_CA], y[Y_SA],
-                                                p[i, q + perturb.Q_SUN_J1])
-        N2 += perturb.gravity_gradient_torque_z(mu_sun, D - (1.0 - nu) * R3, cl, sl, y[Y_CB],
-                                                y[Y_SB], p[i, q + perturb.Q_SUN_J2])
+    for c in ti.static(perturb.THIRD_BODIES):   # the Sun, a passing planet
+        mu3 = p[i, q + c + perturb.T_MU]
+        if mu3 != 0.0:    # its tide in the plane (its orbit's z components are 0)
+            nu = p[i, q + c + perturb.T_NU]
+            D = perturb.third_body_position(p, i, q + c, t)
+            cl = ti.cos(y[Y_LAM])
+            sl = ti.sin(y[Y_LAM])
+            R3 = ti.Vector([r * cl, r * sl, 0.0], ti.f64)
+            a = perturb.solar_acceleration(mu3, D, R3, nu)
+            m = 1.0 / pv[P_INV_M]
+            Fr += m * (a[0] * cl + a[1] * sl)
+            Ft += m * (a[1] * cl - a[0] * sl)
+            N1 += perturb.gravity_gradient_torque_z(mu3, D + nu * R3, cl, sl, y[Y_CA], y[Y_SA],
+                                                    p[i, q + c + perturb.T_J1])
+            N2 += perturb.gravity_gradient_torque_z(mu3, D - (1.0 - nu) * R3, cl, sl, y[Y_CB],
+                                                    y[Y_SB], p[i, q + c + perturb.T_J2])
     dy = state_perturbed(0.0)
     for k in ti.static(range(NSTATE)):
         dy[k] = base[k]

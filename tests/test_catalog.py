@@ -74,6 +74,11 @@ def test_elongation_beyond_b_equals_c_is_refused_with_the_limit():
 
 def test_paper_section_starts_and_heliocentric_orbits():
     assert catalog.section_starts("1991 VH") == [0.43, 0.83, 1.63, 2.31, 2.53]
-    assert catalog.heliocentric_orbit("2004 DC")[1] == pytest.approx(0.397)
-    assert catalog.heliocentric_orbit("Didymos") is None
+    assert catalog.heliocentric_orbit("2004 DC").e == pytest.approx(0.397)
+    # ecliptic elements; the Sun's direction only where the binary's pole is published
+    didymos = catalog.heliocentric_orbit("Didymos")
+    assert (didymos.a_au, didymos.inclination_deg, didymos.pole) == (1.644, 3.41, (310.0, -84.0))
+    assert didymos.oriented and not catalog.heliocentric_orbit("1991 VH").oriented
+    assert catalog.system("Didymos").heliocentric_orbit == didymos
+    assert catalog.heliocentric_orbit("2002 CE26") is None
     assert np.all(np.diff(catalog.section_starts("Didymos")) > 0)

@@ -19,7 +19,7 @@ TIDE = tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6)
 #: and the Sun's tide ×300 in the orbit plane (the planar model carries it), 1e-5 of the
 #: mutual gravity
 ALL = (TIDE, tso.YORP(coefficient=1e-3, strength=1e6), tso.BYORP(coefficient=1e-3, strength=1e6),
-       tso.SolarTide(strength=300.0))
+       tso.SolarTide(inclination_deg=0.0, strength=300.0))
 STARTS = [0.83, 1.63]
 ARGS = dict(orbits=6, rtol=1e-10)
 
@@ -179,7 +179,7 @@ def test_libration_with_perturbations(vh):
 
 
 def test_bad_perturbations_are_named_before_any_work(vh):
-    with pytest.raises(TypeError, match=r"perturbations\[1\] must be a Tides, YORP, BYORP or SolarTide"):
+    with pytest.raises(TypeError, match=r"perturbations\[1\] must be a Tides, YORP, BYORP, SolarTide or Flyby"):
         tso.chaos_map(vh, [0.0], [1.0], orbits=2, perturbations=[TIDE, "tides"])
     with pytest.raises(ValueError, match=r"a second tides on the secondary"):
         tso.overlap_threshold("1991 VH", elongations=[1.05], orbits=2,
@@ -205,7 +205,7 @@ def test_the_heliocentric_orbit_belongs_to_the_system_not_to_its_name(vh):
     # the same torque as the catalogue's when given the same orbit, by field or by keyword
     mine = tso.BinarySystem(vh.primary, vh.secondary, a=vh.a, e=vh.e, name="mine",
                             heliocentric_orbit=vh.heliocentric_orbit)
-    a_au, e_sun = vh.heliocentric_orbit
+    a_au, e_sun = vh.heliocentric_orbit.a_au, vh.heliocentric_orbit.e
     by_keyword = tso.YORP(heliocentric_a_au=a_au, heliocentric_e=e_sun).block(namesake)
     np.testing.assert_array_equal(tso.YORP().block(mine), tso.YORP().block(vh))
     np.testing.assert_array_equal(by_keyword, tso.YORP().block(vh))
@@ -219,7 +219,8 @@ def test_the_heliocentric_orbit_belongs_to_the_system_not_to_its_name(vh):
     with pytest.raises(ValueError, match=r"heliocentric_orbit a must lie in \[0.05, 10000\]"):
         tso.BinarySystem(vh.primary, vh.secondary, a=vh.a, e=vh.e,
                          heliocentric_orbit=(0.01, 0.1))
-    with pytest.raises(TypeError, match=r"heliocentric_orbit must be \(a in AU, e\)"):
+    with pytest.raises(TypeError,
+                       match=r"heliocentric_orbit must be a HeliocentricOrbit, \(a in AU, e\)"):
         tso.BinarySystem(vh.primary, vh.secondary, a=vh.a, e=vh.e, heliocentric_orbit=1.1)
 
 
@@ -250,13 +251,13 @@ def test_resumed_perturbed_run_equals_an_uninterrupted_one(tmp_path, vh):
 def test_checkpoint_of_other_perturbations_is_refused(tmp_path, vh):
     ckpt = tmp_path / "a.ckpt"
     kw = dict(orbits=2, rtol=1e-10)
-    tso.surface_of_section(vh, 0.0, STARTS, **kw, run=tso.Run(checkpoint=ckpt))
+    tso.surface_of_section(vh, 0.0, STARTS, **kw, run=tso.Run(checkpoint=ckpt, keep_checkpoint=True))
     with pytest.raises(ValueError, match=r"other settings: perturbed \(checkpoint False, now "
                                          r"True\)"):
         tso.surface_of_section(vh, 0.0, STARTS, perturbations=[TIDE], **kw,
                                run=tso.Run(checkpoint=ckpt, resume=True))
     tso.surface_of_section(vh, 0.0, STARTS, perturbations=[TIDE], **kw,
-                           run=tso.Run(checkpoint=ckpt, overwrite=True))
+                           run=tso.Run(checkpoint=ckpt, overwrite=True, keep_checkpoint=True))
     with pytest.raises(ValueError, match=r"other settings: perturbed \(checkpoint True, now "
                                          r"False\)"):
         tso.surface_of_section(vh, 0.0, STARTS, **kw, run=tso.Run(checkpoint=ckpt, resume=True))

@@ -510,7 +510,7 @@ def test_a_perturbed_member_whose_accounting_fails_is_flagged_inaccurate():
     (lambda: tso.model.perturbations.check_perturbations([tso.Tides(), tso.Tides(k2=1e-3)]),
      ValueError, "perturbations[1]: a second tides on the secondary"),
     (lambda: tso.model.perturbations.check_perturbations([tso.Tides(), "yorp"]), TypeError,
-     "perturbations[1] must be a Tides, YORP, BYORP or SolarTide object"),
+     "perturbations[1] must be a Tides, YORP, BYORP, SolarTide or Flyby object"),
 ])
 def test_perturbation_inputs_are_refused_in_one_line_naming_the_parameter(make, error, message):
     with pytest.raises(error) as info:

@@ -245,7 +245,7 @@ def test_a_sun_out_of_the_plane_sends_auto_to_3d_and_planar_is_refused():
     par, y0 = system.parameter_row()[None], system.initial_state(0.0, 1.0)[None]
     for sun, model in ((in_plane, models.PLANAR), (retro, models.PLANAR),
                        (tilted, models.SPATIAL)):
-        assert models.choose("auto", par, y0, spatial_forces=PT.needs_3d([sun])) is model
+        assert models.choose("auto", par, y0, spatial_forces=PT.needs_3d([sun], system)) is model
         rows = PT.perturbation_rows([system], [sun])
         assert bool(PT.out_of_plane_rows(rows)[0]) == (model is models.SPATIAL)
         ens = Ensemble(par, y0, perturbation_rows=rows)

@@ -39,7 +39,8 @@ from .output.xarray_io import to_xarray
 from .output import plotting as _plotting  # noqa: F401 (fills results.FIGURES: every .plot())
 from .engine.results import Result, Status
 from .system.initial import InitialState
-from .model.perturbations import BYORP, YORP, SolarTide, Tides
+from .model.perturbations import BYORP, YORP, Flyby, SolarTide, Tides
+from .system.heliocentric import HeliocentricOrbit
 from .studies.warmup import warmup
 from ._version import __version__
 
@@ -52,5 +53,5 @@ __all__ = ["Body", "Ellipsoid", "Sphere", "Polyhedron", "read_shape", "Composite
            "analytic", "classify_section", "relaxed_libration", "libration_amplitude",
            "overlap_threshold", "chaos_map", "parameter_map", "load", "save", "read_metadata",
            "ArchiveError", "to_xarray", "Result",
-           "Status", "warmup", "Tides", "YORP", "BYORP", "SolarTide",
+           "Status", "warmup", "Tides", "YORP", "BYORP", "SolarTide", "Flyby", "HeliocentricOrbit",
            "__version__"]

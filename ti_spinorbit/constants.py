@@ -21,3 +21,9 @@ K2_MODELS = {
     "goldreich-sari": lambda radius_km: 1e-5 * radius_km,         # Goldreich & Sari 2009
     "jacobson-scheeres": lambda radius_km: 2.5e-5 / radius_km,    # Jacobson & Scheeres 2011
 }
+
+#: Planets (and the Moon) a Flyby knows by name: GM in m³ s⁻² (IAU 2015 nominal Earth; the
+#: JPL DE440 values for the others) and mean radius in km (IAU WG on Cartographic
+#: Coordinates 2015).
+PLANETS = {"Earth": (3.986004e14, 6371.0), "Venus": (3.248586e14, 6051.8),
+           "Mars": (4.282837e13, 3389.5), "Moon": (4.902800e12, 1737.4)}

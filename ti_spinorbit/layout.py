@@ -112,14 +112,21 @@ class perturbation:
     Q_YORP1 = 6        # YORP torque on the primary, about its z axis
     Q_YORP2 = 7        # on the secondary
     Q_BYORP = 8        # BYORP acceleration of the relative motion along V
-    # the Sun's tide (SolarTide): μ_⊙ = G M_⊙ × strength (0: none), then the barycentre's
-    # heliocentric Kepler orbit a, e, mean motion, mean anomaly at t = 0, the unit vectors
-    # P (to perihelion) and Q (P rotated 90° in the motion's sense) in the inertial frame,
-    # ν = m2 / (m1 + m2), and each body's J_xx − J_yy = B − A (the planar model's torques)
+    # Third bodies, one slot each: the Sun (SolarTide) and a passing planet (Flyby). A slot
+    # holds μ = G M × strength (0: none), then the body's conic orbit relative to the
+    # barycentre: a (its magnitude for a hyperbola), e (< 1 ellipse, > 1 hyperbola), mean
+    # motion, mean anomaly at t = 0, the unit vectors P and Q (the body at x P + y Q of its
+    # conic, inertial frame), ν = m2 / (m1 + m2), and each body's J_xx − J_yy = B − A (the
+    # planar model's torques). Offsets within a slot:
+    T_MU, T_A, T_E, T_N, T_M0, T_P, T_Q, T_NU, T_J1, T_J2 = 0, 1, 2, 3, 4, 5, 8, 11, 12, 13
+    NTHIRD = 14
     Q_SUN = 9
-    Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0, Q_SUN_P, Q_SUN_Q, Q_SUN_NU = 10, 11, 12, 13, 14, 17, 20
-    Q_SUN_J1, Q_SUN_J2 = 21, 22
-    NPERT = 23
+    Q_FLYBY = Q_SUN + NTHIRD
+    THIRD_BODIES = (Q_SUN, Q_FLYBY)
+    Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0 = Q_SUN + T_A, Q_SUN + T_E, Q_SUN + T_N, Q_SUN + T_M0
+    Q_SUN_P, Q_SUN_Q, Q_SUN_NU = Q_SUN + T_P, Q_SUN + T_Q, Q_SUN + T_NU
+    Q_SUN_J1, Q_SUN_J2 = Q_SUN + T_J1, Q_SUN + T_J2
+    NPERT = Q_FLYBY + NTHIRD
     NACC = 4           # accumulators after the state: W, then L_ext (x, y, z)
     #: Floor of the bulge's relative angular rate in the constant-Q lag (units of n).
     Q_RATE_FLOOR = 1e-3

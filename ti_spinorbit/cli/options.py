@@ -302,15 +302,19 @@ def perturbation_flags(s):
                         "[0.05, 1e4] and e in [0, 1) (default: the catalogued one)")
     g.add_argument("--sun", action="store_true",
                    help="the Sun's tide and torques (SolarTide, docs/physics.md §13.11), the "
-                        "barycentre on the --heliocentric orbit")
+                        "barycentre on the system's heliocentric orbit (oriented by its pole), "
+                        "or on --heliocentric with the --sun-* angles")
     g.add_argument("--sun-inclination", type=SUN_INCLINATION, default=None, metavar="DEG",
                    help="inclination of the --sun orbit to the mutual orbit's initial plane, "
-                        "degrees in [0, 180] (default 0: the Sun in the plane)")
+                        "degrees in [0, 180]; any --sun-* angle replaces the system's orbit "
+                        "orientation (the angles not given are then 0: i 0 puts the Sun in the "
+                        "plane)")
     for dest, what in (("node", "longitude of the ascending node"),
                        ("periapsis", "argument of perihelion"),
                        ("mean-anomaly", "mean anomaly at t = 0")):
         g.add_argument(f"--sun-{dest}", type=ANGLE, default=None, metavar="DEG",
-                       help=f"{what} of the --sun orbit, degrees in [-360, 360] (default 0)")
+                       help=f"{what} of the --sun orbit, degrees in [-360, 360] (0 when "
+                            "another --sun-* angle is given)")
 
 
 def perturbations(args):
@@ -331,9 +335,12 @@ def perturbations(args):
         out.append(BYORP(coefficient=args.byorp, radius=args.byorp_radius,
                          strength=args.strength, **sun))
     if args.sun:
-        angles = {f"{name}_deg": 0.0 if value is None else value for name, value in (
+        # the angles given replace the system's orbit (the others then 0); none given: the
+        # system's own heliocentric orbit, oriented by its pole
+        angles = {f"{name}_deg": value for name, value in (
             ("inclination", args.sun_inclination), ("node", args.sun_node),
-            ("periapsis", args.sun_periapsis), ("mean_anomaly", args.sun_mean_anomaly))}
+            ("periapsis", args.sun_periapsis), ("mean_anomaly", args.sun_mean_anomaly))
+            if value is not None}
         out.append(SolarTide(strength=args.strength, **angles, **sun))
     return out
 
@@ -386,11 +393,19 @@ def check_perturbation_flags(args):
         try:
             p.block(system)
         except ValueError as exc:
-            text = one_line(exc).replace("pass heliocentric_a_au (AU) and heliocentric_e to "
-                                         "YORP / BYORP, or give the system "
-                                         "heliocentric_orbit=(a_AU, e)",
-                                         "pass --heliocentric A_AU E, or give the system "
-                                         "file heliocentric_a_au and heliocentric_e")
+            text = one_line(exc)
+            for api, cli_words in (
+                    ("pass heliocentric_a_au (AU) and heliocentric_e to YORP / BYORP, or give "
+                     "the system heliocentric_orbit=HeliocentricOrbit(a_AU, e, ...)",
+                     "pass --heliocentric A_AU E, or give the system file a heliocentric_orbit"),
+                    ("give the system heliocentric_orbit=HeliocentricOrbit(a_AU, e, ...), or "
+                     "SolarTide(heliocentric_a_au=..., heliocentric_e=...)",
+                     "pass --heliocentric A_AU E, or give the system file a heliocentric_orbit"),
+                    ("give HeliocentricOrbit(..., pole=(longitude, latitude)), or the Sun's "
+                     "angles relative to the binary to SolarTide(inclination_deg=...)",
+                     "give --sun-inclination DEG (and --sun-node, --sun-periapsis), or a "
+                     "system file whose heliocentric_orbit has a pole")):
+                text = text.replace(api, cli_words)
             text = text.replace("pass radius= (m) to the perturbation", f"give {flag}-radius M")
             raise ValueError(f"{flag}: {text}") from None
 
@@ -409,8 +424,12 @@ def perturbation_summary(items, system=None):
         elif p.kind == "yorp":
             parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g}, {p.convention} torque)")
         elif p.kind == "solar_tide":
-            parts.append(f"the Sun's tide (i {p.inclination_deg:g}°, node {p.node_deg:g}°, "
-                         f"perihelion {p.periapsis_deg:g}°, M0 {p.mean_anomaly_deg:g}°)")
+            if p.own_orbit:
+                i, node, peri, m0 = (getattr(p, name) or 0.0 for name in p.ANGLES)
+                parts.append(f"the Sun's tide (i {i:g}°, node {node:g}°, perihelion {peri:g}°, "
+                             f"M0 {m0:g}°)")
+            else:
+                parts.append("the Sun's tide (on the system's heliocentric orbit)")
         else:
             parts.append(f"BYORP (B {p.coefficient:g})")
     if not parts:

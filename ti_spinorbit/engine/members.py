@@ -29,7 +29,8 @@ from .. import layout as _layout
 from .._validate import _as_floats, require_count, require_finite, require_spin, show
 from ..model import coordinates as _coords, models
 from ..model.observables import derive
-from ..model.perturbations import NACC, check_perturbations, needs_3d, perturbation_rows
+from ..model.perturbations import (NACC, check_perturbations, needs_3d, out_of_plane_rows,
+                                   perturbation_rows)
 from ..system import catalog
 from ..system.initial import InitialState, as_scaled_states
 from ..system.systems import BinarySystem, ESCAPE_DISTANCE
@@ -201,11 +202,11 @@ class Members:
         symmetric = None if block is None else \
             ~np.any(block[:, _mp.odd_mask(degrees, axis=2)] != 0.0, axis=1)
         perturbations = check_perturbations(perturbations)
+        rows = perturbation_rows(members, perturbations)
         decided = models.choose(model, par, y0, symmetric,
-                                spatial_forces=needs_3d(perturbations)).name
+                                spatial_forces=bool(np.any(out_of_plane_rows(rows)))).name
         return cls(members, par, y0, theta_p, thetadot_p, decided, coordinates, int(order),
-                   float(escape_distance), perturbations,
-                   perturbation_rows(members, perturbations), degrees, block)
+                   float(escape_distance), perturbations, rows, degrees, block)
 
     @classmethod
     def build(cls, what, system, theta_p, thetadot_p, initial_states, orbits, *,

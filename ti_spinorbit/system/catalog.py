@@ -21,6 +21,7 @@ from importlib import resources
 
 from .._validate import (MAX_DENSITY, MIN_DENSITY, require_positive_scalar, require_range,
                          require_real, show)
+from .heliocentric import HeliocentricOrbit
 from .bodies import DATA_ORDER, Ellipsoid, Sphere
 from .shapes import packaged_shape
 from .systems import BinarySystem
@@ -144,11 +145,10 @@ def section_starts(name):
 
 
 def heliocentric_orbit(name):
-    """(a in AU, e) of the system's heliocentric orbit where catalogued, else None."""
-    d = _data()[_resolve(name)]
-    if "heliocentric_a_au" not in d:
-        return None
-    return d["heliocentric_a_au"], d["heliocentric_e"]
+    """The system's heliocentric orbit (a :class:`~ti_spinorbit.HeliocentricOrbit`, ecliptic
+    elements, with the binary's pole where published) where catalogued, else None."""
+    d = _data()[_resolve(name)].get("heliocentric_orbit")
+    return None if d is None else HeliocentricOrbit(**d)
 
 
 def as_system(system, allow_list=False):
