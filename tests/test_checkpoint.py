@@ -81,9 +81,11 @@ def test_time_series_resume_equals_uninterrupted(tmp_path):
 def test_resume_from_a_finished_checkpoint_and_without_one(tmp_path):
     vh = tso.catalog.system("1991 VH")
     ckpt = tmp_path / "done.ckpt"
-    first = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(**ARGS, checkpoint=ckpt))
+    first = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(**ARGS, checkpoint=ckpt,
+                                                                      keep_checkpoint=True))
     again = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(**ARGS, checkpoint=ckpt, resume=True))
     assert_same_section(first, again)
+    assert not ckpt.exists()                   # the resumed run finished: removed
     fresh = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(**ARGS, checkpoint=tmp_path / "none.ckpt", resume=True))           # no file yet: starts afresh
     assert_same_section(first, fresh)
 
@@ -91,7 +93,8 @@ def test_resume_from_a_finished_checkpoint_and_without_one(tmp_path):
 def test_mismatched_and_damaged_checkpoints_are_refused(tmp_path):
     vh = tso.catalog.system("1991 VH")
     ckpt = tmp_path / "a.ckpt"
-    tso.surface_of_section(vh, 0.0, STARTS[:2], orbits=4, rtol=1e-10, run=tso.Run(checkpoint=ckpt))
+    tso.surface_of_section(vh, 0.0, STARTS[:2], orbits=4, rtol=1e-10,
+                           run=tso.Run(checkpoint=ckpt, keep_checkpoint=True))
     with pytest.raises(ValueError, match=r"other settings: rtol \(checkpoint 1e-10, now 1e-11\)"):
         tso.surface_of_section(vh, 0.0, STARTS[:2], orbits=4, rtol=1e-11,
                                run=tso.Run(checkpoint=ckpt, resume=True))
@@ -118,3 +121,107 @@ def test_mismatched_and_damaged_checkpoints_are_refused(tmp_path):
     (tmp_path / "a_file").write_text("not a checkpoint")
     with pytest.raises(ValueError, match="is not a ti_spinorbit checkpoint directory"):
         checkpoint.load(tmp_path / "a_file", {}, "")
+
+
+# ---- a finished run's checkpoint is removed (Run(keep_checkpoint=True) keeps it) -----------
+class _Interrupt:
+    """A progress callback that raises KeyboardInterrupt at its ``at``-th call (after that
+    window's checkpoint is written)."""
+
+    def __init__(self, at):
+        self.at, self.calls = at, 0
+
+    def __call__(self, fraction):
+        self.calls += 1
+        if self.calls == self.at:
+            raise KeyboardInterrupt
+
+
+@pytest.fixture
+def saves(monkeypatch):
+    """Every window checkpoint written (checkpoint.save calls)."""
+    written = []
+    real = checkpoint.save
+
+    def spy(path, *args, **kwargs):
+        written.append(os.fspath(path))
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(checkpoint, "save", spy)
+    return written
+
+
+def test_a_finished_run_removes_its_checkpoint(tmp_path, saves):
+    vh = tso.catalog.system("1991 VH")
+    ckpt = tmp_path / "run.ckpt"
+    with_ckpt = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(**ARGS, checkpoint=ckpt))
+    assert saves                               # it was checkpointed ...
+    assert not ckpt.exists()                   # ... and the folder is gone once it returned
+    assert os.listdir(tmp_path) == []
+    assert_same_section(with_ckpt, tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(**ARGS)))
+    # a time series likewise (the same Ensemble.run path)
+    tso.time_series(vh, 0.0, STARTS[:1], **run_options(**ARGS, checkpoint=ckpt))
+    assert not ckpt.exists()
+
+
+def test_keep_checkpoint_keeps_it_and_a_resume_from_it_integrates_nothing(tmp_path, saves):
+    vh = tso.catalog.system("1991 VH")
+    ckpt = tmp_path / "kept.ckpt"
+    first = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(
+        **ARGS, checkpoint=ckpt, keep_checkpoint=True))
+    assert checkpoint.holds_checkpoint(ckpt)
+    state = (ckpt / checkpoint.STATE).read_bytes()
+    saves.clear()
+    again = tso.surface_of_section(vh, 0.0, STARTS[:2], **run_options(
+        **ARGS, checkpoint=ckpt, resume=True, keep_checkpoint=True))
+    assert_same_section(first, again)
+    assert saves == []                         # the finished checkpoint gave its result back
+    assert (ckpt / checkpoint.STATE).read_bytes() == state
+    assert np.all(again.count > 0)              # a result with crossings, not an empty one
+    with pytest.raises(TypeError, match="keep_checkpoint must be True or False"):
+        tso.Run(checkpoint=ckpt, keep_checkpoint="yes")
+
+
+def test_an_interrupted_run_keeps_its_checkpoint_and_the_resume_removes_it(tmp_path):
+    vh = tso.catalog.system("1991 VH")
+    ckpt = tmp_path / "stopped.ckpt"
+    with pytest.raises(KeyboardInterrupt):
+        tso.surface_of_section(vh, 0.0, STARTS, **run_options(
+            **{**ARGS, "progress": _Interrupt(3)}, checkpoint=ckpt))
+    assert checkpoint.holds_checkpoint(ckpt)   # kept for the resume
+    assert len(list(ckpt.glob("records-*.npz"))) == 3
+    resumed = tso.surface_of_section(vh, 0.0, STARTS, **run_options(**ARGS, checkpoint=ckpt,
+                                                                    resume=True))
+    assert not ckpt.exists()                   # finished now: removed
+    assert_same_section(resumed, tso.surface_of_section(vh, 0.0, STARTS, **run_options(**ARGS)))
+
+
+def test_a_run_that_fails_keeps_its_checkpoint(tmp_path):
+    """Any exception, not only an interruption, keeps the checkpoint."""
+    vh = tso.catalog.system("1991 VH")
+    ckpt = tmp_path / "failed.ckpt"
+
+    def fail(fraction):
+        raise RuntimeError("the disk is full")
+
+    with pytest.raises(RuntimeError, match="the disk is full"):
+        tso.surface_of_section(vh, 0.0, STARTS[:1], **run_options(
+            **{**ARGS, "progress": fail}, checkpoint=ckpt))
+    assert checkpoint.holds_checkpoint(ckpt)
+
+
+def test_finish_is_the_one_rule(tmp_path):
+    """checkpoint.finish: kept when asked (naming the caller's flag), removed otherwise; a
+    missing folder is nothing to do; files that are not a checkpoint's stay."""
+    ckpt = tmp_path / "c"
+    ckpt.mkdir()
+    (ckpt / checkpoint.STATE).write_bytes(b"x")
+    (ckpt / "records-000000.npz").write_bytes(b"x")
+    assert checkpoint.finish(ckpt, keep=True, flag="--keep-checkpoint") == \
+        f"kept checkpoint {ckpt} (--keep-checkpoint)"
+    assert sorted(os.listdir(ckpt)) == ["records-000000.npz", checkpoint.STATE]
+    (ckpt / "notes.txt").write_text("mine")
+    assert checkpoint.finish(ckpt) == \
+        f"removed checkpoint {ckpt} (the run is complete; keep_checkpoint=True keeps it)"
+    assert os.listdir(ckpt) == ["notes.txt"]  # not a checkpoint file: left, with its folder
+    assert checkpoint.finish(tmp_path / "none") is None

@@ -415,7 +415,8 @@ def whole(vh):
 @pytest.fixture(scope="module")
 def finished(vh, tmp_path_factory):
     path = tmp_path_factory.mktemp("ro") / "run.ckpt"
-    tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS, checkpoint=path))
+    tso.surface_of_section(vh, 0.0, [0.83, 1.63], **run_options(**ARGS, checkpoint=path,
+                                                                 keep_checkpoint=True))
     return path
 
 
@@ -564,7 +565,8 @@ def test_bit_flips_of_a_checkpoint_state_are_checkpoint_damaged(vh, tmp_path):
     a changed number."""
     ckpt = tmp_path / "one.ckpt"
     tso.surface_of_section(vh, 0.0, [1.0], orbits=1, rtol=1e-8, indicators=False,
-                           run=tso.Run(window_orbits=1, checkpoint=ckpt, progress=False))
+                           run=tso.Run(window_orbits=1, checkpoint=ckpt, progress=False,
+                                       keep_checkpoint=True))
     with np.load(ckpt / C.STATE) as f:
         header = json.loads(str(f["header"]))
     settings, fingerprint = header["settings"], header["fingerprint"]
@@ -625,7 +627,7 @@ def test_the_two_leaks_found_by_fuzzing_are_archive_errors(tmp_path, vh):
         tso.load(path)
     ckpt = tmp_path / "c.ckpt"
     tso.surface_of_section(vh, 0.0, [1.0], orbits=1, rtol=1e-8, indicators=False,
-                           run=tso.Run(checkpoint=ckpt, progress=False))
+                           run=tso.Run(checkpoint=ckpt, progress=False, keep_checkpoint=True))
     with np.load(ckpt / C.STATE) as f:
         header = json.loads(str(f["header"]))
     _set_encrypted_flag(ckpt / C.STATE)

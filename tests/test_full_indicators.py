@@ -145,7 +145,8 @@ def test_full_space_recorded_saved_and_in_checkpoint_settings(tmp_path):
     vh = tso.catalog.system("1991 VH")
     r = tso.surface_of_section(vh, 0.0, 1.0, orbits=2, rtol=1e-10, indicators=True,
                                indicator_space="full",
-                               run=tso.Run(checkpoint=tmp_path / "ck", progress=False))
+                               run=tso.Run(checkpoint=tmp_path / "ck", progress=False,
+                                           keep_checkpoint=True))
     loaded = tso.load(tso.save(r, tmp_path / "r.npz"))
     assert loaded.indicator_space == "full"
     assert "planar" in type(r).units()["indicator_space"]

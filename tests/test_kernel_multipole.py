@@ -312,7 +312,8 @@ def test_resume_with_another_order_or_degrees_is_refused(tmp_path):
     table = Members.from_starts(system, [0.0], [1.0], 1000.0)
     path = tmp_path / "ckpt"
     Ensemble(table.par, table.y0, order=6, model="3d",
-             multipole_rows=_rows(system, 6)).run(2.0 * np.pi * 0.5, checkpoint=path)
+             multipole_rows=_rows(system, 6)).run(2.0 * np.pi * 0.5, checkpoint=path,
+                                                  keep_checkpoint=True)
     with pytest.raises(CheckpointError, match=r"order \(checkpoint 6, now 8\)"):
         Ensemble(table.par, table.y0, order=8, model="3d",
                  multipole_rows=_rows(system, 8)).run(2.0 * np.pi, checkpoint=path,

@@ -127,7 +127,8 @@ def test_results_and_files_record_the_method(vh, tmp_path, method):
                                               ("vern9", "dop853")])
 def test_checkpoint_refuses_another_method(members, tmp_path, written, resumed):
     ck = tmp_path / "ck"
-    Ensemble(*members, rtol=1e-10, model="planar", method=written).run(T_STOP, checkpoint=ck)
+    Ensemble(*members, rtol=1e-10, model="planar", method=written).run(T_STOP, checkpoint=ck,
+                                                                       keep_checkpoint=True)
     with pytest.raises(CheckpointError,
                        match=rf"method \(checkpoint '{written}', now '{resumed}'\)"):
         Ensemble(*members, rtol=1e-10, model="planar", method=resumed).run(

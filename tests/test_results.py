@@ -183,7 +183,8 @@ def test_multi_launch_checkpoints_resume_to_the_same_result(vh, tmp_path):
               max_iterations=1, samples_per_orbit=8, converge=False)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        first = tso.relaxed_libration(vh, **kw, run=tso.Run(checkpoint=tmp_path / "ck"))
+        first = tso.relaxed_libration(vh, **kw, run=tso.Run(checkpoint=tmp_path / "ck",
+                                                            keep_checkpoint=True))
         launches = sorted(p.name for p in (tmp_path / "ck").iterdir())
         again = tso.relaxed_libration(vh, **kw,
                                       run=tso.Run(checkpoint=tmp_path / "ck", resume=True))

@@ -63,7 +63,7 @@ def whole(vh):
 def finished(vh, tmp_path_factory):
     """A finished checkpoint directory (copy it before changing it)."""
     path = tmp_path_factory.mktemp("template") / "run.ckpt"
-    run(vh, path)
+    run(vh, path, keep_checkpoint=True)
     return path
 
 
@@ -273,7 +273,7 @@ def test_checkpoint_of_another_run_is_not_overwritten(vh, ckpt, entry):
 @pytest.mark.parametrize("entry", ["section", "chaos_map"])
 def test_overwrite_checkpoint_replaces_it(vh, ckpt, entry):
     result = entry_points(vh, ckpt, overwrite=True)[entry]()
-    again = entry_points(vh, ckpt, resume=True)[entry]()     # resumes the new run, finished
+    again = entry_points(vh, ckpt, resume=True, keep_checkpoint=True)[entry]()   # finished
     if entry == "section":
         assert_same(result, again)
     else:
@@ -316,7 +316,7 @@ def test_directory_killed_before_its_first_state_starts_afresh(vh, tmp_path, who
     ckpt.mkdir()
     for name in leftovers:
         (ckpt / name).write_bytes(b"half-written by a killed run")
-    assert_same(run(vh, ckpt, resume=resume), whole)
+    assert_same(run(vh, ckpt, resume=resume, keep_checkpoint=True), whole)
     assert not [f for f in os.listdir(ckpt) if ".tmp-" in f]        # stray temp files cleaned
     assert_same(run(vh, ckpt, resume=True), whole)                   # and a real checkpoint now
 

@@ -87,16 +87,37 @@ def whole(vh):
 def windows(vh, tmp_path_factory):
     """Windows per stage of the map (counted from a checkpointed run's records files)."""
     path = tmp_path_factory.mktemp("count") / "ck"
-    chaos(vh, checkpoint=path, progress=False)
+    chaos(vh, checkpoint=path, progress=False, keep_checkpoint=True)
     return [len(list((path / f"launch-{k:03d}").glob("records-*.npz"))) for k in range(3)]
 
 
 def test_map_stages_each_have_their_checkpoint(vh, whole, windows, tmp_path):
-    again = chaos(vh, checkpoint=tmp_path / "ck", progress=False)
+    again = chaos(vh, checkpoint=tmp_path / "ck", progress=False, keep_checkpoint=True)
     assert sorted(p.name for p in (tmp_path / "ck").iterdir() if p.is_dir()) == \
         ["launch-000", "launch-001", "launch-002"]
     assert all(w >= 1 for w in windows), windows
     assert_same(again, whole)      # checkpointing changes nothing
+
+
+def test_a_finished_map_removes_its_folder_only_after_its_last_stage(vh, whole, tmp_path,
+                                                                     monkeypatch):
+    """Each stage keeps its launch-kkk while the map goes on (a resume reuses it); the map's
+    folder goes once the last stage has succeeded."""
+    ckpt = tmp_path / "ck"
+    seen = []
+    real = C.finish
+
+    def spy(path, *args, **kwargs):
+        seen.append((os.path.basename(os.fspath(path)),
+                     sorted(p.name for p in ckpt.iterdir() if p.is_dir())))
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(C, "finish", spy)
+    done = chaos(vh, checkpoint=ckpt, progress=False)
+    assert not ckpt.exists() and os.listdir(tmp_path) == []
+    # one removal, of the map's folder, when all three stages were there
+    assert seen == [("ck", ["launch-000", "launch-001", "launch-002"])], seen
+    assert_same(done, whole)
 
 
 @pytest.mark.parametrize("where", ["first evidence length", "second evidence length",
@@ -112,7 +133,7 @@ def test_map_interrupted_in_any_stage_resumes_bit_identical(vh, whole, windows, 
     done = {f"launch-{k:03d}": (ckpt / f"launch-{k:03d}" / C.STATE).read_bytes()
             for k in range(stage)}
     saves.clear()
-    resumed = chaos(vh, checkpoint=ckpt, resume=True, progress=False)
+    resumed = chaos(vh, checkpoint=ckpt, resume=True, progress=False, keep_checkpoint=True)
     assert_same(resumed, whole)
     # no finished stage was integrated again: none of its windows was saved, its state is
     # byte for byte the one written before the interruption
@@ -137,6 +158,7 @@ def test_map_interrupted_at_every_window_then_resumed_each_time(vh, whole, windo
     else:
         result = chaos(vh, checkpoint=ckpt, resume=True, progress=False)
     assert_same(result, whole)
+    assert not ckpt.exists()     # every interrupted resume kept it; the one that finished not
 
 
 def test_parameter_map_interrupted_in_its_evidence_resumes_bit_identical(tmp_path, saves):
@@ -158,8 +180,8 @@ def test_overlap_doubling_interrupted_in_a_longer_length_resumes(tmp_path, saves
     whole = tso.overlap_threshold("1991 VH", **kw, run=tso.Run(progress=False))
     ckpt = tmp_path / "ck"
     full = []
-    tso.overlap_threshold("1991 VH", **kw,
-                          run=tso.Run(checkpoint=tmp_path / "count", progress=False))
+    tso.overlap_threshold("1991 VH", **kw, run=tso.Run(checkpoint=tmp_path / "count",
+                                                       progress=False, keep_checkpoint=True))
     full = sorted(p.name for p in (tmp_path / "count").iterdir() if p.is_dir())
     assert len(full) >= 2, full          # the doubling ran a second length
     first = len(list((tmp_path / "count" / "launch-000").glob("records-*.npz")))
@@ -198,7 +220,7 @@ def test_overwrite_replaces_every_stage_and_remove_deletes_them(vh, whole, tmp_p
         chaos(vh, checkpoint=ckpt, progress=Interrupt(1))
     (ckpt / "launch-007").mkdir()      # a stale launch of some longer computation
     assert C.holds_checkpoint(ckpt)
-    fresh = chaos(vh, checkpoint=ckpt, overwrite=True, progress=False)
+    fresh = chaos(vh, checkpoint=ckpt, overwrite=True, progress=False, keep_checkpoint=True)
     assert_same(fresh, whole)
     assert not (ckpt / "launch-007").exists()
     C.remove(ckpt)
@@ -209,7 +231,7 @@ def test_resume_refused_after_a_perturbation_changed_names_it(vh, tmp_path):
     tide = tso.Tides(k2=1e-5, time_lag=600.0, strength=1e6)
     ckpt = tmp_path / "ck"
     tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8, perturbations=[tide],
-                           run=tso.Run(checkpoint=ckpt, progress=False))
+                           run=tso.Run(checkpoint=ckpt, progress=False, keep_checkpoint=True))
     stronger = dataclasses.replace(tide, strength=2e6)
     with pytest.raises(C.CheckpointError, match=r"other inputs \(perturbations \(tides, YORP, "
                                                 r"BYORP or their parameters\) differ\)"):
@@ -268,10 +290,10 @@ def test_cli_map_killed_in_its_evidence_resumes_to_the_same_data(tmp_path):
 def test_a_single_run_and_a_staged_checkpoint_are_not_confused(vh, tmp_path):
     single, staged = tmp_path / "single", tmp_path / "staged"
     tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8,
-                           run=tso.Run(checkpoint=single, progress=False))
+                           run=tso.Run(checkpoint=single, progress=False, keep_checkpoint=True))
     with pytest.raises(C.CheckpointError, match="holds a single run's checkpoint"):
         chaos(vh, checkpoint=single, resume=True, progress=False)
-    chaos(vh, checkpoint=staged, progress=False)
+    chaos(vh, checkpoint=staged, progress=False, keep_checkpoint=True)
     with pytest.raises(C.CheckpointError, match=r"holds the launches \(launch-kkk\)"):
         tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8,
                                run=tso.Run(checkpoint=staged, resume=True, progress=False))

@@ -14,7 +14,7 @@ import numpy as np
 from .. import init
 from ..engine import progress as _progress
 from ..engine.accuracy import TRUNCATION_LIMITS
-from ..engine.checkpoint import check_target, holds_checkpoint, remove
+from ..engine.checkpoint import check_target, finish, holds_checkpoint
 from ..engine.options import Integrator, Run
 from ..engine.results import STATUS_NAMES, Status
 from ..files import check_name, claim, safe_part, target
@@ -406,27 +406,23 @@ def entry_options(args, data, bar):
     checkpoint and resume) from the flags; the directory was checked by :func:`output_paths`
     before any work."""
 
+    # keep_checkpoint=True: the run keeps its checkpoint until the command's outputs are
+    # written, then finish_checkpoint applies the library's rule (a kill before the figure
+    # still resumes without integrating: _finishes_a_run)
     return {"method": args.method,
             "integrator": Integrator(model=args.model, order=getattr(args, "order", 4)),
             "run": Run(progress=bar, checkpoint=checkpoint_path(args, data), resume=args.resume,
-                       overwrite=args.overwrite_checkpoint)}
+                       overwrite=args.overwrite_checkpoint, keep_checkpoint=True)}
 
 
 def finish_checkpoint(args, data):
-    """After a run's outputs are written: remove its checkpoint directory (the files a run
-    writes there, then the directory if empty) unless --keep-checkpoint. Returns the line to
-    print, or None."""
+    """After a run's outputs are written: the library's rule for a finished run's checkpoint
+    (:func:`ti_spinorbit.engine.checkpoint.finish`, as ``Run(keep_checkpoint=...)``): removed
+    unless --keep-checkpoint. Returns the line to print, or None."""
     path = checkpoint_path(args, data)
-    if path is None or not os.path.isdir(path):
+    if path is None:
         return None
-    if getattr(args, "keep_checkpoint", False):
-        return f"kept checkpoint {path} (--keep-checkpoint)"
-
-    try:
-        remove(path)
-    except OSError as exc:       # a read-only folder: the outputs are written all the same
-        return f"kept checkpoint {path} (it cannot be removed: {exc.strerror or exc})"
-    return f"removed checkpoint {path} (the run is complete; --keep-checkpoint keeps it)"
+    return finish(path, keep=getattr(args, "keep_checkpoint", False), flag="--keep-checkpoint")
 
 
 # ---- progress ---------------------------------------------------------------------------

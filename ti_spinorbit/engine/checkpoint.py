@@ -37,6 +37,14 @@ Safety rules:
   says to replace it. A directory left by a kill before the first state (records files or
   ``*.tmp-PID`` files only) holds no checkpoint: a run (resumed or not) starts afresh in it;
   stray ``*.tmp-*`` files are removed whenever a run takes the lock;
+* **tidy**: the checkpoint of a run that finished is removed when the run returns, unless
+  ``keep_checkpoint=True`` (:class:`ti_spinorbit.Run`; CLI ``--keep-checkpoint``): one rule,
+  :func:`finish`, applied by :func:`claim` to a single run, by :meth:`Launches.owned` to the
+  ``DIR`` of a computation of several launches once its last launch has succeeded (the
+  launches themselves never remove their ``launch-kkk``: a resume reuses finished ones), and
+  by the command line once its outputs are written (so that a kill before its figure still
+  resumes without integrating). A run that raises or is interrupted (KeyboardInterrupt,
+  kill) keeps its checkpoint, so that ``resume=True`` continues it;
 * **read-only checkpoints**: a checkpoint in a directory that cannot be written (a read-only
   folder or mount, an archive of finished runs) resumes without a lock and without writing
   anything when its run is finished; an unfinished one is refused before any work, in one
@@ -255,17 +263,42 @@ def holds_checkpoint(path):
         os.path.isfile(os.path.join(d, STATE)) for d in _launch_dirs(path))
 
 
-def remove(path):
+def remove(path, held=False):
     """Delete a finished run's checkpoint: the files a run writes in ``path`` (state, records,
     lock, temporary files; its launch checkpoints likewise), then the directory itself when
-    nothing else is left in it."""
+    nothing else is left in it. ``held``: this process holds the lock, whose file goes last
+    (POSIX deletes a locked file; where the OS refuses, :func:`claim` deletes it once
+    released)."""
     path = _fspath(path)
     for sub in _launch_dirs(path):
         remove(sub)
     _clean(path, [n for n in os.listdir(path) if _is_checkpoint_file(n)
-                  and not _LAUNCH_DIR.match(n)])
+                  and not _LAUNCH_DIR.match(n) and n != LOCK])
+    with contextlib.suppress(FileNotFoundError) if not held else contextlib.suppress(OSError):
+        os.remove(os.path.join(path, LOCK))
     with contextlib.suppress(OSError):
         os.rmdir(path)
+
+
+def finish(path, keep=False, flag="keep_checkpoint=True", held=False):
+    """The one rule for the checkpoint of a run that finished (its entry point returned): it
+    is removed (:func:`remove`) unless ``keep``; a run that raised or was interrupted never
+    gets here, so its checkpoint stays for a resume. :func:`claim` applies it when a run
+    leaves its directory, :meth:`Launches.owned` when the last stage of a computation of
+    several has succeeded, and the command line once its outputs are written. Returns one
+    line saying what was done, naming ``flag`` (how the caller spells "keep"; a directory that
+    cannot be removed is kept and says why), or None when there is no directory. ``held``: this
+    process holds the directory's lock (:func:`remove`)."""
+    path = _fspath(path)
+    if not os.path.isdir(path):
+        return None
+    if keep:
+        return f"kept checkpoint {path} ({flag})"
+    try:
+        remove(path, held=held)
+    except OSError as exc:       # a read-only folder: the results stand all the same
+        return f"kept checkpoint {path} (it cannot be removed: {exc.strerror or exc})"
+    return f"removed checkpoint {path} (the run is complete; {flag} keeps it)"
 
 
 def check_target(path, resume=False, overwrite=False, cli=False,
@@ -317,7 +350,7 @@ def _check_finished(path):
 
 
 @contextlib.contextmanager
-def claim(path, resume=False, overwrite=False):
+def claim(path, resume=False, overwrite=False, keep=True):
     """Own the checkpoint directory ``path`` for one run (a context manager).
 
     Creates the directory, takes its lock at once or raises :class:`CheckpointLocked`
@@ -325,6 +358,11 @@ def claim(path, resume=False, overwrite=False):
     (:func:`check_target`), removes stray temporary files and, for a fresh start, any
     earlier checkpoint files (the state first, so that a kill midway leaves no state).
     The lock is released however the block ends (return, exception, KeyboardInterrupt).
+    With ``keep=False`` (what ``Run(keep_checkpoint=False)`` asks; the default here keeps,
+    since a bare claim does not say that a run finished) a block that ends without an
+    exception (the run finished) removes the checkpoint (:func:`finish`), still under the
+    lock, so that no other run can have taken the directory in between; an exception or
+    interruption always keeps it, and a read-only checkpoint (below) is only ever read.
 
     A ``resume`` of a checkpoint in a directory that cannot be written (read-only folder or
     mount) takes no lock and writes nothing: it is allowed when the checkpointed run is
@@ -342,6 +380,7 @@ def claim(path, resume=False, overwrite=False):
     except OSError as exc:
         raise CheckpointError(f"checkpoint {path!r} cannot be created: {_one_line(exc)}") from None
     lock = _lock_class()(os.path.join(path, LOCK), timeout=0)
+    finished = False
     try:
         lock.acquire()
     except filelock.Timeout:
@@ -365,10 +404,18 @@ def claim(path, resume=False, overwrite=False):
             for sub in _launch_dirs(path):                 # nor stale launches
                 remove(sub)
         yield path
+        finished = True
     finally:
         with contextlib.suppress(OSError):
             os.remove(os.path.join(path, OWNER))
+        if finished and not keep:     # under the lock: no other run can take it meanwhile
+            finish(path, held=True)
         lock.release()
+        if finished and not keep and os.path.isdir(path):
+            with contextlib.suppress(OSError):   # where the OS kept the held lock file
+                if os.name == "nt":
+                    os.remove(os.path.join(path, LOCK))
+                os.rmdir(path)
 
 
 # ---- reading ------------------------------------------------------------------------------
@@ -527,12 +574,16 @@ class Launches:
     is made (:func:`check_target`: no overwrite without ``overwrite``, no file, no foreign
     directory), and :meth:`owned` holds ``DIR``'s lock for the whole computation, so that a
     second computation on it is refused at once (:class:`CheckpointLocked`), and a fresh
-    start (no ``resume``) removes every earlier launch first. ``next()`` gives the keywords of
-    the next launch ({} without a directory)."""
+    start (no ``resume``) removes every earlier launch first. When the computation's last
+    launch has succeeded (the :meth:`owned` block ends without an exception) ``DIR`` is
+    removed, launches and all, unless ``keep`` (:func:`finish`); the launches themselves
+    always keep theirs until then. ``next()`` gives the keywords of the next launch ({}
+    without a directory)."""
 
-    def __init__(self, directory, resume=False, overwrite=False):
+    def __init__(self, directory, resume=False, overwrite=False, keep=False):
         self.directory = None if directory is None else _fspath(directory)
         self.resume, self.overwrite, self.count = bool(resume), bool(overwrite), 0
+        self.keep = bool(keep)
         if self.directory is not None:
             check_target(self.directory, self.resume, self.overwrite,
                          holds="directory of launch checkpoints")
@@ -549,7 +600,7 @@ class Launches:
         if self.directory is None:
             yield self
             return
-        with claim(self.directory, self.resume, self.overwrite):
+        with claim(self.directory, self.resume, self.overwrite, keep=self.keep):
             yield self
 
     def next(self):
@@ -557,5 +608,7 @@ class Launches:
             return {}
         path = os.path.join(self.directory, f"launch-{self.count:03d}")
         self.count += 1
-        # DIR's own claim applied the overwrite rule to every launch at once
-        return {"checkpoint": path, "resume": self.resume, "overwrite": False}   # Run's fields
+        # DIR's own claim applied the overwrite rule to every launch at once, and removes
+        # them all when the last one has succeeded: a launch keeps its own until then
+        return {"checkpoint": path, "resume": self.resume, "overwrite": False,
+                "keep_checkpoint": True}                                   # Run's fields

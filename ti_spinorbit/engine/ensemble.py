@@ -23,8 +23,8 @@ from typing import Callable, List, Optional
 import numpy as np
 
 from .. import layout, runtime
-from .._validate import (require_count, require_memory, require_order, require_positive,
-                         require_range, require_real)
+from .._validate import (require_bool, require_count, require_memory, require_order,
+                         require_positive, require_range, require_real)
 from ..kernels.controller import DEFAULT_CONTROLLER
 from ..model import models
 from ..model.perturbations import NACC, NPERT, out_of_plane_rows
@@ -300,8 +300,8 @@ class Ensemble:
     def run(self, t_stop, *, window_orbits=DEFAULT_WINDOW_ORBITS, sample_dt=None,
             indicators=False, separation=SHADOW_SEPARATION,
             progress: Optional[Callable[[float], None]] = None, checkpoint=None,
-            resume=False, overwrite_checkpoint=False, indicator_space="planar",
-            max_steps=None) -> RunOutput:
+            resume=False, overwrite_checkpoint=False, keep_checkpoint=False,
+            indicator_space="planar", max_steps=None) -> RunOutput:
         """Integrate every member to ``t_stop`` (scaled; scalar or per member).
 
         ``sample_dt`` (scaled) turns on the dense time series. ``progress(fraction)`` is
@@ -331,7 +331,9 @@ class Ensemble:
         damaged: ..."). The run holds the directory's lock throughout; a second run on it is
         refused at once (``CheckpointLocked``). Without ``resume`` a directory that holds a
         checkpoint is refused (``CheckpointExists``, nothing touched) unless
-        ``overwrite_checkpoint=True`` replaces it.
+        ``overwrite_checkpoint=True`` replaces it. A run that returns removes its checkpoint
+        unless ``keep_checkpoint=True``; one that raises or is interrupted keeps it for a
+        resume (``checkpoint.finish``).
 
         ``max_steps`` caps every member's accepted + rejected steps (default: the budget of
         :func:`ti_spinorbit.engine.cost.step_budget`, 100 times the most expensive member's
@@ -382,7 +384,8 @@ class Ensemble:
                 resume, settings, budget)
         if checkpoint is None:
             return self._windows(*args)
-        with ckpt.claim(checkpoint, resume=resume, overwrite=overwrite_checkpoint):
+        keep = require_bool("keep_checkpoint", keep_checkpoint)
+        with ckpt.claim(checkpoint, resume=resume, overwrite=overwrite_checkpoint, keep=keep):
             return self._windows(*args)
 
     def _windows(self, t_stop, window_orbits, sample_dt, indicators, separation, progress,

@@ -176,6 +176,11 @@ class Run:
     overwrite : bool
         Replace a checkpoint already in ``checkpoint`` when not resuming (refused by
         default).
+    keep_checkpoint : bool
+        Keep ``checkpoint`` when the run finishes (default: removed once the run returns; a
+        map or scan removes it after its last stage succeeded). A run that raises or is
+        interrupted always keeps it, so that ``resume=True`` continues it
+        (:func:`ti_spinorbit.engine.checkpoint.finish`; CLI ``--keep-checkpoint``).
     window_orbits : int
         Orbits per kernel launch, in [1, 1e6] (default 16): the interval of progress reports
         and checkpoints, and the size of the event buffers.
@@ -201,6 +206,7 @@ class Run:
     retries: int = DEFAULT_RETRIES
     worker_arch: Optional[str] = None
     worker_threads: Optional[int] = None
+    keep_checkpoint: bool = False
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -208,6 +214,7 @@ class Run:
         set_(self, "checkpoint", _checkpoint.check_path(self.checkpoint))   # a str or None
         set_(self, "resume", require_bool("resume", self.resume))
         set_(self, "overwrite", require_bool("overwrite", self.overwrite))
+        set_(self, "keep_checkpoint", require_bool("keep_checkpoint", self.keep_checkpoint))
         set_(self, "window_orbits", require_count("window_orbits", self.window_orbits, 1, 10**6))
         check_client(self.client)
         if self.chunk_size is not None:
@@ -226,10 +233,10 @@ class Run:
         return Run(progress=False, window_orbits=self.window_orbits)
 
     def checkpoint_keywords(self) -> dict:
-        """``checkpoint``, ``resume``, ``overwrite_checkpoint`` as ``Ensemble.run`` takes
-        them."""
+        """``checkpoint``, ``resume``, ``overwrite_checkpoint``, ``keep_checkpoint`` as
+        ``Ensemble.run`` takes them."""
         return dict(checkpoint=self.checkpoint, resume=self.resume,
-                    overwrite_checkpoint=self.overwrite)
+                    overwrite_checkpoint=self.overwrite, keep_checkpoint=self.keep_checkpoint)
 
 
 def run(run=None) -> Run:

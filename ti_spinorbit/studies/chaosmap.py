@@ -278,7 +278,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
-    launches = Launches(run.checkpoint, run.resume, run.overwrite)
+    launches = Launches(run.checkpoint, run.resume, run.overwrite, run.keep_checkpoint)
     indicator_space = check_indicator_space(indicator_space)
     tilt = _check_tilt(tilt, coordinates)
     perturbations = check_perturbations(perturbations)
@@ -518,7 +518,7 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     if max_drift is not None:
         accuracy.drift_limit(rtol, orbits, max_drift)        # checked before any work
     shorter = _fraction_lengths(orbits, fraction_orbits)
-    launches = Launches(run.checkpoint, run.resume, run.overwrite)
+    launches = Launches(run.checkpoint, run.resume, run.overwrite, run.keep_checkpoint)
     perturbations = check_perturbations(perturbations)
     if isinstance(system, str):
         name = system

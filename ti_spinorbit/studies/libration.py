@@ -430,7 +430,8 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
                   max_extent=max_extent, max_drift=max_drift, integrator=integrator,
                   coordinates=coordinates, perturbations=perturbations,
                   launch=Run(window_orbits=run.window_orbits),
-                  checkpoints=Launches(run.checkpoint, run.resume, run.overwrite))
+                  checkpoints=Launches(run.checkpoint, run.resume, run.overwrite,
+                                       run.keep_checkpoint))
     with search["checkpoints"].owned(), \
             _progress.reporting(run.progress, "relaxed_libration") as report:
         # progress: each search its share of the work, ∝ its length (rtol/10: ~1.6x the steps)

@@ -303,7 +303,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
                         f"(elongation) -> BinarySystem (got {type(system).__name__})")
     make, name = _factory(system, eccentricity)
     perturbations = check_perturbations(perturbations)
-    launches = Launches(run.checkpoint, run.resume, run.overwrite)
+    launches = Launches(run.checkpoint, run.resume, run.overwrite, run.keep_checkpoint)
     if elongations is not None and (np.ndim(elongations) != 1 or np.size(elongations) == 0):
         raise ValueError(f"elongations must be a non-empty 1-D array of a/b values in (1, 10] "
                          f"(got {show(elongations)})")
