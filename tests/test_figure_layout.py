@@ -236,6 +236,12 @@ def test_libration_three_panels(relaxed_libration, tmp_path):
     assert legend.y1 <= ax.xaxis.get_tightbbox(renderer).y0 + TOL
 
 
+@pytest.mark.parametrize("where", ["right", "inside"])
+def test_libration_legend_elsewhere(relaxed_libration, tmp_path, where):
+    ax = plotting.plot_libration(relaxed_libration, legend_loc=where)
+    _check(ax, tmp_path, f"libration_{where}", legends=2)
+
+
 def test_libration_alone_and_search(relaxed_libration, tmp_path):
     _check(relaxed_libration.plot(search=False), tmp_path, "libration_alone", legends=1)
     _check(plotting.plot_libration_search(relaxed_libration), tmp_path, "search", legends=1)

@@ -183,8 +183,8 @@ def _legend_outside(ax, where="right", **kwargs):
 
 
 def class_legend(ax, classes, where="right", **kwargs):
-    """A legend of the classes present (the paper's colours), titled "class", placed by
-    ``where`` as :func:`_legend_outside` does (outside the axes unless "inside")."""
+    """A legend of the classes present (the paper's colours), titled "class", at ``where``:
+    "right" of the axes, "below" them (under the x label) or "inside" them."""
     from matplotlib.lines import Line2D      # matplotlib: when a figure is drawn
 
     present = [c for c in CLASS_ORDER if c in set(map(str, classes))]
@@ -571,7 +571,7 @@ def plot_libration(result, ax=None, title=None, search=None, legend_loc="below")
                    label=rf"amplitude max $|\alpha|$ = {result.amplitude:.3g}°" if sign > 0 else None)
     ax.set_xlabel("time (orbital periods)")
     ax.set_ylabel(r"$\alpha$ (deg)")
-    _legend_outside(ax, legend_loc, ncol=2)
+    _legend_outside(ax, legend_loc, **({"ncol": 2} if legend_loc == "below" else {}))
     if title is None:
         system = [result.system] if result.system is not None else ()
         title = run_title(system, result.orbits, result.rtol,
