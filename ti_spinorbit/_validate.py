@@ -11,6 +11,7 @@ import os
 import numpy as np
 
 from .layout import multipole as _multipole_layout
+from . import units as _units
 
 #: require_memory refuses a request above this share of the available memory (the rest is
 #: left for the interpreter, Taichi and the operating system).
@@ -112,10 +113,14 @@ def _fmt(x):
     return f"{x:g}" if isinstance(x, float) else str(x)
 
 
-def require_real(name, value):
+def require_real(name, value, unit=None):
     """``value`` as a float, or TypeError naming the parameter unless it is ONE real number
     (int, float, NumPy real scalar or 0-d array): not text, None, bool, complex, a list or an
-    array of several values."""
+    array of several values. An astropy Quantity is converted to ``unit`` (a unit text of
+    :mod:`ti_spinorbit.units`: "m", "kg", "s", "deg", "(units of n)", ...; None or "" for
+    dimensionless), or refused in one line when its dimension does not fit."""
+    if _units.is_quantity(value):
+        value = _units.to_plain(name, value, "" if unit is None else unit)
     if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
         return float(value)
     if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
@@ -136,8 +141,11 @@ def require_scalar(name, value, low=-math.inf, high=math.inf, *, low_open=False,
                    high_open=False, unit=""):
     """``value`` as a float: one real number (:func:`require_real`, else TypeError), finite,
     in the interval (ends as flagged, else ValueError "<name> must lie in [low, high] <unit>
-    (got ...)"). Infinite ends only check finiteness."""
-    number = require_real(name, value)
+    (got ...)"). Infinite ends only check finiteness. A Quantity is converted to ``unit``
+    first (:func:`require_real`); a plain angle in degrees ("deg", "degrees") that looks
+    like radians gets the degree hint (:mod:`ti_spinorbit.units`)."""
+    value = _units.to_plain(name, value, unit)
+    number = require_real(name, value, unit)
     ok = math.isfinite(number)
     ok = ok and (number > low if low_open else number >= low)
     ok = ok and (number < high if high_open else number <= high)
@@ -154,7 +162,9 @@ def require_scalar(name, value, low=-math.inf, high=math.inf, *, low_open=False,
 
 def require_positive_scalar(name, value, low, high, unit=""):
     """One real number (TypeError otherwise) that is finite and > 0 (require_positive's
-    message) and lies in [low, high] (require_scalar's message); returns it as a float."""
+    message) and lies in [low, high] (require_scalar's message); returns it as a float,
+    a Quantity converted to ``unit`` first (:func:`require_real`)."""
+    value = _units.to_plain(name, value, unit)
     require_real(name, value)
     require_positive(name, value)
     return require_scalar(name, value, low, high, unit=unit)
@@ -196,8 +206,12 @@ def require_bool(name, value):
     return bool(value)
 
 
-def require_spin(name, value):
-    """Spin rates in units of n (scalar or array): finite with |value| <= MAX_SPIN."""
+def require_spin(name, value, system=None):
+    """Spin rates in units of n (scalar or array): finite with |value| <= MAX_SPIN. Returns
+    ``value``; a Quantity converted to units of n first (dimensionless, ``units.n``, or an
+    angular rate divided by the mean motion of ``system`` when there is one:
+    :func:`ti_spinorbit.units.to_plain`)."""
+    value = _units.to_plain(name, value, "n", system=system)
     arr = _as_floats(name, value)
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must be finite (got {show(value)})")
@@ -215,7 +229,10 @@ class InsufficientMemoryError(ValueError, MemoryError):
 
 def _as_floats(name, value):
     """``value`` as a float64 array, or TypeError naming the parameter (text is not a number,
-    even where NumPy would parse it)."""
+    even where NumPy would parse it). A Quantity must be dimensionless here (the callers
+    that take a unit convert it first), else :class:`~ti_spinorbit.units.UnitMismatchError`."""
+    if _units.is_quantity(value):
+        value = _units.to_plain(name, value, "")
     try:
         kind = np.asarray(value).dtype.kind
     except (TypeError, ValueError):                    # ragged nesting
