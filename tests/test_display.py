@@ -194,3 +194,133 @@ def test_system_repr_says_when_densities_were_scaled_to_a_period():
     text = repr(s)
     assert "P_orb 11 h" in text and "scaled ×" in text and "to match P_orb" in text
     assert "scaled" not in repr(d)
+
+
+# ---- helper results: classification, overlap decisions, conservation, status names --------
+
+def assert_short(text, lines=MAX_LINES):
+    assert len(text) <= MAX_CHARS, (len(text), text)
+    assert len(text.splitlines()) <= lines, text
+    assert "array(" not in text and "{" not in text, text
+
+
+def test_classification_repr_counts_labels_not_arrays(big_section):
+    """classify_section() printed ~200 lines of arrays; now members per label and ranges."""
+    c = tso.classify_section(big_section)
+    text = repr(c)
+    assert_short(text)
+    assert text.startswith("<SectionClassification>\n") and "members 1024" in text
+    labels, n = np.unique(c.classification, return_counts=True)
+    for label, k in zip(labels, n):
+        assert f"{label} {k}" in text, (label, text)
+    assert f"section points {display.span(c.count, 'g')}" in text
+    page = c._repr_html_()
+    assert page.startswith("<table><caption>SectionClassification</caption>")
+
+
+def test_classification_names_its_resonances():
+    c = SimpleClassification(["resonant", "resonant", "chaotic"], [1.0, 1.5, np.nan])
+    text = repr(c)
+    assert "resonances 1:1 (1), 3:2 (1)" in text and "resonant 2, chaotic 1" in text
+
+
+def SimpleClassification(labels, p):
+    from ti_spinorbit.studies.classify import SectionClassification
+
+    n = len(labels)
+    nan = np.full(n, np.nan)
+    return SectionClassification(
+        classification=np.array(labels, dtype=object),
+        classification_geometric=np.array(labels, dtype=object), resonance_p=np.array(p),
+        libration_centre_deg=nan, libration_half_extent_deg=nan, libration_centre_thetadot=nan,
+        mean_thetadot=nan, largest_gap_deg=nan, order_ratio=np.array([0.05, 0.06, 0.6]),
+        count=np.array([100, 100, 90]), megno=nan)
+
+
+def test_overlap_decision_is_one_line_with_its_verdict(overlap_scan):
+    d = overlap_scan.decisions[0]
+    text = repr(d)
+    assert "\n" not in text and len(text) <= 250, text
+    assert text.startswith("<OverlapDecision a/b 1.01,") and text.endswith(">")
+    assert f"ω0 {d.omega0:.4g} n" in text
+    assert ("verdict overlap" if d.overlap else "verdict separate") in text
+    assert f"inaccurate {d.inaccurate}" in text
+    # the scan's list of decisions prints one line per decision
+    assert repr(overlap_scan.decisions).count("<OverlapDecision") == 2
+    assert len(repr(overlap_scan.decisions)) <= 2 * 250 + 4
+    page = d._repr_html_()
+    assert "<caption>OverlapDecision</caption>" in page and "1:1 centre" in page
+
+
+def test_conservation_is_a_small_result_that_still_unpacks(time_series):
+    c = time_series.conservation(1)
+    text = repr(c)
+    assert_short(text, lines=4)
+    assert text.startswith("<Conservation>\n") and "member 1" in text
+    assert f"samples {c.samples}" in text and "orbits" in text
+    assert display.sci(c.energy_drift) in text and display.sci(c.angmom_drift) in text
+    # the data stay reachable: attributes, the dict, the per-sample series, and the old pair
+    numbers, (t, de, dl, parts) = c
+    assert numbers == c.numbers and numbers["energy_drift"] == c.energy_drift == c["energy_drift"]
+    assert c[0] == numbers and len(c) == 2
+    assert t.shape == de.shape == dl.shape == parts["orbit"].shape == (c.samples,)
+    assert c.energy_drift == float(np.max(np.abs(de)))
+    assert "<caption>Conservation</caption>" in c._repr_html_()
+
+
+def test_conservation_plot_draws_plot_conservation(time_series):
+    import matplotlib.pyplot as plt
+
+    c = time_series.conservation(0)
+    ax = c.plot(title="member 0")
+    try:
+        fig = ax.figure
+        assert len(fig.axes) == 2 and ax.get_title() == "member 0"
+        assert len(ax.lines) >= 2 and len(ax.lines[0].get_xdata()) == c.samples
+    finally:
+        plt.close("all")
+
+
+def test_a_spheres_spin_exchange_prints_as_zero(time_series):
+    """1991 VH has a spherical primary: its spin energy exchange is round-off (1e-37 of
+    |E0|) and prints as 0, while the data keep the computed value."""
+    c = time_series.conservation(0)
+    assert 0 < c.exchange_primary < 1e-20 and c.exchange_orbit > 1e-6
+    assert "primary spin 0," in repr(c)
+    assert display.sci(c.exchange_orbit) in repr(c)
+
+
+def test_negligible_is_relative_to_the_values_beside_it():
+    assert display.negligible([2.3e-3, 9.4e-37, 2.3e-3]) == [2.3e-3, 0.0, 2.3e-3]
+    assert display.negligible([1e-13, 1e-14]) == [1e-13, 1e-14]     # alike: both kept
+    assert display.negligible([5e-14, 1.0], scale=400.0) == [0.0, 1.0]
+    nan = float("nan")
+    kept = display.negligible([nan, 1e-30])
+    assert np.isnan(kept[0]) and kept[1] == 1e-30                   # nothing to compare with
+    assert display.sci(0.0) == "0" and display.sci(2.274e-3) == "2.274e-03"
+
+
+def test_status_names_print_on_one_line(big_section):
+    names = big_section.status_names
+    assert names == ["done"] * 1024 and isinstance(names, list)    # still a plain list
+    text = repr(names)
+    assert "\n" not in text and len(text) < 120, text
+    assert "1024 items: done 1024" in text
+    mixed = display.Names(["done"] * 1020 + ["inaccurate"] * 4)
+    assert repr(mixed) == ("['done', 'done', 'done', …, 'inaccurate', 'inaccurate'] "
+                           "(1024 items: done 1020, inaccurate 4)")
+    assert repr(display.Names(["done", "collision"])) == "['done', 'collision']"
+
+
+def test_fields_print_a_description_without_dict_reprs():
+    lines = display.fields({"name": "x", "primary": {"bounding_radius_m": 400.0,
+                                                     "offset_m": [1.2e-14, -5e-15, 3e-14],
+                                                     "semi_axes_m": [400.0, 400.0, 400.0]},
+                            "rotation": [[1.0, -1.3e-14, 0.0], [1.3e-14, 1.0, 0.0],
+                                         [0.0, 0.0, 1.0]],
+                            "period_s": None, "e": 0.05000000001})
+    text = "\n".join(lines)
+    assert "{" not in text and "[" not in text, text
+    assert "  offset_m" in text and "0 × 0 × 0" in text         # round-off of a 400 m body
+    assert "400 × 400 × 400" in text and "(1, 0, 0), (0, 1, 0), (0, 0, 1)" in text
+    assert "period_s                 —" in text and "e                        0.05" in text

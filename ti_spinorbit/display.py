@@ -50,6 +50,155 @@ def counts(mapping):
     return ", ".join(f"{k} {v}" for k, v in items)
 
 
+#: Relative size below which a value printed beside others is round-off and prints as 0.
+ROUNDOFF = 1e-12
+
+
+def negligible(values, scale=None, rel=ROUNDOFF):
+    """``values`` (floats) with every one whose magnitude is below ``rel`` times ``scale``
+    (default: the largest finite magnitude among them) set to 0.0: numbers printed side by
+    side, of which some are round-off (a sphere's spin energy exchange, 1e-37 of the total,
+    beside the orbit's 1e-3). Non-finite values are kept; the data are never changed, only
+    what is printed."""
+    values = [float(v) for v in values]
+    finite = [abs(v) for v in values if math.isfinite(v)]
+    if scale is None:
+        scale = max(finite, default=0.0)
+    scale = abs(float(scale))
+    return [0.0 if math.isfinite(v) and abs(v) < rel * scale else v for v in values]
+
+
+def sci(x, digits=3):
+    """A float in scientific notation (``2.274e-03``), plain "0" when it is exactly zero
+    (as :func:`negligible` makes round-off)."""
+    if x is not None and float(x) == 0.0:
+        return "0"
+    return number(x, f".{digits}e")
+
+
+def items(values, limit=6, spec=None):
+    """A sequence as a short text: all of it when it has at most ``limit`` items, else its
+    first and last items, "…" and the count, with a count of the distinct values when they
+    are few (``['done', 'done', …, 'inaccurate'] (1024 items: done 1020, inaccurate 4)``)."""
+    values = list(values)
+
+    def show(v):
+        return number(v, spec) if spec and isinstance(v, (int, float, np.number)) else repr(v)
+
+    if len(values) <= limit:
+        return "[" + ", ".join(show(v) for v in values) + "]"
+    first = max(limit // 2, 1)
+    last = max(limit - first - 1, 1)
+    text = ("[" + ", ".join(show(v) for v in values[:first]) + ", …, "
+            + ", ".join(show(v) for v in values[-last:]) + "]")
+    try:
+        distinct = {}
+        for v in values:
+            distinct[v] = distinct.get(v, 0) + 1
+    except TypeError:                     # unhashable items: the count only
+        distinct = {}
+    if 0 < len(distinct) <= MAX_DISTINCT:
+        return f"{text} ({len(values)} items: {counts({str(k): n for k, n in distinct.items()})})"
+    return f"{text} ({len(values)} items)"
+
+
+def fields(mapping, width=24, indent="", length_scale=None):
+    """Lines of a nested mapping (a ``describe()``) as a two-column table: numbers in
+    ``.6g``, None as "—", lists of numbers joined with "×" when they are three (semi-axes)
+    or ", ", a nested mapping as an indented block under its key, a long list by
+    :func:`items`. No Python dict or list reprs.
+
+    Round-off prints as 0 (:func:`negligible`, ``ROUNDOFF`` = 1e-12 relative): in a block
+    with a ``bounding_radius_m`` (a body), lengths (keys ending in ``_m``) below 1e-12 of it
+    (a polyhedron's centroid offset of 1e-14 m); in a list of numbers (a rotation matrix),
+    entries below 1e-12 of its largest."""
+    if isinstance(mapping.get("bounding_radius_m"), (int, float)):
+        length_scale = float(mapping["bounding_radius_m"])
+    lines = []
+    for key, value in mapping.items():
+        label = f"{indent}{key}"
+        if isinstance(value, dict):
+            lines.append(label)
+            lines.extend(fields(value, width, indent + "  ", length_scale))
+        elif isinstance(value, (list, tuple)) and value and all(isinstance(v, dict) for v in value):
+            lines.append(f"{label:{width}s} {len(value)} items")
+            for k, v in enumerate(value):
+                lines.append(f"{indent}  [{k}]")
+                lines.extend(fields(v, width, indent + "    ", length_scale))
+        else:
+            scale = length_scale if str(key).endswith("_m") else None
+            lines.append(f"{label:{width}s} {_field(_rounded(value, scale))}")
+    return lines
+
+
+def _numbers(value):
+    """The floats of a number or a nested list of numbers, else None."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float, np.number)):
+        return [float(value)]
+    if isinstance(value, (list, tuple, np.ndarray)) and len(value):
+        parts = [_numbers(v) for v in value]
+        return None if any(p is None for p in parts) else [x for p in parts for x in p]
+    return None
+
+
+def _rounded(value, scale=None):
+    """``value`` with its round-off set to 0 (:func:`negligible`): against ``scale`` when
+    given, else against the largest magnitude of a list (a lone number is kept)."""
+    flat = _numbers(value)
+    if flat is None or (scale is None and len(flat) < 2):
+        return value
+    zeroed = iter(negligible(flat, scale))
+
+    def rebuild(v):
+        if isinstance(v, (list, tuple, np.ndarray)):
+            return [rebuild(x) for x in v]
+        x = next(zeroed)
+        return 0 if x == 0.0 else (v if isinstance(v, (int, np.integer)) else x)
+
+    return rebuild(value)
+
+
+def _field(value):
+    if value is None:
+        return "—"
+    if isinstance(value, bool) or isinstance(value, str):
+        return str(value)
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    if isinstance(value, (float, np.floating)):
+        return number(value, ".6g")
+    if isinstance(value, (list, tuple, np.ndarray)):
+        values = list(np.ravel(value)) if isinstance(value, np.ndarray) else list(value)
+        if len(values) > MAX_FIELD_ITEMS:
+            return items(values, spec=".6g")
+        if values and all(isinstance(v, (list, tuple, np.ndarray)) for v in values):
+            return ", ".join("(" + ", ".join(_field(x) for x in v) + ")" for v in values)
+        joiner = " × " if len(values) == 3 and all(
+            isinstance(v, (int, float, np.number)) for v in values) else ", "
+        return joiner.join(_field(v) for v in values) if values else "—"
+    return str(value)
+
+
+#: Longest list :func:`fields` shows item by item.
+MAX_FIELD_ITEMS = 8
+#: Most distinct values a long sequence's summary counts one by one.
+MAX_DISTINCT = 8
+
+
+class Names(list):
+    """A list (of status names, labels) whose repr stays one line however long it is: the
+    first and last items and the count of each distinct value (:func:`items`). It is a
+    plain ``list`` in every other way (equality, indexing, ``json``, ``numpy.array``)."""
+
+    def __repr__(self):
+        return items(self)
+
+    def _repr_pretty_(self, p, cycle):     # IPython's pretty printer would list every item
+        p.text(repr(self))
+
+
 def span(values, spec=".3g"):
     """Range of an array as "lo–hi" (ignoring NaN), "lo" when constant, "—" when empty/NaN."""
     values = np.asarray(values, dtype=np.float64).ravel()
@@ -256,8 +405,77 @@ def _libration(r):
     return "RelaxedLibration", lines
 
 
-#: Summaries of the inputs, by class name (a class or one of its bases).
-_SUMMARIES = {"Body": _body, "BinarySystem": _system}
+# ---- helper results (not archived results: summarised by class name) ----------------------
+def _classification(c):
+    labels = np.asarray(c.classification)
+    n = int(labels.size)
+    lines = [[("members", str(n)),
+              ("classes", counts({k: v for k, v in c.counts().items() if v}))]]
+    p = np.asarray(c.resonance_p, dtype=np.float64)
+    p = p[np.isfinite(p)]
+    if p.size:
+        found = {}
+        for value in p:
+            found[_resonance(value)] = found.get(_resonance(value), 0) + 1
+        lines.append([("resonances", ", ".join(f"{k} ({v})" for k, v in
+                                               sorted(found.items(), key=lambda kv: -kv[1])))])
+    row = [("section points", span(c.count, "g")), ("order ratio", span(c.order_ratio))]
+    megno = np.asarray(c.megno, dtype=np.float64)
+    if np.isfinite(megno).any():
+        row.append(("⟨Y⟩", span(megno)))
+    lines.append(row)
+    confined = np.asarray(c.libration_half_extent_deg, dtype=np.float64)
+    if np.isfinite(confined).any():
+        lines.append([("libration half extent", f"{span(confined)} deg"),
+                      ("centre θ̇_p/n", span(c.libration_centre_thetadot))])
+    return "SectionClassification", lines
+
+
+def _resonance(p):
+    """p of a p:1 resonance as "1:1", "3:2", "2:1", "1:2"."""
+    for q in (1, 2, 3, 4):
+        if abs(p * q - round(p * q)) < 1e-9:
+            return f"{int(round(p * q))}:{q}"
+    return f"{number(p, '.3g')}:1"
+
+
+def _decision(d):
+    verdict = "overlap" if d.overlap else "separate"
+    if d.megno_overlap is not None and bool(d.megno_overlap) != bool(d.overlap):
+        verdict += f" (MEGNO says {'overlap' if d.megno_overlap else 'separate'})"
+    lines = [[("a/b", number(d.elongation, ".4g")), ("ω0", f"{number(d.omega0, '.4g')} n"),
+              ("verdict", verdict)],
+             [("1:1 centre", f"{number(d.centre_1, '.4g')} n"),
+              ("3:2 centre", f"{number(d.centre_3_2, '.4g')} n"
+               + ("" if d.centre_3_2_found else " (not found)"))]]
+    if d.connecting_start is not None:
+        lo, hi = d.connecting_range
+        lines.append([("connecting start", f"{number(d.connecting_start, '.4g')} n"),
+                      ("θ̇_p/n range", f"{number(lo, '.4g')}–{number(hi, '.4g')}"),
+                      ("⟨Y⟩", number(d.connecting_megno, ".3g"))])
+    row = [("orbits", number(d.orbits, "g")), ("inaccurate", str(d.inaccurate)),
+           ("max energy drift", number(d.max_energy_drift, ".2g"))]
+    lines.append(row)
+    return "OverlapDecision", lines
+
+
+def _conservation(c):
+    exchange = negligible([c.exchange_orbit, c.exchange_primary, c.exchange_secondary])
+    t = np.asarray(c.t, dtype=np.float64)
+    period = float(c.orbital_period) if c.orbital_period is not None else math.nan
+    orbits = math.isfinite(period) and period > 0
+    lines = [[("member", str(c.member)), ("samples", str(c.samples)),
+              ("t", f"{span(t / period if orbits else t)} {'orbits' if orbits else 's'}")],
+             [("max |ΔE|/|E0|", sci(c.energy_drift)), ("max |ΔL|/|L0|", sci(c.angmom_drift))],
+             [("largest exchange |ΔE_i|/|E0|",
+               f"orbit {sci(exchange[0])}, primary spin {sci(exchange[1])}, "
+               f"secondary spin {sci(exchange[2])}")]]
+    return "Conservation", lines
+
+
+#: Summaries of the inputs and helper results, by class name (a class or one of its bases).
+_SUMMARIES = {"Body": _body, "BinarySystem": _system, "SectionClassification": _classification,
+              "OverlapDecision": _decision, "Conservation": _conservation}
 #: Summaries of results, by the kind each result class declares (``Result.kind``).
 _RESULT_SUMMARIES = {"section": _section, "time_series": _time_series,
                      "chaos_map": _chaos_map, "parameter_map": _parameter_map,
@@ -285,15 +503,19 @@ def summary(obj):
 
 def _perturbations(items):
     """"tides on the secondary ×1e+06, byorp ×1e+06": kind, body, strength."""
-    return ", ".join(f"{p.kind}" + ("" if p.kind in ("byorp", "solar_tide") else f" on the {p.body}")
+    return ", ".join(f"{p.kind}" + ("" if p.kind == "byorp" or p.body == "both"
+                                     else f" on the {p.body}")
                      + ("" if p.strength == 1 else f" ×{p.strength:g}") for p in items)
 
 
-def text(obj):
-    """A ``__repr__`` of at most a few short lines."""
+def text(obj, one_line=False):
+    """A ``__repr__`` of at most a few short lines; ``one_line``: the same on one line, the
+    lines separated by ";" (for objects that come in lists, as a scan's decisions)."""
     title, lines = summary(obj)
-    body = ["  " + ", ".join(f"{k} {v}" for k, v in line) for line in lines if line]
-    return "\n".join([f"<{title}>"] + body)
+    body = [", ".join(f"{k} {v}" for k, v in line) for line in lines if line]
+    if one_line:
+        return f"<{title} " + "; ".join(body) + ">"
+    return "\n".join([f"<{title}>"] + ["  " + line for line in body])
 
 
 def html(obj):
@@ -315,3 +537,11 @@ class Readable:
 
     def _repr_html_(self):
         return html(self)
+
+
+class ReadableLine(Readable):
+    """:class:`Readable` with a one-line ``__repr__`` (:func:`text` ``one_line``): for what
+    comes in lists, where a list of several-line reprs would be hard to read."""
+
+    def __repr__(self):
+        return text(self, one_line=True)

@@ -7,6 +7,7 @@ import sys
 import numpy as np
 
 from .. import time_series
+from ..display import negligible, sci
 from ..system import catalog
 from .common import (EXIT_CHECK_FAILED, EXIT_OK, build_system, catalogue_name,
                      check_figure_outputs, check_system_flags, entry_options, finish_checkpoint,
@@ -50,6 +51,15 @@ def check(args):
     check_system_flags(args)
     check_perturbation_flags(args)
     check_figure_outputs(args)
+
+
+def _exchange_line(numbers):
+    """The orbit/spin energy exchange, |ΔE_i|/|E0|; an exchange below 1e-12 of the largest
+    is round-off and prints as 0 (a sphere's spin: 1e-37; display.negligible)."""
+    orbit, primary, secondary = negligible([numbers["exchange_orbit"], numbers["exchange_primary"],
+                                            numbers["exchange_secondary"]])
+    return (f"  largest exchange, |ΔE_i|/|E0|: orbit {sci(orbit)}, primary spin {sci(primary)}, "
+            f"secondary spin {sci(secondary)}")
 
 
 def energy_check(ts, member=0):
@@ -103,8 +113,7 @@ def run(args):
         f"samples, status {status}",
         f"  max relative energy drift           {numbers['energy_drift']:.3e}",
         f"  max relative angular-momentum drift {numbers['angmom_drift']:.3e}",
-        "  largest exchange, |ΔE_i|/|E0|: orbit {exchange_orbit:.3e}, primary spin "
-        "{exchange_primary:.3e}, secondary spin {exchange_secondary:.3e}".format(**numbers),
+        _exchange_line(numbers),
         *([] if ts.work is None else [_work_line(ts)]),
         f"wrote {out} and {data}", *filter(None, [finish_checkpoint(args, data)]))
     if not worst <= args.max_drift:          # also catches NaN

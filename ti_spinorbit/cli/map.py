@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..display import counts
 from ..studies.chaosmap import chaos_map
 from .common import (accuracy_status, build_system, check_figure_outputs, check_system_flags,
                      entry_options, finish_checkpoint, init_taichi, output_paths, progress_bar,
@@ -65,7 +66,7 @@ def run(args):
     counted = "all finished members" if args.allow_inaccurate else \
         f"{cmap.n_inaccurate} inaccurate left out"
     say(args, f"{system.name}: {nt} x {nd} map, {args.orbits:g} orbits: chaotic fraction "
-              f"{cmap.chaotic_fraction:.3f} ({counted}; statuses {cmap.status_counts}) in "
+              f"{cmap.chaotic_fraction:.3f} ({counted}; statuses: {counts(cmap.status_counts)}) in "
               f"{cmap.seconds:.1f} s; largest energy drift {np.nanmax(cmap.energy_drift):.1e}"
               f" (limit {cmap.max_drift:.1e}); wrote {out} and {data}")
     say(args, f"  {cmap.fraction_message}", *filter(None, [finish_checkpoint(args, data)]))

@@ -80,11 +80,13 @@ def run(args):
     out, data = write_outputs(scan, data, {"command": args.command_line,
                                            "converged": scan.converged,
                                            "convergence": scan.message}, scan.plot, out)
-    bound = "" if scan.converged else " (upper bound: not converged)"
-    say(args, f"{scan.name} (e = {scan.eccentricity}): first overlap at a/b = {scan.first_overlap}"
-              f"{bound} (analytic {scan.elongation_ro:.4f}; MEGNO criterion "
-              f"{scan.megno_first_overlap}) in {scan.seconds:.1f} s, "
-              f"{scan.member_orbits:.3g} member-orbits; wrote {out} and {data}")
+    bound = "" if scan.converged or scan.first_overlap is None else \
+        " (upper bound: not converged)"
+    say(args, f"{scan.name} (e = {scan.eccentricity:g}): first overlap at a/b = "
+              f"{_elongation(scan.first_overlap)}{bound} (analytic {scan.elongation_ro:.4f}; "
+              f"MEGNO criterion {_elongation(scan.megno_first_overlap)}) in "
+              f"{scan.seconds:.1f} s, {scan.member_orbits:.3g} member-orbits; wrote {out} and "
+              f"{data}")
     say(args, *scan.evidence())
     for d in scan.decisions:
         extra = f", connecting <Y> = {d.connecting_megno:.1f}" if d.overlap else ""
@@ -92,3 +94,8 @@ def run(args):
         say(args, f"  a/b = {d.elongation:.2f}: {'overlap' if d.overlap else 'separate'}{extra}")
     sec = scan.sections
     return accuracy_status(args, sec.status, sec.energy_drift, scan.max_drift, "trajectories")
+
+
+def _elongation(q):
+    """An a/b threshold as printed: "1.23", or "none in the scan" (None)."""
+    return "none in the scan" if q is None else f"{q:.4g}"

@@ -1,5 +1,6 @@
 """``ti-spinorbit systems``: list the catalogued systems, or show one (a name or a file)."""
 
+from ..display import fields
 from ..files import write_json   # atomic: a killed write leaves no partial file
 from ..system import catalog
 from .common import check_output, check_system_flags, is_system_file, load_system_file, say
@@ -44,9 +45,9 @@ def run(args):
             else catalog.system(args.show)
         if args.out:
             write_json(args.out, system.describe(), indent=1)
-        if not args.quiet:
-            for k, v in system.describe().items():
-                print(f"{k:24s} {v}")
+        if not args.quiet:               # a table: nested entries indented, no dict reprs
+            for line in fields(system.describe()):
+                print(line)
         return 0
     systems = [catalog.system(name) for name in catalog.names()]
     if args.out:

@@ -170,8 +170,11 @@ class Result:
     @property
     def status_names(self):
         """Each member's status as text ("done", "inaccurate", "collision", ...), a list in
-        the order (and, flattened, the shape) of ``status``."""
-        return [STATUS_NAMES[s] for s in self._status_array().ravel()]
+        the order (and, flattened, the shape) of ``status``; it prints on one line, however
+        many members (:class:`ti_spinorbit.display.Names`)."""
+        from ..display import Names      # the display module: no engine imports, no cycle
+
+        return Names(STATUS_NAMES[s] for s in self._status_array().ravel())
 
     @property
     def status_counts(self) -> dict:

@@ -88,6 +88,7 @@ from typing import ClassVar, Dict
 
 import numpy as np
 
+from .. import display as _display
 from .._validate import require_count, require_positive, require_range
 from ..engine.accuracy import usable
 from ..model.analytic import _decoupled_half_orbit, omega0_effective
@@ -123,9 +124,11 @@ _PAD = 8
 _EXACT_PAIRS_MAX = 2000
 
 
-@dataclass
-class SectionClassification:
-    """Per-member classification of a surface of section (arrays of length N).
+@dataclass(repr=False)
+class SectionClassification(_display.Readable):
+    """Per-member classification of a surface of section (arrays of length N). Printed, a
+    few lines (members per label, resonances, ranges; :mod:`ti_spinorbit.display`), never
+    the arrays.
 
     ``classification`` one of "resonant", "quasi-periodic", "chaotic", "undetermined";
     ``classification_geometric`` the same from the section points alone (before any MEGNO);

@@ -69,10 +69,11 @@ LIBRATION_LIMIT_DEG = 80.0
 
 
 @record
-@dataclass
-class OverlapDecision:
+@dataclass(repr=False)
+class OverlapDecision(_display.ReadableLine):
     """Evidence for one elongation: island centres (units of n), and the trajectory that
     connects them (index into the separatrix column, its start and its θ̇_p range) or None.
+    Printed, one line (:mod:`ti_spinorbit.display`).
     ``inaccurate``: starts at this elongation whose conservation drift exceeded the limit
     (excluded from the decision unless the scan includes them); ``max_energy_drift`` the
     largest relative energy drift among its starts."""

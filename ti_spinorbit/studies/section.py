@@ -430,6 +430,67 @@ def _state_property(name, shape, doc):
     return property(lambda self: self._state(name, shape), doc=doc)
 
 
+@dataclass(repr=False, eq=False)
+class Conservation(_display.Readable):
+    """Conservation check of one member of a time series (:meth:`TimeSeriesResult.conservation`):
+    prints as a few lines, draws with :meth:`plot`, and unpacks as the ``(numbers, series)``
+    pair it replaces (``numbers, (t, de, dl, parts) = ts.conservation(0)``).
+
+    ``energy_drift``, ``angmom_drift`` the largest relative drift of the total energy
+    (ΔE/|E0|) and of the total angular-momentum vector (|ΔL|/|L0|) over the samples;
+    ``exchange_orbit``, ``exchange_primary``, ``exchange_secondary`` the largest change of
+    each energy part relative to |E0|; ``samples`` the samples used; ``t`` their times (s),
+    ``de``, ``dl`` the drifts and ``parts`` {part: ΔE_part/|E0|} per sample; ``numbers`` and
+    ``series`` the dict and tuple of before. Printed, an exchange below 1e-12 of the largest
+    one is round-off and shows as 0 (:func:`ti_spinorbit.display.negligible`); the numbers
+    themselves are kept as computed."""
+
+    member: int
+    energy_drift: float
+    angmom_drift: float
+    exchange_orbit: float
+    exchange_primary: float
+    exchange_secondary: float
+    samples: int
+    t: np.ndarray
+    de: np.ndarray
+    dl: np.ndarray
+    parts: dict
+    orbital_period: float = float("nan")
+    result: "TimeSeriesResult" = None
+
+    @property
+    def numbers(self) -> dict:
+        """The numbers as a dict (what the CLI writes to its data file's metadata)."""
+        return {"energy_drift": self.energy_drift, "angmom_drift": self.angmom_drift,
+                "exchange_orbit": self.exchange_orbit, "exchange_primary": self.exchange_primary,
+                "exchange_secondary": self.exchange_secondary, "samples": self.samples}
+
+    @property
+    def series(self) -> tuple:
+        """(t s, ΔE/|E0|, |ΔL|/|L0|, {part: ΔE_part/|E0|}) per sample."""
+        return self.t, self.de, self.dl, self.parts
+
+    def __iter__(self):        # numbers, series = ts.conservation(member)
+        return iter((self.numbers, self.series))
+
+    def __len__(self):
+        return 2
+
+    def __getitem__(self, key):
+        """``[0]`` the numbers, ``[1]`` the series (the pair of before); a name, one number."""
+        if isinstance(key, str):
+            return self.numbers[key]
+        return (self.numbers, self.series)[key]
+
+    def plot(self, title=None):
+        """The conservation figure of this member
+        (:func:`ti_spinorbit.output.plotting.plot_conservation`). Returns the top Axes."""
+        if self.result is None:
+            raise ValueError("this conservation check has no time series to plot")
+        return self.result.plot_conservation(member=self.member, title=title)
+
+
 @dataclass(repr=False)
 class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
@@ -554,15 +615,17 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
         against time (:func:`ti_spinorbit.output.plotting.plot_conservation`). Returns the top Axes."""
         return self._figure("conservation", member=member, title=title)
 
-    def conservation(self, member=0):
+    def conservation(self, member=0) -> Conservation:
         """Conservation numbers of one member: the largest relative drift of the total energy
         and of the total angular-momentum vector over its samples, and the largest change of
         each energy part relative to |E0| (the orbit/spin exchange). With perturbations the
         totals are E − W and L − L_ext (``work``, ``external_angmom``; docs/physics.md §13.4).
 
-        Returns (numbers, series): ``numbers`` a dict of floats ("energy_drift",
-        "angmom_drift", "exchange_orbit", "exchange_primary", "exchange_secondary") and
-        "samples"; ``series`` (t s, ΔE/|E0|, |ΔL|/|L0|, {part: ΔE_part/|E0|}) per sample."""
+        Returns a :class:`Conservation`: a few lines when printed, ``.plot()`` draws
+        :meth:`plot_conservation`; the numbers are attributes (``energy_drift``,
+        ``angmom_drift``, ``exchange_orbit``, ``exchange_primary``, ``exchange_secondary``,
+        ``samples``) and it unpacks as ``numbers, (t, de, dl, parts)``: a dict of those and
+        (t s, ΔE/|E0|, |ΔL|/|L0|, {part: ΔE_part/|E0|}) per sample."""
         member = require_count("member", member, 0, len(self.t) - 1)
         ok = np.isfinite(self.t[member])
         t = self.t[member][ok]
@@ -577,10 +640,13 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
         dl = np.linalg.norm(angmom - angmom[0], axis=1) / l0
         parts = {k: (getattr(self, f"energy_{k}")[member][ok] - getattr(self, f"energy_{k}")[member][ok][0])
                  / abs(e0) for k in ("orbit", "primary", "secondary")}
-        numbers = {"energy_drift": float(np.max(np.abs(de))), "angmom_drift": float(np.max(dl)),
-                   **{f"exchange_{k}": float(np.max(np.abs(v))) for k, v in parts.items()},
-                   "samples": int(len(t))}
-        return numbers, (t, de, dl, parts)
+        systems = getattr(self, "systems", None) or ()
+        period = float(systems[member].orbital_period) if len(systems) > member else float("nan")
+        return Conservation(member=member, energy_drift=float(np.max(np.abs(de))),
+                            angmom_drift=float(np.max(dl)),
+                            **{f"exchange_{k}": float(np.max(np.abs(v))) for k, v in parts.items()},
+                            samples=int(len(t)), t=t, de=de, dl=dl, parts=parts,
+                            orbital_period=period, result=self)
 
 
 def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
