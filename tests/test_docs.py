@@ -1,7 +1,9 @@
-"""The documentation site builds with warnings as errors, quickly: the gallery's
-pages are generated but its examples are not executed (``-D plot_gallery=0``; CI's full build
-in .ci/run executes them). The build runs on a copy of docs/ and examples/ in a temporary
-folder, so the checkout gains no generated files."""
+"""The documentation site builds with warnings as errors and every cross-reference resolved
+(``nitpicky``, intersphinx from the inventories in docs/_intersphinx/), quickly: the
+gallery's pages are generated but its examples are not executed (``-D plot_gallery=0``; CI's
+full build in .ci/run executes them), while the notebook (docs/notebook.ipynb, tiny runs) is
+executed and must show every figure. The build runs on a copy of docs/ and examples/ in a
+temporary folder, so the checkout gains no generated files."""
 
 import importlib.util
 import os
@@ -15,7 +17,8 @@ import pytest
 import ti_spinorbit as tso
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TOOLS = ["sphinx", "numpydoc", "pydata_sphinx_theme", "sphinx_gallery", "myst_parser"]
+TOOLS = ["sphinx", "numpydoc", "pydata_sphinx_theme", "sphinx_gallery", "myst_parser", "myst_nb",
+         "ipykernel"]
 MISSING = [name for name in TOOLS if importlib.util.find_spec(name) is None]
 GENERATED = ("_build", "auto_examples", "generated", "sg_execution_times.rst")
 
@@ -47,7 +50,8 @@ def site(tmp_path_factory):
 def test_the_site_builds_with_warnings_as_errors(site):
     index = (site / "index.html").read_text(encoding="utf-8")
     for page in ("auto_examples/index.html", "api/index.html", "physics.html", "design.html",
-                 "dask.html"):
+                 "dask.html", "install.html", "notebook.html", "cli.html", "statuses.html",
+                 "units.html", "extending.html"):
         assert (site / page).is_file(), page
         assert f'href="{page}"' in index, f"the index does not link {page}"
 
@@ -96,3 +100,80 @@ def test_docstring_citations_link_to_sections_that_exist(site):
         encoding="utf-8")
     assert 'href="../../physics.html#67-section-coordinates-inertial-and-apsidal"' in surface
     assert links > 20
+
+
+def test_the_configuration_is_nitpicky_with_local_inventories():
+    """-W makes every unresolved reference an error only when nitpicky is on; the
+    inventories are local files (no network where the site is built), and the script that
+    writes them reproduces them byte for byte."""
+    conf = open(os.path.join(ROOT, "docs", "conf.py"), encoding="utf-8").read()
+    assert re.search(r"^nitpicky = True$", conf, flags=re.M)
+    spec = importlib.util.spec_from_file_location(
+        "make_inventories", os.path.join(ROOT, "docs", "_intersphinx", "make_inventories.py"))
+    make = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make)
+    for project in ("python", "numpy", "matplotlib", "xarray", "astropy", "dask"):
+        path = os.path.join(ROOT, "docs", "_intersphinx", f"{project}.inv")
+        root, version, entries = make.NAMES[project]
+        assert open(path, "rb").read() == make.inventory(project, version, entries), project
+        assert f'"{project}": "{root}"' in conf, project
+
+
+def test_the_notebook_shows_every_figure(site):
+    """docs/notebook.ipynb is executed by the build in a Jupyter kernel without a display:
+    one image per plotting cell (four .plot() calls or figures of the user's own)."""
+    import json
+
+    nb = json.load(open(os.path.join(ROOT, "docs", "notebook.ipynb"), encoding="utf-8"))
+    plotting = [c for c in nb["cells"] if c["cell_type"] == "code"
+                and re.search(r"\.plot\(|plt\.subplots", "".join(c["source"]))]
+    assert len(plotting) >= 4
+    assert all(not c.get("outputs") for c in nb["cells"] if c["cell_type"] == "code"), \
+        "store the notebook without outputs: the build executes it"
+    page = (site / "notebook.html").read_text(encoding="utf-8")
+    images = re.findall(r'<img[^>]+src="([^"]+\.png)"', page)
+    assert len(images) >= len(plotting), images
+    for src in images:
+        assert (site / src).is_file(), src
+    assert "Traceback" not in page
+
+
+def test_the_command_line_page_is_the_parser_help(site):
+    from ti_spinorbit.cli import COMMANDS
+
+    page = (site / "cli.html").read_text(encoding="utf-8")
+    for command in COMMANDS:
+        assert f"usage: ti-spinorbit {command.NAME}" in page, command.NAME
+    assert "--max-drift" in page and "--checkpoint" in page
+
+
+def test_the_status_tables_come_from_the_code(site):
+    from ti_spinorbit.cli import common
+
+    page = (site / "statuses.html").read_text(encoding="utf-8")
+    for status in tso.Status:
+        assert f"Status.{status.name}" in page and status.label in page, status
+    for name in ("EXIT_OK", "EXIT_CHECK_FAILED", "EXIT_ERROR", "EXIT_INACCURATE",
+                 "EXIT_INTERRUPTED"):
+        assert name in page and hasattr(common, name), name
+
+
+def test_the_plot_options_are_documented(site):
+    """Every result's .plot(**options) forwards to a plot_* function with its own page."""
+    from ti_spinorbit.engine.results import FIGURES
+
+    functions = {f.__name__ for f in FIGURES.values()}
+    assert functions
+    for name in functions:
+        page = site / "api" / "generated" / f"ti_spinorbit.output.plotting.{name}.html"
+        assert page.is_file(), f"add output.plotting.{name} to docs/api/index.rst"
+
+
+def test_no_private_name_in_the_api_pages(site):
+    """A private module (ti_spinorbit._validate, ...) is named in no page of the API
+    reference: the pages say what the bound is, not where it is kept."""
+    leaks = []
+    for page in (site / "api").rglob("*.html"):
+        text = re.sub(r"<[^>]+>", "", page.read_text(encoding="utf-8"))
+        leaks += [f"{page.name}: {m}" for m in re.findall(r"\b_validate\.\w+", text)]
+    assert not leaks, leaks[:10]
