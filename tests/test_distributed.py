@@ -135,7 +135,8 @@ def test_overlap_scans_with_client_equal_local(client):
     got = overlap_threshold("1991 VH", **kwargs, run=tso.Run(client=client))
     np.testing.assert_array_equal(got.overlaps, local.overlaps)
     assert got.decisions == local.decisions or all(  # NaN != NaN in the evidence
-        repr(a) == repr(b) for a, b in zip(got.decisions, local.decisions))
+        str(dataclasses.astuple(a)) == str(dataclasses.astuple(b))   # every field, as text
+        for a, b in zip(got.decisions, local.decisions))
     assert_sections_equal(got.sections, local.sections)
     # overlap_vs_eccentricity passes run=Run(client=...) on to every scan
     _, _, _, scans = overlap_vs_eccentricity("1991 VH", [local.eccentricity], **kwargs,
