@@ -88,7 +88,7 @@ import ti_spinorbit as tso
 small = tso.load(sys.argv[1])
 big = dataclasses.replace(small, theta_p=np.random.default_rng(1).random((2, 2_500_000)))
 print("saving", flush=True)
-tso.save(big, sys.argv[2])
+tso.save(big, sys.argv[2], overwrite=True)
 print("saved", flush=True)
 """
 
@@ -123,7 +123,7 @@ def test_save_killed_mid_write_leaves_the_old_file_byte_identical(small, tmp_pat
     same_arrays(small, tso.load(target))
     left = [n for n in os.listdir(tmp_path) if n not in ("good.npz", "result.npz", "kill.py")]
     assert len(left) == 1 and left[0].startswith(".result.npz.") and left[0].endswith(".tmp")
-    io.save(small, target)                           # a later save over it works
+    io.save(small, target, overwrite=True)           # a later save over it works
     same_arrays(small, tso.load(target))
 
 
@@ -149,7 +149,8 @@ def _fail_in_savefig(monkeypatch, exc):
 
 
 WRITERS = {
-    "tso.save": ("r.npz", _fail_in_savez, lambda small, path: io.save(small, path)),
+    "tso.save": ("r.npz", _fail_in_savez,
+                 lambda small, path: io.save(small, path, overwrite=True)),
     "save_figure": ("r.png", _fail_in_savefig,
                     lambda small, path: plotting.save_figure(small.plot(), path)),
     "report (JSON)": ("r.json", None,
@@ -186,13 +187,13 @@ def test_atomic_writes_keep_modes_and_symlinks(small, tmp_path):
     kept = tmp_path / "kept.npz"
     kept.write_bytes(b"x")
     os.chmod(kept, 0o604)
-    io.save(small, kept)
+    io.save(small, kept, overwrite=True)
     assert os.stat(kept).st_mode & 0o777 == 0o604    # the mode of the file it replaced
     real = tmp_path / "real.npz"
     real.write_bytes(b"x")
     link = tmp_path / "link.npz"
     link.symlink_to(real)
-    io.save(small, link)
+    io.save(small, link, overwrite=True)
     assert link.is_symlink() and os.readlink(link) == str(real)
     same_arrays(small, tso.load(real))
 

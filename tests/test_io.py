@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
+from ti_spinorbit import files
 from ti_spinorbit.output import io
 from ti_spinorbit.studies.chaosmap import ChaosMap, ParameterMap
 from ti_spinorbit.studies.libration import RelaxedLibration
@@ -310,3 +311,57 @@ def test_package_import_does_not_import_xarray():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().splitlines()[-1] == "False"
+
+
+# ---- one overwrite rule: refused unless overwrite=True (as the CLI's --overwrite) -----------
+def test_save_refuses_an_existing_file_in_one_line_and_touches_nothing(section, tmp_path):
+    path = tmp_path / "s.npz"
+    path.write_bytes(b"an earlier result")
+    for save in (lambda: io.save(section, path), lambda: tso.save(section, path),
+                 lambda: section.save(path), lambda: io.save_result(section, path)):
+        with pytest.raises(FileExistsError) as info:
+            save()
+        text = str(info.value)
+        assert text == (f"{str(path)!r} already exists; pass overwrite=True to replace it, "
+                        "or choose another name"), text
+        assert isinstance(info.value, files.OutputExists)
+    assert path.read_bytes() == b"an earlier result"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.npz"]      # no temporary left
+    # the name actually written counts: "b" is written as "b.npz"
+    (tmp_path / "b.npz").write_bytes(b"x")
+    with pytest.raises(FileExistsError, match=r"b\.npz' already exists"):
+        io.save(section, tmp_path / "b")
+    # a symbolic link by that name is an existing name too
+    (tmp_path / "link.npz").symlink_to(tmp_path / "s.npz")
+    with pytest.raises(FileExistsError, match=r"link\.npz' already exists"):
+        section.save(tmp_path / "link.npz")
+    assert path.read_bytes() == b"an earlier result"
+    with pytest.raises(TypeError, match="overwrite must be True or False"):
+        io.save(section, tmp_path / "new.npz", overwrite="yes")
+
+
+def test_save_with_overwrite_replaces_and_a_new_name_needs_nothing(section, tmp_path):
+    path = tmp_path / "s.npz"
+    assert io.save(section, path) == path                 # a new name: written
+    path.write_bytes(b"an earlier result")
+    assert section.save(path, overwrite=True) == path
+    assert_same(section, tso.load(path))
+    assert tso.save(section, path, overwrite=True) == path
+
+
+def test_a_file_that_appears_during_the_save_is_not_replaced(section, tmp_path, monkeypatch):
+    """The name is checked before the work and again when the file is put in place (a hard
+    link, which fails on an existing name): another writer's file that appeared meanwhile
+    stays, and no temporary file is left."""
+    path = tmp_path / "s.npz"
+    real = np.savez_compressed
+
+    def racing(fh, **arrays):
+        real(fh, **arrays)
+        path.write_bytes(b"written meanwhile by someone else")
+
+    monkeypatch.setattr(np, "savez_compressed", racing)
+    with pytest.raises(FileExistsError, match="already exists; pass overwrite=True"):
+        io.save(section, path)
+    assert path.read_bytes() == b"written meanwhile by someone else"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.npz"]

@@ -16,6 +16,14 @@ Every result file (:func:`ti_spinorbit.output.io.save`), figure
   The temporary file is in the same folder because ``os.replace`` is only atomic within one
   file system. A final name that is a symbolic link to a file keeps its link: the file it
   points to is replaced (as ``open(path, "w")`` would have written through it).
+* **One overwrite rule.** An output that exists is refused, not replaced, unless the caller
+  says so: Python's :func:`ti_spinorbit.save` (and ``result.save``) raise
+  :class:`OutputExists` (a FileExistsError; one line naming the file and ``overwrite=True``)
+  unless ``overwrite=True``; the command line refuses before any work unless
+  ``--overwrite``. The check is made before the work and again when the file is put in
+  place (a hard link, which fails on an existing name), so a file that appeared meanwhile
+  is not replaced either. The package writes figures only for the command line (Python
+  users call Matplotlib's ``savefig``, whose rule is Matplotlib's).
 * **Claimed outputs.** A run takes an exclusive OS lock (``flock``) on a hidden file beside
   each output, ``.<name>.lock``, before it checks whether the output exists and holds it until
   it ends, so two runs with the same output names started together cannot both go on: the
@@ -159,14 +167,50 @@ def target(path):
     return os.path.realpath(path) if os.path.islink(path) else path
 
 
+class OutputExists(FileExistsError):
+    """An output that exists already, written with ``overwrite=False`` (one line naming the
+    file and ``overwrite=True``)."""
+
+
+def refuse_existing(path, how="overwrite=True"):
+    """Raise :class:`OutputExists` when ``path`` (or a symbolic link by that name) exists: the
+    one overwrite rule (module docstring), ``how`` saying what allows it."""
+    path = os.fspath(path)
+    if os.path.lexists(path):
+        raise OutputExists(f"{path!r} already exists; pass {how} to replace it, or choose "
+                           "another name")
+
+
+def _publish_new(tmp, final, path):
+    """Give the finished temporary file ``tmp`` the name ``final`` only if no file has it: a
+    hard link fails when the name exists (atomic, so a file that appeared while this one was
+    written is never replaced); where the file system has no hard links, the name is checked
+    and then replaced."""
+    try:
+        os.link(tmp, final)
+    except FileExistsError:
+        refuse_existing(path)
+    except OSError:          # no hard links here (FAT, some network and FUSE file systems)
+        refuse_existing(path)
+        os.replace(tmp, final)
+        return
+    os.remove(tmp)
+
+
 @contextlib.contextmanager
-def atomic_write(path, mode="wb", encoding=None):
+def atomic_write(path, mode="wb", encoding=None, overwrite=True):
     """Write ``path`` atomically (module docstring): yields a file object on a temporary file
     beside it (``mode`` "wb" or "w"; text in ``encoding``, UTF-8 by default) that replaces
     ``path`` when the block ends without an exception. On an exception (KeyboardInterrupt
-    included) the temporary file is removed and ``path`` is left as it was."""
+    included) the temporary file is removed and ``path`` is left as it was.
+
+    ``overwrite=False`` refuses a ``path`` that exists (:class:`OutputExists`, one line), at
+    once and again when the file is put in place, where a file that appeared meanwhile is
+    never replaced either."""
     if mode not in ("wb", "w"):
         raise ValueError(f"mode must be 'wb' or 'w' (got {mode!r})")
+    if not overwrite:
+        refuse_existing(path)
     final = target(path)
     folder = os.path.dirname(os.path.abspath(final))
     old_mode = None
@@ -200,7 +244,10 @@ def atomic_write(path, mode="wb", encoding=None):
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, final)
+        if overwrite:
+            os.replace(tmp, final)
+        else:
+            _publish_new(tmp, final, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.remove(tmp)
@@ -330,5 +377,5 @@ def claim(outputs, command=None):
     return held
 
 
-__all__ = ["atomic_write", "write_text", "write_json", "claim", "Claim", "OutputBusy",
-           "check_name", "safe_part", "lock_path", "name_max", "target"]
+__all__ = ["OutputExists", "refuse_existing", "atomic_write", "write_text", "write_json",
+           "claim", "Claim", "OutputBusy", "check_name", "safe_part", "lock_path", "name_max", "target"]

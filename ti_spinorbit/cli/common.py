@@ -439,9 +439,11 @@ def progress_bar(args):
 def _save(result, path, extra):
     """Write a result with :func:`ti_spinorbit.output.io.save` (self-describing, loadable with
     ``io.load``; atomic: a killed write leaves no partial file), the command's own numbers in
-    the metadata under ``extra``."""
+    the metadata under ``extra``. The overwrite rule was applied before any work
+    (:func:`output_paths`: --overwrite, or a --resume that finishes the same command's run)
+    and the name is this run's since (:func:`claim_outputs`), hence ``overwrite=True``."""
 
-    return save(result, path, extra=extra)
+    return save(result, path, extra=extra, overwrite=True)
 
 
 class FigureError(RuntimeError):

@@ -190,7 +190,8 @@ class Result:
 
     def save(self, path, **kwargs):
         """Write this result to ``path`` (``.npz``): :func:`ti_spinorbit.output.io.save` (keywords
-        ``extra``, ``include_sections``); returns the path written."""
+        ``extra``, ``include_sections``, ``overwrite``: an existing file is refused unless
+        ``overwrite=True``); returns the path written."""
         return _backend("save", "io")(self, path, **kwargs)
 
     def to_xarray(self):

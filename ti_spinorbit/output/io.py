@@ -46,7 +46,8 @@ from .. import runtime
 from ..engine import results as _results
 from .._version import __version__
 from ..model.attitude import CLASS_UNIT, CLASSES
-from ..files import atomic_write
+from .._validate import require_bool
+from ..files import atomic_write, refuse_existing
 from ..layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
 from ..npzfile import _DAMAGE, ArchiveError, _Entries, _one_line  # noqa: F401 (ArchiveError: public here)
 from ..engine.results import STATUS, STATUS_NAMES, units as field_units
@@ -130,22 +131,32 @@ def _json_default(x):
     return str(x)
 
 
-def write_archive(path, arrays, metadata):
+def _archive_name(path):
+    """The name an archive is written under: ``path``, with ``.npz`` appended unless it ends
+    so in any case (``r.NPZ`` stays); a file object as it is."""
+    if isinstance(path, (str, os.PathLike)) and not os.fspath(path).lower().endswith(".npz"):
+        return os.fspath(path) + ".npz"
+    return path
+
+
+def write_archive(path, arrays, metadata, overwrite=True):
     """Write ``arrays`` and the ``metadata`` dict (as JSON) to a compressed ``.npz``,
     atomically (:func:`ti_spinorbit.files.atomic_write`: a temporary file in the same folder,
     fsync-ed, then moved over the name; a failed or killed write leaves an existing file as
     it was and never a partial one). ``path`` may also be an open binary file object.
 
     Returns the path written. A name ending in ``.npz`` in any case (``r.NPZ``) is written
-    as given; NumPy's rule of appending ``.npz`` applies to other names only."""
+    as given; NumPy's rule of appending ``.npz`` applies to other names only. This is the
+    low-level writer (experiment scripts rewrite their own files with it); :func:`save`
+    applies the overwrite rule, ``overwrite=False`` here refusing an existing file
+    (:class:`ti_spinorbit.files.OutputExists`)."""
     entries = dict(metadata=np.array(json.dumps(metadata, indent=1, default=_json_default)),
                    **{k: np.asarray(v) for k, v in arrays.items()})
     if isinstance(path, (str, os.PathLike)):
-        if not os.fspath(path).lower().endswith(".npz"):
-            path = os.fspath(path) + ".npz"
+        path = _archive_name(path)
         # a temporary file beside it, fsync-ed, then os.replace: a write that fails or is
         # killed never leaves a partial file under the name nor harms the file it replaces
-        with atomic_write(path) as fh:      # a file object: NumPy keeps the name as it is
+        with atomic_write(path, overwrite=overwrite) as fh:   # NumPy keeps a file object's name
             np.savez_compressed(fh, **entries)
         return path
     np.savez_compressed(path, **entries)
@@ -270,8 +281,14 @@ def _encode_records(kind, name, records):
     return {"type": types.pop() if types else None, "tuples": tuples, "items": items}
 
 
-def save(result, path, extra=None, include_sections=True):
+def save(result, path, extra=None, include_sections=True, overwrite=False):
     """Save a result object to ``path`` (``.npz``, compressed); returns the path written.
+
+    An existing file is never replaced unless ``overwrite=True``: without it the save is
+    refused before any work with one line naming the file and ``overwrite=True``
+    (:class:`ti_spinorbit.files.OutputExists`, a FileExistsError), the rule of the command
+    line's ``--overwrite``. The write is atomic: a failed or killed save leaves an existing
+    file as it was and never a partial one.
 
     Parameters
     ----------
@@ -287,6 +304,8 @@ def save(result, path, extra=None, include_sections=True):
         Also save a nested section (``ChaosMap.section``, ``OverlapScan.sections``) under the
         prefix ``section/`` (or ``sections/``). False drops it: smaller file, and the loaded
         result has None there.
+    overwrite : bool
+        Replace a file already at ``path`` (default False: refused, see above).
 
     The metadata holds ``kind``, ``format_version``, ``package``, ``version``, ``arch``,
     ``created_utc``, ``rtol``/``atol``/``order``/``orbits`` where the result has them,
@@ -295,6 +314,9 @@ def save(result, path, extra=None, include_sections=True):
     """
     kind = kind_of(result)
     _check_save_args(path, extra)
+    overwrite = require_bool("overwrite", overwrite)
+    if not overwrite and isinstance(path, (str, os.PathLike)):
+        refuse_existing(_archive_name(path))          # before any work; again when written
     systems, arrays, units_out = _Systems(), {}, {}
     block = _encode(result, "", systems, arrays, units_out, bool(include_sections))
     fields = block["fields"]
@@ -312,7 +334,7 @@ def save(result, path, extra=None, include_sections=True):
             raise ValueError(f"extra metadata keys {clash} clash with the standard keys; "
                              "rename them")
         meta.update(extra)
-    return write_archive(path, arrays, meta)
+    return write_archive(path, arrays, meta, overwrite=overwrite)
 
 
 def _check_save_args(path, extra):
@@ -331,13 +353,13 @@ def _check_save_args(path, extra):
                         f"{bad[0]!r})")
 
 
-def save_result(result, path, kind=None, extra=None):
+def save_result(result, path, kind=None, extra=None, overwrite=False):
     """Alias of :func:`save` kept for older callers; ``kind``, if given, must match the
     result's kind ("section" for a SectionResult, "time_series" for a TimeSeriesResult, ...)."""
     if kind is not None and kind != kind_of(result):
         raise ValueError(f"kind {kind!r} does not match the result: a {type(result).__name__} "
                          f"is saved as kind {kind_of(result)!r}")
-    return save(result, path, extra=extra)
+    return save(result, path, extra=extra, overwrite=overwrite)
 
 
 # ---- reading ----------------------------------------------------------------------------
