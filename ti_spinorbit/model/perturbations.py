@@ -52,6 +52,7 @@ from .._validate import (check_heliocentric, require_positive_scalar, require_ra
                          show)
 from ..layout import perturbation as _layout
 from ..system.systems import BinarySystem, G
+from ..units import plain_fields as _plain_fields
 
 #: The kernels' perturbation block, its accumulators (work, L_ext x, y, z) and the
 #: constant-Q rate floor (units of the system's n; the analytic rates use it too), from
@@ -202,12 +203,12 @@ class Tides:
         Love number, in (0, 10]. Default: the rubble-pile model of Goldreich & Sari (2009),
         k2 = 1e-5 R[km] (:meth:`rubble_pile`); :meth:`jacobson_scheeres` gives
         k2 = 2.5e-5 / R[km].
-    time_lag : float, optional
+    time_lag : float or Quantity, optional
         Constant time lag Δt, s (> 0). Give this or ``Q``, not both.
     Q : float, optional
         Constant tidal quality factor (> 0): the lag angle is 1/(2Q) whatever the tidal
         frequency. Default when neither is given: Q = 100 (the paper's, docs/physics.md §9.4).
-    radius : float, optional
+    radius : float or Quantity, optional
         The body's radius, m; default its volume-equivalent radius.
     strength : float
         Factor on the force and torque (default 1): 1e5 makes 1e5 years of tides act in one.
@@ -223,6 +224,7 @@ class Tides:
     kind = "tides"
 
     def __post_init__(self):
+        _plain_fields(self, k2="", time_lag="s", Q="", radius="m", strength="")
         _check_body(self.body)
         if self.k2 is not None:
             require_positive_scalar("k2", self.k2, *K2_RANGE)
@@ -294,9 +296,9 @@ class YORP:
     body : {"secondary", "primary"}
     coefficient : float
         f_Y, signed, |f_Y| <= 1 (default 5e-4, the paper's).
-    heliocentric_a_au, heliocentric_e : float, optional
+    heliocentric_a_au, heliocentric_e : float or Quantity, optional
         The binary's heliocentric orbit (AU, and e in [0, 1)); default the catalogued one.
-    radius : float, optional
+    radius : float or Quantity, optional
         The body's radius, m; default its volume-equivalent radius.
     strength : float
         Factor on the torque (default 1).
@@ -316,6 +318,8 @@ class YORP:
     kind = "yorp"
 
     def __post_init__(self):
+        _plain_fields(self, coefficient="", heliocentric_a_au="AU", heliocentric_e="",
+                      radius="m", strength="")
         _check_body(self.body)
         _check_signed("YORP coefficient (f_Y)", self.coefficient, COEFFICIENT_LIMIT)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
@@ -360,9 +364,9 @@ class BYORP:
     ----------
     coefficient : float
         B, signed, |B| <= 1 (default 1e-3, the order Jacobson & Scheeres 2011 use).
-    heliocentric_a_au, heliocentric_e : float, optional
+    heliocentric_a_au, heliocentric_e : float or Quantity, optional
         The binary's heliocentric orbit; default the catalogued one.
-    radius : float, optional
+    radius : float or Quantity, optional
         The secondary's radius R_s, m; default its volume-equivalent radius.
     strength : float
         Factor on the force (default 1).
@@ -378,6 +382,8 @@ class BYORP:
     body = "secondary"
 
     def __post_init__(self):
+        _plain_fields(self, coefficient="", heliocentric_a_au="AU", heliocentric_e="",
+                      radius="m", strength="")
         _check_signed("BYORP coefficient (B)", self.coefficient, COEFFICIENT_LIMIT)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         _check_radius_and_strength(self)
@@ -420,12 +426,12 @@ class SolarTide:
 
     Parameters
     ----------
-    heliocentric_a_au, heliocentric_e : float, optional
+    heliocentric_a_au, heliocentric_e : float or Quantity, optional
         The barycentre's heliocentric semimajor axis (AU) and eccentricity; default the
         system's ``heliocentric_orbit``.
-    inclination_deg : float
+    inclination_deg : float or Quantity
         i, degrees in [0, 180] (default 0: the Sun in the mutual orbit plane).
-    node_deg, periapsis_deg, mean_anomaly_deg : float
+    node_deg, periapsis_deg, mean_anomaly_deg : float or Quantity
         Ω, ω and the mean anomaly at t = 0, degrees in [−360, 360] (default 0).
     strength : float
         Factor on the Sun's mass in the force and torques (default 1); the Sun's motion
@@ -445,6 +451,8 @@ class SolarTide:
     radius = None
 
     def __post_init__(self):
+        _plain_fields(self, heliocentric_a_au="AU", heliocentric_e="", inclination_deg="deg",
+                      node_deg="deg", periapsis_deg="deg", mean_anomaly_deg="deg", strength="")
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         if self.heliocentric_e is not None and not self.heliocentric_e < 1.0:
             raise ValueError(f"heliocentric_e must be in [0, 1) (got {show(self.heliocentric_e)})")

@@ -44,6 +44,7 @@ from .._validate import (MAX_DENSITY, MAX_LENGTH, MAX_MASS, MIN_DENSITY, MIN_LEN
                          MIN_MOMENT_RATIO, require_count, require_finite, require_positive_scalar,
                          require_real, show, _as_floats)
 from .. import display as _display
+from ..units import plain_fields, to_plain
 from . import integrals as _integrals
 # the monomial orders of a body's row (Body.as_row), shared with the kernels
 from ..layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4, ROW_LENGTH
@@ -131,8 +132,9 @@ class Body(_display.Readable):
 
     Parameters
     ----------
-    mass : float
-        Mass in kg, in [1e-9, 1e35] (``MIN_MASS``, ``MAX_MASS`` of ``ti_spinorbit._validate``).
+    mass : float or Quantity
+        Mass in kg, in [1e-9, 1e35] (``MIN_MASS``, ``MAX_MASS`` of ``ti_spinorbit._validate``);
+        a Quantity is converted (:mod:`ti_spinorbit.units`).
     integrals : dict
         ``{(l, m, n): T^{lmn}}`` for 2 <= l + m + n <= ``order``, SI units (kg m^{l+m+n}).
         Missing entries are zero (the body keeps a copy without the zero entries). Second-order
@@ -141,7 +143,7 @@ class Body(_display.Readable):
         principal moment: its potential is fine, but
         :class:`~ti_spinorbit.system.systems.BinarySystem` refuses it, since the spin equations
         divide by the moments.)
-    bounding_radius : float
+    bounding_radius : float or Quantity
         Radius (m) of a sphere about the centre of mass that contains the body; used for the
         collision test and the overlap check at start. In [1e-3, 1e10] m (``MIN_LENGTH``,
         ``MAX_LENGTH``) and no smaller than the integrals allow: a body inside a sphere of
@@ -172,6 +174,7 @@ class Body(_display.Readable):
     _row: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
+        plain_fields(self, mass="kg", bounding_radius="m")
         require_positive_scalar("mass", self.mass, MIN_MASS, MAX_MASS, "kg")
         require_positive_scalar("bounding_radius", self.bounding_radius, MIN_LENGTH, MAX_LENGTH, "m")
         if not isinstance(self.integrals, dict):
@@ -297,7 +300,7 @@ class Body(_display.Readable):
     @classmethod
     def from_point_masses(cls, points, masses, name="point cloud", bounding_radius=None,
                           order=DATA_ORDER):
-        """A body made of point masses (m, kg), shifted to its centre of mass and rotated into
+        """A body made of point masses (m, kg; arrays or Quantities), shifted to its centre of mass and rotated into
         its principal axes (x = smallest moment, i.e. the long axis), with every integral up
         to ``order`` (4..16, default ``DATA_ORDER`` = 8). Integrals below 1e-13 of
         Σ m_i |r_i|^(l+m+n) (round-off of a symmetry) are set to exactly 0.
@@ -306,8 +309,8 @@ class Body(_display.Readable):
         the body also carries it as ``body.rotation`` and the centre of mass in the input
         frame as ``body.offset`` (m): ``x_body = rotation @ (x_input - offset)``."""
         order = check_order(order)
-        points = _as_floats("points", points)
-        masses = _as_floats("masses", masses)
+        points = _as_floats("points", to_plain("points", points, "m"))
+        masses = _as_floats("masses", to_plain("masses", masses, "kg"))
         if points.ndim != 2 or points.shape[1] != 3 or masses.shape != points.shape[:1]:
             raise ValueError("points must have shape (n, 3) and masses shape (n,)")
         require_finite("points", points)
@@ -355,11 +358,14 @@ def Ellipsoid(a, b, c, density=None, *, mass=None, name="ellipsoid", order=MAX_O
     """Uniform triaxial ellipsoid with semi-axes a ≥ b ≥ c (m) along x, y, z.
 
     Give exactly one of ``density`` (kg m^-3, in [1, 1e5]: ``MIN_DENSITY``, ``MAX_DENSITY``)
-    or ``mass`` (kg, in [1e-9, 1e35]). Semi-axes lie in [1e-3, 1e10] m (``MIN_LENGTH``,
+    or ``mass`` (kg, in [1e-9, 1e35]). Each is a float or Quantity (semi-axes, density and
+    mass alike: ``Ellipsoid(0.245 * u.km, ..., 2.6 * u.g / u.cm**3)``,
+    :mod:`ti_spinorbit.units`). Semi-axes lie in [1e-3, 1e10] m (``MIN_LENGTH``,
     ``MAX_LENGTH``) and the body may not be a needle: (b² + c²)/(a² + b²) >= 1e-6 (its
     smallest principal moment over its largest). x is the long axis and z the short one (the
     spin axis of a principal-axis rotator). Every integral up to ``order`` (4..16, default
     ``MAX_ORDER`` = 16) is the closed form of the module docstring, the odd ones exactly 0."""
+    a, b, c = (to_plain(label, value, "m") for label, value in (("a", a), ("b", b), ("c", c)))
     for label, value in (("a", a), ("b", b), ("c", c)):
         require_positive_scalar(label, value, MIN_LENGTH, MAX_LENGTH, "m")
     if not isinstance(name, str):
@@ -388,11 +394,13 @@ def Ellipsoid(a, b, c, density=None, *, mass=None, name="ellipsoid", order=MAX_O
 
 
 def Sphere(radius, density=None, *, mass=None, name="sphere", order=MAX_ORDER) -> Body:
-    """Uniform sphere of ``radius`` (m); give ``density`` (kg m^-3) or ``mass`` (kg).
+    """Uniform sphere of ``radius`` (m); give ``density`` (kg m^-3) or ``mass`` (kg); each a
+    float or Quantity.
 
     Its exterior field is exactly that of a point mass; the integrals are kept anyway so the
     same kernels serve every body. ``radius`` in [1e-3, 1e10] m; density and mass bounds, and
     ``order``, as for :func:`Ellipsoid`."""
+    radius = to_plain("radius", radius, "m")
     require_positive_scalar("radius", radius, MIN_LENGTH, MAX_LENGTH, "m")
     return Ellipsoid(radius, radius, radius, density, mass=mass, name=name, order=order)
 

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import MAX_PRIMARY_SPIN, MAX_SPIN, require_scalar, show
+from ..units import to_plain
 
 #: |R × V| / (|R| |V|) at or below which V counts as parallel to R (the orbit normal is then
 #: rounding noise): :meth:`InitialState.kicked` applies only radial kicks there.
@@ -51,6 +52,8 @@ ROW_SLICES = {"R": slice(0, 3), "V": slice(3, 6), "primary_attitude": slice(6, 1
 ROW_UNIT = ("state row (docs/physics.md §6.8): R m (3), V m/s (3), primary attitude body->inertial "
             "(9, row-major), primary omega rad/s body frame (3), secondary attitude (9), "
             "secondary omega rad/s (3)")
+#: Units the fields of an InitialState take a Quantity in (:mod:`ti_spinorbit.units`).
+_FIELD_UNITS = {"R": "m", "V": "m/s", "primary_omega": "rad/s", "secondary_omega": "rad/s"}
 _UNITS = {"R": "m", "V": "m/s", "primary_attitude": "1 (body -> inertial)",
           "primary_omega": "rad/s (primary body frame)",
           "secondary_attitude": "1 (body -> inertial)",
@@ -103,7 +106,8 @@ def rotation(axis, angle):
     return A
 
 
-def _finite(name, value, shape):
+def _finite(name, value, shape, unit=""):
+    value = to_plain(name, value, unit)          # a Quantity in ``unit`` (or dimensionless)
     try:
         a = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -137,12 +141,13 @@ class InitialState:
 
     Parameters
     ----------
-    R, V : array_like, shape (3,)
+    R, V : array_like or Quantity, shape (3,)
         Secondary's position (m) and velocity (m/s) relative to the primary, inertial frame.
     primary_attitude, secondary_attitude : array_like, shape (3, 3) or (4,)
         Body -> inertial rotation matrix, or a unit quaternion (w, x, y, z).
-    primary_omega, secondary_omega : array_like, shape (3,)
-        Angular velocity in the body's own (principal) frame, rad/s.
+    primary_omega, secondary_omega : array_like or Quantity, shape (3,)
+        Angular velocity in the body's own (principal) frame, rad/s (a Quantity in any
+        angular rate, e.g. ``u.deg / u.day``).
 
     Checked on construction: shapes, finiteness, orthonormal with det +1. What needs the
     bodies (no contact, a bound orbit) is checked by :meth:`check` and by every entry point.
@@ -163,7 +168,8 @@ class InitialState:
     def __post_init__(self):
         for name in _FIELDS:
             value = getattr(self, name)
-            v = _attitude(name, value) if name.endswith("attitude") else _finite(name, value, (3,))
+            v = _attitude(name, value) if name.endswith("attitude") else \
+                _finite(name, value, (3,), _FIELD_UNITS[name])
             v.setflags(write=False)
             object.__setattr__(self, name, v)
         if not np.linalg.norm(self.R) > 0:
@@ -327,21 +333,24 @@ def tilted_start(system, theta_p, thetadot_p, *, roll=0.0, pitch=0.0, yaw=0.0,
     Parameters
     ----------
     system : BinarySystem
-    theta_p : float
+    theta_p : float or Quantity
         Angle of the secondary's long axis from the line of centres, degrees (as in
-        :func:`ti_spinorbit.surface_of_section`).
-    thetadot_p : float
-        The secondary's spin about its body z axis, units of the mean motion n.
-    roll, pitch, yaw : float
+        :func:`ti_spinorbit.surface_of_section`), or an angle Quantity (``u.rad``). A plain
+        value that looks like radians gets the degree hint (:mod:`ti_spinorbit.units`).
+    thetadot_p : float or Quantity
+        The secondary's spin about its body z axis, units of the mean motion n; a Quantity
+        dimensionless, in ``ti_spinorbit.units.n``, or an angular rate (rad/s), divided by
+        the system's n.
+    roll, pitch, yaw : float or Quantity
         Further rotation of the secondary, degrees, about the orbit frame's radial,
         along-track and normal axes, applied as yaw, then pitch, then roll in body axes
         (secondary attitude = orbit frame · Rz(θ_p + yaw) · Ry(pitch) · Rx(roll)).
-    spin_x, spin_y : float
+    spin_x, spin_y : float or Quantity
         Off-axis components of the secondary's angular velocity in its body frame, units of n.
-    inclination : float
+    inclination : float or Quantity
         Inclination of the mutual orbit to the primary's equator, degrees: the orbit is
         turned about the line of centres (the pericentre is its ascending node).
-    primary_tilt : float
+    primary_tilt : float or Quantity
         Tilt of the primary's pole from the initial orbit normal toward the line of centres
         (a rotation of the primary about the along-track axis), degrees: with
         ``inclination`` it sets the primary's obliquity to the mutual orbit in any direction.
@@ -349,12 +358,14 @@ def tilted_start(system, theta_p, thetadot_p, *, roll=0.0, pitch=0.0, yaw=0.0,
     With every angle and off-axis spin zero this is exactly
     ``system.initial_state(radians(theta_p), thetadot_p)`` (the paper's start, §6.4).
     """
-    theta_p = require_scalar("theta_p", theta_p)
-    thetadot_p = require_scalar("thetadot_p", thetadot_p, -MAX_SPIN, MAX_SPIN, unit="(units of n)")
-    ang = {k: np.radians(require_scalar(k, v, -360.0, 360.0)) for k, v in
+    theta_p = require_scalar("theta_p", theta_p, unit="deg")
+    thetadot_p = require_scalar("thetadot_p", to_plain("thetadot_p", thetadot_p, "n", system=system),
+                                -MAX_SPIN, MAX_SPIN, unit="(units of n)")
+    ang = {k: np.radians(require_scalar(k, v, -360.0, 360.0, unit="deg")) for k, v in
            dict(roll=roll, pitch=pitch, yaw=yaw, inclination=inclination,
                 primary_tilt=primary_tilt).items()}
-    spins = [require_scalar(k, v, -MAX_SPIN, MAX_SPIN, unit="(units of n)")
+    spins = [require_scalar(k, to_plain(k, v, "n", system=system), -MAX_SPIN, MAX_SPIN,
+                            unit="(units of n)")
              for k, v in (("spin_x", spin_x), ("spin_y", spin_y))]
     n, a, e = system.mean_motion, system.a, system.e
     # the paper's pericentre start (docs/physics.md §6.4), then the orbit turned about x

@@ -62,6 +62,7 @@ from .._validate import MAX_LENGTH, require_real, show, _as_floats
 from . import integrals as _integrals
 from . import shapefiles as _shapefiles
 from .bodies import DATA_ORDER, Body, _mass_from, check_order
+from ..units import plain_fields, to_plain
 
 __all__ = ["Polyhedron", "read_shape", "Part", "Composite", "PACKAGED", "packaged_shape",
            "ROUND_OFF", "Source"]
@@ -158,16 +159,16 @@ def Polyhedron(vertices, faces, *, density=None, mass=None, name="polyhedron",
 
     Parameters
     ----------
-    vertices : array_like, shape (V, 3)
+    vertices : array_like or Quantity, shape (V, 3)
         Vertex coordinates in the shape frame, m (:func:`read_shape` reads a file in km or m).
     faces : array_like of int, shape (F, 3)
         0-based vertex indices of the triangles, each wound counter-clockwise seen from
         outside. The mesh must be closed, consistently wound, outward and without
         degenerate facets (:func:`~ti_spinorbit.system.shapefiles.check_mesh`: a one-line
         ValueError says what is wrong and where, facet and vertex indices).
-    density : float, optional
+    density : float or Quantity, optional
         kg m^-3, in [1, 1e5]; give exactly one of ``density`` and ``mass``.
-    mass : float, optional
+    mass : float or Quantity, optional
         kg, in [1e-9, 1e35]; the density is then mass / volume.
     name : str
         Label.
@@ -187,7 +188,8 @@ def Polyhedron(vertices, faces, *, density=None, mass=None, name="polyhedron",
     """
     _check_name(name)
     order = check_order(order)
-    v, f = _mesh_arrays(vertices, faces, name)
+    density, mass = to_plain("density", density, "kg/m^3"), to_plain("mass", mass, "kg")
+    v, f = _mesh_arrays(to_plain("vertices", vertices, "m"), faces, name)
     # integrate about the centre of mass itself (found at order 1 first): moving integrals
     # of degree n by a distance d costs up to ((d + size) / size)^n of their precision, so
     # neither the model's origin nor the shift to the centre of mass may come after them
@@ -237,10 +239,10 @@ def read_shape(path, *, unit="km", density=None, mass=None, format=None, facets=
         The file: OBJ, PDS/Gaskell vertex-facet or plate tables, Gaskell ICQ, or the GUBAS
         CSV pair (give both files as a tuple, or the vertex file with ``facets=``); other
         extensions through ``trimesh`` when it is installed.
-    unit : {"km", "m"}
+    unit : {"km", "m"} or astropy unit
         Unit of the file's coordinates (default km, as in PDS and Gaskell models; GUBAS
-        files are in m).
-    density, mass : float
+        files are in m); ``u.km`` and ``u.m`` are accepted too.
+    density, mass : float or Quantity
         Exactly one: kg m^-3 or kg.
     format : {"obj", "tab", "icq", "gubas"}, optional
         The format, when the extension does not tell it.
@@ -274,6 +276,8 @@ def read_shape(path, *, unit="km", density=None, mass=None, format=None, facets=
                         f"{show(path)})")
     name = Path(path).stem if name is None else _check_name(name)
     order = check_order(order)
+    density, mass = to_plain("density", density, "kg/m^3"), to_plain("mass", mass, "kg")
+    unit = unit.to_string() if hasattr(unit, "to_string") else unit    # an astropy unit
     vertices, faces = _shapefiles.read_mesh(path, unit=unit, format=format, facets=facets)
     body = Polyhedron(vertices, faces, density=density, mass=mass, name=name, order=order)
     source = {"shape": "polyhedron", "file": os.path.abspath(os.fspath(path))}
@@ -294,6 +298,7 @@ def packaged_shape(model, *, density=None, mass=None, name=None, order=DATA_ORDE
     if model not in PACKAGED:
         raise ValueError(f"unknown packaged shape {show(model)}; the packaged shapes are "
                          f"{', '.join(map(repr, PACKAGED))}")
+    density, mass = to_plain("density", density, "kg/m^3"), to_plain("mass", mass, "kg")
     vertices, faces = PACKAGED[model]()
     body = Polyhedron(vertices, faces, density=density, mass=mass,
                       name=model if name is None else name, order=order)
@@ -312,7 +317,7 @@ class Part:
     ----------
     body : Body
         The part, with its own density or mass (any constructor of the package).
-    offset : array_like, shape (3,)
+    offset : array_like or Quantity, shape (3,)
         Where the part's origin (its centre of mass) sits in the composite frame, m.
     rotation : array_like, shape (3, 3), optional
         Rotation from the part's body frame to the composite frame (orthonormal, det +1):
@@ -330,6 +335,7 @@ class Part:
     def __post_init__(self):
         if not isinstance(self.body, Body):
             raise TypeError(f"Part body must be a ti_spinorbit Body (got {show(self.body)})")
+        plain_fields(self, offset="m")
         offset = _as_floats("Part offset", self.offset)
         if offset.shape != (3,) or not np.all(np.isfinite(offset)):
             raise ValueError(f"Part offset must be a finite vector of 3 lengths in m (got "

@@ -45,10 +45,9 @@ ESCAPE_DISTANCE = 50.0
 SMALL_BODY_M, SMALL_ORBIT_M = 1.0, 10.0
 
 
-class ImplausibleInputWarning(UserWarning):
-    """An input that is allowed but probably not meant: bodies or an orbit far smaller than
-    any asteroid (kilometres typed as metres?), or a surface of section at e ≈ 0 where the
-    pericentre is ill-defined."""
+# ImplausibleInputWarning (kilometres typed as metres?, radians typed as degrees?) lives with
+# the unit conversions; this module's warnings derive from it
+from ..units import ImplausibleInputWarning, plain_fields as _plain_fields, to_plain as _to_plain
 
 
 #: Below this eccentricity a surface of section at pericentre warns (NearCircularWarning).
@@ -74,12 +73,12 @@ class BinarySystem(_display.Readable):
         The mass ratio m1/m2 must lie in [1e-12, 1e12] (``MAX_MASS_RATIO``) and each body's
         principal moments must be at least 1e-6 of its largest (``MIN_MOMENT_RATIO``: the
         spin equations divide by them, so a body collapsed onto a line is refused).
-    a : float
+    a : float or Quantity
         Initial osculating semimajor axis of the mutual orbit, m, in [1e-3, 1e13]
         (``MAX_SEMIMAJOR_AXIS``) and beyond contact at pericentre.
     e : float
         Initial osculating eccentricity, 0 <= e < 1.
-    primary_spin_period : float, optional
+    primary_spin_period : float or Quantity, optional
         Primary's spin period about its short axis, s (None: not spinning; irrelevant for a
         spherical primary); negative for retrograde spin. Its rate 2π/|P| may be at most
         1e5 n (``MAX_PRIMARY_SPIN``): |P| >= orbital period / 1e5.
@@ -91,7 +90,7 @@ class BinarySystem(_display.Readable):
         BYORP use (:mod:`ti_spinorbit.model.perturbations`). The catalogue fills it where the
         orbit is known (``catalog.heliocentric_orbit``); None (default) for a system of your
         own, whatever its name, until you give it.
-    orbital_period : float, optional
+    orbital_period : float or Quantity, optional
         Observed orbital period of the mutual orbit, s (positive, finite), e.g. 11.92 h =
         42912 s for Didymos-Dimorphos. When given, both bodies' masses (hence densities; shapes
         unchanged) are multiplied by one factor ``density_scale`` = (P_Kepler / P)² so that
@@ -130,6 +129,7 @@ class BinarySystem(_display.Readable):
     density_scale: float = field(default=1.0, init=False, compare=False)
 
     def __post_init__(self):
+        _plain_fields(self, a="m", e="", primary_spin_period="s")
         for label, body in (("primary", self.primary), ("secondary", self.secondary)):
             if not isinstance(body, Body):
                 raise TypeError(f"{label} must be a ti_spinorbit Body (Sphere, Ellipsoid, Body), "
@@ -778,6 +778,7 @@ def _volume(body: Body) -> float:
 
 def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, name="binary",
                       heliocentric_orbit=None, *, orbital_period=None):
+    orbital_period = _to_plain("orbital_period", orbital_period, "s")
     if orbital_period is None:
         return _dataclass_init(self, primary, secondary, a, e, primary_spin_period, name,
                                heliocentric_orbit)
