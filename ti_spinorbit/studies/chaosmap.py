@@ -42,7 +42,7 @@ from ..engine.results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN
                               Status, unit)
 from ..engine.results import FLOAT as _F, INTEGER as _I, BOOL as _B, TEXT as _S
 from .classify import MIN_POINTS, classify_section
-from .section import INDICATOR_SPACE, SectionResult, check_orbits, surface_of_section
+from .section import INDICATOR_SPACE, SectionResult, check_orbits, plain_starts, surface_of_section
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 #: Default starts per (a/b, e) of a parameter map: θ_p ∈ {0°, 90°} × θ̇_p/n in the 1:1-3:2 band.
@@ -215,12 +215,15 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
     ----------
     system : BinarySystem or str
         The system, or a catalogue name (``ti_spinorbit.system.catalog``).
-    theta_p : 1-D array
-        Initial θ_p values, deg (x axis of the map).
-    thetadot_p : 1-D array
-        Initial θ̇_p/n values, units of n (y axis), in [-100, 100] (``_validate.MAX_SPIN``).
-    orbits : float
-        Integration time in orbital periods, > 0. ⟨Y⟩ of a chaotic orbit grows ≈ λ t / 2, so
+    theta_p : 1-D array or Quantity
+        Initial θ_p values, deg (x axis of the map); an angle Quantity is converted, a plain
+        axis that looks like radians gets the degree hint (:mod:`ti_spinorbit.units`).
+    thetadot_p : 1-D array or Quantity
+        Initial θ̇_p/n values, units of n (y axis), in [-100, 100] (``_validate.MAX_SPIN``);
+        a Quantity dimensionless, in ``ti_spinorbit.units.n``, or an angular rate (rad/s).
+    orbits : float or Quantity
+        Integration time in orbital periods, > 0 (a Quantity in ``units.orbit``, or a
+        time, divided by the system's period). ⟨Y⟩ of a chaotic orbit grows ≈ λ t / 2, so
         with λ ≈ 0.5/orbit a few tens of orbits separate the classes; weak chaos needs more.
     rtol, method, integrator : optional
         How the equations are integrated (:class:`ti_spinorbit.Integrator`; ``rtol``
@@ -268,6 +271,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
     """
     check_coordinates(coordinates)
     system = catalog.as_system(system)
+    theta_p, thetadot_p, orbits = plain_starts(system, theta_p, thetadot_p, orbits)
     theta_p = _axis("theta_p", theta_p)
     thetadot_p = require_spin("thetadot_p", _axis("thetadot_p", thetadot_p))
     check_orbits(orbits)
@@ -476,10 +480,12 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
         function ``(q, e) -> BinarySystem``.
     elongations, eccentricities : 1-D arrays
         The a/b (≥ 1) and e (0 ≤ e < 1) axes.
-    orbits : float
-        Integration time in orbital periods, > 0.
-    thetadot_p, theta_p : 1-D arrays
-        Starts per grid point: the product θ_p (deg) × θ̇_p/n. Default {0°, 90°} × 12 rates
+    orbits : float or Quantity
+        Integration time in orbital periods, > 0 (a Quantity dimensionless or in
+        ``ti_spinorbit.units.orbit``: the grid's systems differ in period).
+    thetadot_p, theta_p : 1-D arrays or Quantities
+        Starts per grid point: the product θ_p (deg, or an angle Quantity) × θ̇_p/n (a
+        Quantity dimensionless or in ``units.n``: the grid's systems differ in n). Default {0°, 90°} × 12 rates
         from 0.6 to 2.0 n, the band of the 1:1 and 3:2 resonances whose overlap is at issue.
     rtol, method, integrator, run
         As for :func:`chaos_map` (``rtol`` default 1e-10).
@@ -501,6 +507,7 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     ParameterMap
     """
     check_coordinates(coordinates)
+    theta_p, thetadot_p, orbits = plain_starts(None, theta_p, thetadot_p, orbits)
     elongations = _axis("elongations", elongations)
     eccentricities = _axis("eccentricities", eccentricities)
     theta_p = _axis("theta_p", theta_p)

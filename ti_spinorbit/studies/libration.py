@@ -58,7 +58,8 @@ from ..engine.convergence import run_lengths
 from ..engine.options import Run
 from ..engine.results import COORDINATES, METHOD, ORBITS, RELATIVE, SPIN, Result, unit
 from .classify import horizontal_extent
-from .section import SystemLike, check_orbits, surface_of_section, time_series
+from .section import SystemLike, check_orbits, plain_starts, surface_of_section, time_series
+from ..units import to_plain
 from ..engine.results import FLOAT as _F
 from ..model.perturbations import UNIT as PERTURBATIONS, check_perturbations
 
@@ -114,10 +115,12 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
     system : BinarySystem, str or list of them
         Broadcast against ``thetadot_p`` as in :func:`~ti_spinorbit.surface_of_section` (a
         str is a catalogue name).
-    thetadot_p : float or array
-        Initial spin rate of the secondary, units of n.
-    orbits : float
-        Integration time in initial orbital periods.
+    thetadot_p : float, array or Quantity
+        Initial spin rate of the secondary, units of n (a Quantity as for
+        :func:`~ti_spinorbit.surface_of_section`).
+    orbits : float or Quantity
+        Integration time in initial orbital periods (a Quantity as for
+        :func:`~ti_spinorbit.surface_of_section`).
     samples_per_orbit : int
         Samples of α per orbital period (α's maximum falls between pericentres).
     rtol, method, integrator, run : optional
@@ -141,6 +144,7 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         circulates, the integration stopped early (collision, escape, ...) or the member
         failed the accuracy check (unless ``include_inaccurate``).
     """
+    _, thetadot_p, orbits = plain_starts(system, None, thetadot_p, orbits)
     integrator = _options.integrator(integrator, rtol, method)
     run = _options.run(run)
     with _progress.reporting(run.progress, "libration_amplitude") as report:
@@ -299,9 +303,10 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
     ----------
     system : BinarySystem or str
         The system, or a catalogue name (``ti_spinorbit.system.catalog``).
-    orbits : float
+    orbits : float or Quantity
         Integration time of every trajectory, initial orbital periods (the section of each
-        candidate has about this many points).
+        candidate has about this many points); a Quantity in ``ti_spinorbit.units.orbit``
+        or a time (divided by the system's period).
     rtol, method, integrator : optional
         How the equations are integrated (:class:`ti_spinorbit.Integrator`; ``rtol``
         default 1e-12), the same for every launch.
@@ -309,7 +314,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
         How the run is carried out (:class:`ti_spinorbit.Run`; in this process, no client):
         the progress (see below), the checkpoints of the search's launches (``DIR/launch-kkk``,
         one per launch: :class:`ti_spinorbit.engine.checkpoint.Launches`).
-    candidates : array, optional
+    candidates : array or Quantity, optional
         Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending, each in
         [-100, 100] (``_validate.MAX_SPIN``); default 45 values over 0.2-1.3.
     zoom_candidates : int
@@ -323,7 +328,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
     coarse_arm_points : int
         Points per arm of the V fitted on the coarse bracket (its arms bend away from the
         centre, so only the nearest few are used).
-    max_extent : float
+    max_extent : float or Quantity
         Largest section extent (deg) allowed at the centre found; above it the search is
         reported as not converged (a chaotic zone can also narrow the zoom window).
     Progress (``run.progress``): None (default) a bar in a terminal or Jupyter for runs
@@ -351,7 +356,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
         the search converged *and* both checks pass; ``message`` says which failed
         ("not converged by N orbits", "not converged in tolerance"). The reported centre and
         amplitude are those at ``orbits`` and ``rtol``; the others are the evidence.
-    max_orbits : float, optional
+    max_orbits : float or Quantity, optional
         Cap of the doubling, in [orbits, 1e7] (default ``4 · orbits``).
     centre_tol : float, optional
         Agreement required of the centres, units of n (default ``max(10 · xtol, 1e-5)``).
@@ -376,6 +381,9 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
         No coarse candidate librates, or the trajectory at the centre found does not.
     """
     system = catalog.as_system(system)
+    candidates, orbits, max_orbits = (to_plain(name, value, unit, system=system) for name, value, unit
+                                      in (("candidates", candidates, "n"), ("orbits", orbits, "orbit"),
+                                          ("max_orbits", max_orbits, "orbit")))
     check_coordinates(coordinates)
     if not system.omega0 > 0:
         raise ValueError("the secondary must be elongated (B > A, omega0 > 0) to have a "
@@ -392,7 +400,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
     require_real("xtol", xtol)
     accuracy.drift_limit(rtol, orbits, max_drift)           # max_drift checked before any work
     require_positive("xtol", xtol)
-    require_scalar("max_extent", max_extent, 0.0, 90.0, low_open=True, unit="deg")
+    max_extent = require_scalar("max_extent", max_extent, 0.0, 90.0, low_open=True, unit="deg")
     zoom_candidates = require_count("zoom_candidates", zoom_candidates, 5, 100001)
     if zoom_candidates % 2 == 0:
         raise ValueError(f"zoom_candidates must be odd (got {zoom_candidates})")

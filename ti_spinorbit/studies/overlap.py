@@ -63,6 +63,7 @@ from .chaosmap import MAP_RTOL
 from .classify import MEGNO_CHAOTIC
 from .libration import section_extent
 from .section import check_orbits, surface_of_section
+from ..units import to_plain
 
 #: Horizontal extent (deg) below which a θ_p = 0 trace counts as librating.
 LIBRATION_LIMIT_DEG = 80.0
@@ -235,9 +236,11 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     eccentricity : float, optional
         Override the catalogue eccentricity, in [0, 1) (names only: with a factory it is
         refused, the factory sets e, the same for every elongation).
-    orbits : float
-        Orbits of the first (shortest) integration; longer ones find slower connections.
-    max_orbits : float, optional
+    orbits : float or Quantity
+        Orbits of the first (shortest) integration; longer ones find slower connections
+        (a Quantity dimensionless or in ``ti_spinorbit.units.orbit``: the elongations'
+        systems differ in period).
+    max_orbits : float or Quantity, optional
         Cap of the doubling (default ``4 · orbits``: lengths orbits, 2·orbits, 4·orbits).
         The scan integrates at orbits, 2·orbits, 4·orbits, ... (each length integrates again,
         from the start, only the elongations still "separate": a connection once seen is
@@ -257,7 +260,7 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
         members run in chunks on its workers, with an identical result).
     centre_starts, separatrix_starts : int
         Starts per elongation in the θ_p = 0 and θ_p = 90° columns, each in [2, 100000].
-    libration_limit : float
+    libration_limit : float or Quantity
         Section extent (deg, in (0, 90]) below which a θ_p = 0 trace counts as librating.
     indicators : bool
         Integrate MEGNO / Lyapunov shadows too (about twice the cost) for the evidence.
@@ -281,6 +284,8 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     """
     # every scalar before any system is built or integrated
     check_coordinates(coordinates)
+    orbits, max_orbits = (to_plain(k, v, "orbit") for k, v in (("orbits", orbits),
+                                                                ("max_orbits", max_orbits)))
     check_orbits(orbits)
     if max_orbits is None:
         max_orbits = 4.0 * float(orbits)
@@ -298,7 +303,8 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     rtol = integrator.rtol
     centre_starts = require_count("centre_starts", centre_starts, 2, 100000)
     separatrix_starts = require_count("separatrix_starts", separatrix_starts, 2, 100000)
-    require_scalar("libration_limit", libration_limit, 0.0, 90.0, low_open=True, unit="deg")
+    libration_limit = require_scalar("libration_limit", libration_limit, 0.0, 90.0, low_open=True,
+                                     unit="deg")
     if not (isinstance(system, str) or callable(system)):
         raise TypeError(f"system must be a catalogue name or a callable "
                         f"(elongation) -> BinarySystem (got {type(system).__name__})")
@@ -515,6 +521,8 @@ def overlap_vs_eccentricity(name, eccentricities, elongations=None, orbits=1000,
     meaning is documented there; ``run=Run(client=...)`` sends every scan to the cluster).
     Returns (eccentricities, numerical first_overlap (NaN if none), analytic a/b at
     ω0^RO(e), list of OverlapScan)."""
+    orbits, max_orbits = (to_plain(k, v, "orbit") for k, v in (("orbits", orbits),
+                                                                ("max_orbits", max_orbits)))
     ecc = _as_floats("eccentricities", eccentricities).ravel()
     require_range("eccentricities", ecc, 0.0, 1.0)
     # every scan keeps its sections: size all of them together, before the first

@@ -36,6 +36,7 @@ from ..model.observables import derive
 from ..model.perturbations import UNIT as PERTURBATIONS
 from ..system.initial import ROW_SLICES, ROW_UNIT as STATE_ROW, physical_rows
 from ..system.systems import BinarySystem, NEAR_CIRCULAR_E, NearCircularWarning
+from ..units import to_plain
 
 SystemLike = Union[BinarySystem, Sequence[BinarySystem]]
 
@@ -53,9 +54,20 @@ INDICATOR_SPACE = ("text: shadow direction of MEGNO and the Lyapunov exponent, '
                    "planar direction) or 'full' (the whole state, attitudes by a small rotation)")
 
 
+def plain_starts(system, theta_p, thetadot_p, orbits):
+    """(θ_p in degrees, θ̇_p in units of n, orbits) of an entry point as plain numbers: a
+    Quantity converted (:mod:`ti_spinorbit.units`: an angle, a rate dimensionless or in
+    ``units.n``, or an angular rate divided by the system's n; a length of time in
+    ``units.orbit`` or a time divided by the period 2π/n, where ``system`` is one system),
+    a plain value unchanged after the degree hint. None stays None."""
+    return (to_plain("theta_p", theta_p, "deg"),
+            to_plain("thetadot_p", thetadot_p, "n", system=system),
+            to_plain("orbits", orbits, "orbit", system=system))
+
+
 def check_orbits(orbits):
     """``orbits`` as a float, or ValueError unless it is finite and lies in (0, MAX_ORBITS]."""
-    value = require_real("orbits", orbits)
+    value = require_real("orbits", orbits, "orbit")
     if not np.isfinite(value) or value <= 0:
         raise ValueError(f"orbits must be a finite number > 0 (got {orbits!r})")
     if value > MAX_ORBITS:
@@ -209,14 +221,19 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     system : BinarySystem, str or list of them
         One system for all members, or one per member (broadcast with the other inputs); a
         str is a catalogue name (``ti_spinorbit.system.catalog``).
-    theta_p : float or array
-        Initial angle of the secondary's long axis from the line of centres, degrees.
-    thetadot_p : float or array
+    theta_p : float, array or Quantity
+        Initial angle of the secondary's long axis from the line of centres, degrees (a
+        plain value that looks like radians, e.g. ``np.pi / 2``, gets a one-line
+        ``DegreesExpectedWarning``), or an angle Quantity (``np.pi / 2 * u.rad``).
+    thetadot_p : float, array or Quantity
         Initial spin rate of the secondary, units of the mean motion n, in [-100, 100]
-        (``_validate.MAX_SPIN``, the bound of the command line's --thetadot).
-    orbits : float
+        (``_validate.MAX_SPIN``, the bound of the command line's --thetadot); a Quantity
+        dimensionless, in ``ti_spinorbit.units.n``, or an angular rate (rad/s), divided by
+        the system's n (one system, or systems of one n).
+    orbits : float or Quantity
         Integration time in initial orbital periods 2π/n (each member its own n); orbits
-        must lie in (0, 1e7] (``MAX_ORBITS``).
+        must lie in (0, 1e7] (``MAX_ORBITS``). A Quantity in ``ti_spinorbit.units.orbit``,
+        or a time, divided by the period of the system (one system, or systems of one n).
     rtol : float, optional
         Relative tolerance of the integration, in [1e-16, 1e-2] (default 1e-12); the same
         as ``Integrator(rtol=...)``, which it must not contradict.
@@ -268,6 +285,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     -------
     SectionResult
     """
+    theta_p, thetadot_p, orbits = plain_starts(system, theta_p, thetadot_p, orbits)
     integrator = _options.integrator(integrator, rtol, method)
     run = _options.run(run)
     started = time.perf_counter()
@@ -675,7 +693,11 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     ``perturbations`` (tides, YORP, BYORP; as for surface_of_section) also fill ``work``
     (the energy the perturbations put in since the start, J, negative when they dissipate)
     and ``external_angmom`` (the angular momentum they brought in, inertial, kg m² s⁻¹) at
-    every sample; the drifts are those of E − W and L − L_ext."""
+    every sample; the drifts are those of E − W and L − L_ext.
+
+    ``theta_p``, ``thetadot_p`` and ``orbits`` are floats (arrays) or Quantities, as for
+    surface_of_section."""
+    theta_p, thetadot_p, orbits = plain_starts(system, theta_p, thetadot_p, orbits)
     integrator = _options.integrator(integrator, rtol, method)
     run = _options.run(run)
     if run.client is not None:
