@@ -9,6 +9,8 @@ Every result class of the package (:class:`~ti_spinorbit.studies.section.Section
 * ``status`` (codes, :class:`Status`), ``status_names``, ``status_counts``, ``n_inaccurate``;
 * ``seconds`` (wall time), ``rtol`` (integrator tolerance), ``orbits`` (run length, orbital
   periods);
+* ``.quantity(name)``: a field as an astropy Quantity in its unit (:mod:`ti_spinorbit.units`;
+  needs astropy, the ``units`` extra);
 * ``.plot()`` (figures live in :mod:`ti_spinorbit.output.plotting`), ``.save(path)``
   (:func:`ti_spinorbit.output.io.save`), ``.to_xarray()`` (:func:`ti_spinorbit.output.xarray_io.to_xarray`);
 * the unit of every field on the field itself: ``dataclasses.fields(cls)[k].metadata["unit"]``
@@ -26,7 +28,7 @@ import enum
 
 import numpy as np
 
-from .. import layout
+from .. import layout, units as _units
 from ..kernels import tableau as _tableau
 
 
@@ -213,6 +215,20 @@ class Result:
     def units(cls):
         """{field: unit} of this result class (:func:`units`)."""
         return units(cls)
+
+    def quantity(self, name):
+        """Field ``name`` as an ``astropy.units.Quantity`` in its unit (the unit text of
+        :meth:`units` read by :func:`ti_spinorbit.units.astropy_unit`): "m", "s", "J",
+        "deg" as astropy's, dimensionless ratios as ``dimensionless_unscaled``, spin rates
+        in ``ti_spinorbit.units.n`` (the mean motion) and lengths of time in
+        ``ti_spinorbit.units.orbit`` (the orbital period), which
+        ``ti_spinorbit.units.equivalencies(system)`` turns into rad/s and s. A field of
+        records is named "field/name", as :meth:`units` lists it
+        (``scan.quantity("decisions/centre_1")``: one value per record). A field that holds no physical quantity
+        (status codes, names, flags, objects) or no field at all: ValueError listing the
+        valid names. Needs astropy (``pip install ti-spinorbit[units]``): ImportError
+        otherwise."""
+        return _units.field_quantity(self, name, units(self))
 
     def plot(self, *args, **kwargs):      # pragma: no cover - every result overrides it
         raise NotImplementedError(f"{type(self).__name__}.plot")
