@@ -324,3 +324,50 @@ def test_fields_print_a_description_without_dict_reprs():
     assert "  offset_m" in text and "0 × 0 × 0" in text         # round-off of a 400 m body
     assert "400 × 400 × 400" in text and "(1, 0, 0), (0, 1, 0), (0, 0, 1)" in text
     assert "period_s                 —" in text and "e                        0.05" in text
+
+
+# ---- the command line's summaries: tables and counts, never a dict/list repr -------------
+
+def no_reprs(text):
+    return "{" not in text and "[" not in text and "None" not in text and "array(" not in text
+
+
+def test_systems_show_prints_a_table(capsys):
+    from ti_spinorbit import cli
+
+    assert cli.main(["systems", "--show", "Didymos (radar shape)"]) == 0
+    out = capsys.readouterr().out
+    assert no_reprs(out), out
+    lines = out.splitlines()
+    assert "primary" in lines and "secondary" in lines                 # nested blocks
+    assert any(line.split()[:1] == ["mass_ratio"] for line in lines)
+    offset = next(line for line in lines if line.strip().startswith("offset_m"))
+    assert offset.split()[1:] == ["0", "×", "0", "×", "0"], offset       # 1e-14 m: round-off
+
+
+def test_cli_summaries_count_statuses_and_zero_round_off(tmp_path, capsys):
+    from ti_spinorbit import cli
+
+    assert cli.main(["map", "--system", "1991 VH", "--grid", "2", "2", "--orbits", "3",
+                     "--out", str(tmp_path / "m.png")]) == 0
+    out = capsys.readouterr().out
+    assert "statuses: done 4)" in out and no_reprs(out), out
+    # 1991 VH has a spherical primary: its spin exchange is round-off and prints as 0
+    assert cli.main(["energy", "--system", "1991 VH", "--orbits", "1", "--rtol", "1e-10",
+                     "--max-drift", "1e-6", "--out", str(tmp_path / "e.png")]) == 0
+    out = capsys.readouterr().out
+    exchange = next(line for line in out.splitlines() if "largest exchange" in line)
+    assert "primary spin 0," in exchange and "orbit 0," not in exchange, exchange
+    assert no_reprs(out), out
+
+
+def test_overlap_summary_says_none_in_words(tmp_path, capsys):
+    from ti_spinorbit import cli
+
+    assert cli.main(["overlap", "--system", "2004 DC", "--elongations", "1.01", "1.03", "0.02",
+                     "--orbits", "5", "--max-orbits", "10", "--out", str(tmp_path / "o.png")]) \
+        in (0, cli.EXIT_INACCURATE)
+    out = capsys.readouterr().out
+    first = out.splitlines()[0]
+    assert first.startswith("2004 DC (e = 0.3): first overlap at a/b = "), first
+    assert "None" not in out and "MEGNO criterion" in first
