@@ -121,6 +121,8 @@ def test_entry_points_take_quantities_bit_for_bit(plain):
     assert np.array_equal(r.thetadot, s.thetadot) and r.orbits == s.orbits
     m = tso.chaos_map(plain, [0.0, 90.0] * u.deg, [1.0] * u.one, 2 * tsu.orbit)
     assert np.array_equal(m.theta_p, [0.0, 90.0]) and m.orbits == 2.0
+    from ti_spinorbit.studies.chaosmap import _check_tilt
+    assert _check_tilt((10 * u.deg, 0.5 * u.deg), "inertial").tolist() == [10.0, 0.5]
 
 
 # ---- wrong dimensions: one line, the parameter, the unit given and the one expected -------

@@ -43,6 +43,7 @@ from ..engine.results import (CLASS, COORDINATES, METHOD, ORBITS, RELATIVE, SPIN
 from ..engine.results import FLOAT as _F, INTEGER as _I, BOOL as _B, TEXT as _S
 from .classify import MIN_POINTS, classify_section
 from .section import INDICATOR_SPACE, SectionResult, check_orbits, plain_starts, surface_of_section
+from ..units import to_plain
 
 #: Colour range of MEGNO maps: 2 (regular) sits low, everything ≥ 8 saturates as chaotic.
 #: Default starts per (a/b, e) of a parameter map: θ_p ∈ {0°, 90°} × θ̇_p/n in the 1:1-3:2 band.
@@ -252,7 +253,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
         Shadow direction of MEGNO and λ (docs/physics.md §10.4): "planar" (default) the
         planar-restricted indicators, "full" deviations of the whole state (the 3-D model
         runs). Recorded in the map (``indicator_space``).
-    tilt : (roll, pitch), optional
+    tilt : (roll, pitch) of floats or Quantities, optional
         Start every grid point tilted out of the plane by these angles, degrees in
         [-90, 90] (``BinarySystem.tilted_start``; inertial coordinates):
         the map's ``max_tilt`` then shows how far each pole strays (``plot(quantity=
@@ -344,7 +345,7 @@ def _check_tilt(tilt, coordinates):
     """chaos_map's ``tilt`` as a float (roll, pitch) array in degrees, or None."""
     if tilt is None:
         return None
-    values = _as_floats("tilt", tilt)
+    values = _as_floats("tilt", to_plain("tilt", tilt, "deg"))
     if values.shape != (2,) or not np.all(np.isfinite(values)) or np.any(np.abs(values) > 90):
         raise ValueError(f"tilt must be (roll, pitch), two finite angles in [-90, 90] degrees "
                          f"(got {show(tilt)})")
