@@ -21,6 +21,8 @@ import errno
 import glob
 import json
 import os
+import re
+import shlex
 import shutil
 import signal
 import subprocess
@@ -288,18 +290,52 @@ def test_unwritable_names_are_refused_before_any_work(vh, tmp_path, monkeypatch,
     assert set(os.listdir(tmp_path)) <= {"gone.npz", "own.json"}   # nothing written
 
 
-@pytest.mark.parametrize("name, stem", [("sub/evil", "sos_sub-evil"), ("a\nb", "sos_a-b"),
-                                        ("../up", "sos_up"), ("tab\there", "sos_tab-here")])
+@pytest.mark.parametrize("name, stem", [
+    ("sub/evil", "sos_sub-evil"), ("a\nb", "sos_a-b"), ("../up", "sos_up"),
+    ("tab\there", "sos_tab-here"),
+    # shell-safe: [A-Za-z0-9._-] only, whatever the name holds
+    ("Didymos (radar shape)", "sos_Didymos-radarshape"), ("$(rm -rf ~)", "sos_rm-rf"),
+    ("a;b&c|d>e", "sos_a-b-c-d-e"), ("O'Brien \"x\"", "sos_O-Brien-x"), ("`id`", "sos_id"),
+    ("Šteins", "sos_Steins"), ("Didymos–Dimorphos", "sos_Didymos-Dimorphos"),
+    ("(65803) Didymos", "sos_65803-Didymos"), ("-rf", "sos_rf"), ("*?[]", "sos_unnamed"),
+    ("α Cen + β", "sos_Cen"), ("x=1,y@2+3", "sos_x-1-y-2-3"), ("v1.2_b", "sos_v1.2_b"),
+])
 def test_system_names_are_made_safe_in_default_file_names(vh, tmp_path, monkeypatch, name,
                                                           stem):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "sub").mkdir()
     args = cli._parser().parse_args(["section", "--system", _system_file(tmp_path, vh, name)])
     assert cli.default_stem(args, "sos", name) == stem
+    assert re.fullmatch(r"[A-Za-z0-9._-]+", stem) and shlex.quote(stem) == stem
     out, data = common.output_paths(args, "sos", name)
     common.release_outputs()
     assert (out, data) == (stem + ".png", stem + ".npz")
     assert os.listdir(tmp_path / "sub") == [] and "\n" not in out
+
+
+@pytest.mark.parametrize("value, power, text", [
+    (9.999999999999999e-12, True, "1e-11"), (1e-4, True, "1e-4"), (2.5e-11, True, "2.5e-11"),
+    (3e-10, False, "3e-10"), (1e6, False, "1e6"), (1e-5, False, "1e-5"), (5e-4, False, "0.0005"),
+    (1000.0, False, "1000"), (-30.0, False, "-30"), (0.1 + 0.2, False, "0.3"),
+    (1.0000001, False, "1.0000001"), (1234567.0, False, "1234567"), (2.5e-7, False, "2.5e-7"),
+    (1.06, False, "1.06"), (64, False, "64"), (1e22, False, "1e22"),
+])
+def test_numbers_in_default_names_are_g_style(value, power, text):
+    """%g, with more digits (up to 12) only where %g's 6 would change the value; never a
+    double's binary noise; exponents short and without "+"."""
+    assert common.name_number(value, power=power) == text
+
+
+@pytest.mark.parametrize("argv, stem", [
+    (["--rtol", "1e-11", "--elongation", "1.0000001"], "sos_1991VH_ab1.0000001_rtol1e-11"),
+    (["--orbits", "1234567", "--eccentricity", "0.30000000000000004"], "sos_1991VH_e0.3_o1234567"),
+    (["--thetadot", "1e-5", "2.5e-7", "1e2"], "sos_1991VH_td1e-5-2.5e-7-100"),
+    (["--orbits", "1e6", "--strength", "1e12", "--tide", "secondary"],
+     "sos_1991VH_o1e6_tide-secondary_str1e12"),
+])
+def test_default_names_write_numbers_g_style(argv, stem):
+    args = cli._parser().parse_args(["section", *argv])
+    assert cli.default_stem(args, "sos", "1991 VH") == stem
 
 
 def test_default_names_of_catalogued_systems_are_unchanged():

@@ -63,8 +63,10 @@ import filelock
 NAME_MAX = 255
 #: Longest path (bytes) where the system does not say (Linux's PATH_MAX).
 PATH_MAX = 4096
-#: Characters kept in a file-name part besides letters and digits (others become "-").
-SAFE_PUNCTUATION = "-_.+,=@"
+#: Characters kept in a file-name part besides ASCII letters and digits (others become "-"):
+#: a name made of [A-Za-z0-9._-] needs no quoting in any shell and means the same on every
+#: file system.
+SAFE_PUNCTUATION = "-_."
 
 
 class OutputBusy(ValueError):
@@ -92,17 +94,19 @@ def _shorten(text, limit):
 
 
 def safe_part(text, fallback="unnamed", tidy=True):
-    """``text`` as one file-name part: spaces dropped (``"1991 VH"`` -> ``"1991VH"``), every
-    character other than a letter, digit or one of :data:`SAFE_PUNCTUATION` (folder separators,
-    control characters, newlines, quotes, ``*?<>|:``) replaced by ``-``; with ``tidy`` (names)
-    also runs of ``-`` joined and leading/trailing ``-`` and ``.`` removed (without it, for
-    flag values, ``-`` stays as it is: ``td-1--2`` is not ``td-1-2``); ``fallback`` when
-    nothing is left."""
+    """``text`` as one shell-safe file-name part, made of ``[A-Za-z0-9._-]`` only: spaces
+    dropped (``"1991 VH"`` -> ``"1991VH"``), accents taken off (``"Šteins"`` -> ``"Steins"``),
+    every other character than an ASCII letter, digit or one of :data:`SAFE_PUNCTUATION`
+    (parentheses, folder separators, control characters, newlines, quotes, ``*?<>|:$&;``,
+    other scripts) replaced by ``-`` (``"Didymos (radar shape)"`` -> ``"Didymos-radarshape"``);
+    with ``tidy`` (names) also runs of ``-`` joined and leading/trailing ``-`` and ``.``
+    removed (without it, for flag values, ``-`` stays as it is: ``td-1--2`` is not
+    ``td-1-2``); ``fallback`` when nothing is left."""
     out = []
-    for ch in unicodedata.normalize("NFC", str(text)):
-        if ch == " ":
+    for ch in unicodedata.normalize("NFKD", str(text)):
+        if ch == " " or unicodedata.combining(ch):      # spaces and accents go
             continue
-        ok = (ch.isalnum() and unicodedata.category(ch)[0] in "LN") or ch in SAFE_PUNCTUATION
+        ok = (ch.isascii() and ch.isalnum()) or ch in SAFE_PUNCTUATION
         out.append(ch if ok else "-")
     part = "".join(out)
     if tidy:

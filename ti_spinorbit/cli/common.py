@@ -4,6 +4,7 @@ Matplotlib backend, Taichi start-up, the system a command runs on (catalogued or
 file), default file names, progress, checkpoints, writing results and the accuracy verdict."""
 
 import dataclasses
+import math
 import os
 import re
 import sys
@@ -288,15 +289,15 @@ def default_stem(args, prefix, system_name):
     per physics flag that differs from its default (:data:`NAME_TAGS`), so that runs with
     other parameters never share a file: ``sos_1991VH_ab1.06_o1000``."""
     defaults = vars(PARSER().parse_args([args.command]))
-    # a system's name (a system file's included) is made safe for a file name: no folder
-    # separators, control characters or newlines ("sub/evil" -> "sub-evil")
+    # a system's name (a system file's included) is made shell-safe, [A-Za-z0-9._-] only:
+    # no folder separators, parentheses, spaces or newlines ("sub/evil" -> "sub-evil")
     parts = [prefix, safe_part(system_name)]
     for dest, tag in NAME_TAGS:
         value = getattr(args, dest, None)
         if value is None or value == defaults.get(dest):
             continue
         if isinstance(value, (list, tuple)):
-            items = [fmt(v) for v in value]
+            items = [name_number(v) if isinstance(v, (int, float)) else str(v) for v in value]
             if dest == "grid":
                 text = "x".join(items)
             elif len(items) > 3:
@@ -305,16 +306,31 @@ def default_stem(args, prefix, system_name):
                 text = "-".join(items)
         elif isinstance(value, bool):                # a switch: its tag alone
             text = ""
-        elif dest in ("rtol", "xtol"):               # tolerances always as powers: 1e-4
-            # 12 digits: 1e-11 is 9.99999999999999939e-12 in binary, and 15 digits showed it
-            mantissa, exponent = f"{value:.12e}".split("e")
-            text = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+        elif isinstance(value, (int, float)):
+            text = name_number(value, power=dest in ("rtol", "xtol"))
         else:
-            text = fmt(value) if isinstance(value, (int, float)) else str(value)
-        # exponents short and without "+": 1e6, 1e-13 (not 1e+06, 1e-13 stays)
-        text = re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
+            text = str(value)
         parts.append(safe_part(tag + text, tidy=False))
     return "_".join(parts)
+
+
+def name_number(value, power=False):
+    """A number as a file name writes it: ``%g`` (``1e6``, ``0.0005``, ``1000``, ``-30``), with
+    up to 12 significant digits where ``%g``'s 6 would change the value (``1.0000001``), never
+    the binary noise of a double (``--rtol 1e-11`` is 9.999999999999999e-12: ``1e-11``); the
+    exponent short and without "+" (``1e6``, ``1e-13``); ``power`` (tolerances) always as a
+    power of ten (``1e-4``, ``2.5e-11``). Integers as they are."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    value = float(value)
+    if power and value and math.isfinite(value):
+        mantissa, exponent = f"{value:.12e}".split("e")
+        text = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"
+    else:
+        text = f"{value:g}"
+        if float(text) != float(f"{value:.12g}"):
+            text = f"{value:.12g}"
+    return re.sub(r"e\+?(-?)0*(\d)", r"e\1\2", text)
 
 
 # ---- output paths, claims and checkpoints -----------------------------------------------
