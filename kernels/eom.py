@@ -149,10 +149,11 @@ def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.templ
     f2 = perturb.tide_of(p, i, q + perturb.Q_TIDE2, R, V, om2)
     F = f1 + f2
     # YORP about each body's z axis; each body takes its own tide's torque
-    N1 = vec3(0.0, 0.0, p[i, q + perturb.Q_YORP1]) - R.cross(f1)
-    N2 = p[i, q + perturb.Q_YORP2] * vec3(S[0, 2], S[1, 2], S[2, 2]) - R.cross(f2)
+    rad = perturb.radiation_factor(p, i, q, t)      # YORP, BYORP at the Sun's distance
+    N1 = vec3(0.0, 0.0, rad * p[i, q + perturb.Q_YORP1]) - R.cross(f1)
+    N2 = (rad * p[i, q + perturb.Q_YORP2]) * vec3(S[0, 2], S[1, 2], S[2, 2]) - R.cross(f2)
     m = p[i, P_MRED]
-    F += (m * p[i, q + perturb.Q_BYORP] / V.norm()) * V
+    F += (m * rad * p[i, q + perturb.Q_BYORP] / V.norm()) * V
     for c in ti.static(perturb.THIRD_BODIES):   # the Sun, a passing planet
         mu3 = p[i, q + c + perturb.T_MU]
         if mu3 != 0.0:    # its tide and its torques on both bodies (frame A)

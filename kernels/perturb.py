@@ -61,7 +61,7 @@ Q_TIDE1, Q_TIDE2, Q_YORP1, Q_YORP2, Q_BYORP = _L.Q_TIDE1, _L.Q_TIDE2, _L.Q_YORP1
 Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0 = _L.Q_SUN, _L.Q_SUN_A, _L.Q_SUN_E, _L.Q_SUN_N, _L.Q_SUN_M0
 Q_SUN_P, Q_SUN_Q, Q_SUN_NU = _L.Q_SUN_P, _L.Q_SUN_Q, _L.Q_SUN_NU
 Q_SUN_J1, Q_SUN_J2 = _L.Q_SUN_J1, _L.Q_SUN_J2
-Q_FLYBY, THIRD_BODIES = _L.Q_FLYBY, _L.THIRD_BODIES
+Q_FLYBY, THIRD_BODIES, Q_RAD = _L.Q_FLYBY, _L.THIRD_BODIES, _L.Q_RAD
 T_MU, T_A, T_E, T_N, T_M0, T_P, T_Q, T_NU, T_J1, T_J2 = (_L.T_MU, _L.T_A, _L.T_E, _L.T_N, _L.T_M0,
                                                          _L.T_P, _L.T_Q, _L.T_NU, _L.T_J1, _L.T_J2)
 #: Newton iterations on Kepler's equation at most (they stop at round-off, in a few)
@@ -120,6 +120,38 @@ def tide_polar_of(p: ti.template(), i, col: ti.template(), r, vr, ell, omega):
 
 
 @ti.func
+def eccentric_anomaly(M, e):
+    """E of Kepler's equation E − e sin E = M (e < 1) by Newton's method from Danby's start
+    E = M + 0.85 e sign(M), M reduced to [−π, π), stopped at round-off."""
+    two_pi = 6.283185307179586
+    M = M - two_pi * ti.floor(M / two_pi + 0.5)          # in [−π, π)
+    E = M + ti.select(M < 0.0, -0.85, 0.85) * e
+    for _ in range(KEPLER_ITERATIONS):
+        dE = (E - e * ti.sin(E) - M) / (1.0 - e * ti.cos(E))
+        E -= dE
+        if ti.abs(dE) <= 1e-15 * (1.0 + ti.abs(E)):   # the next would be below round-off
+            break
+    return E
+
+
+@ti.func
+def radiation_factor(p: ti.template(), i, q: ti.template(), t):
+    """(a⊙² sqrt(1 − e⊙²)) / d(t)², the factor on the mean-distance YORP torques and BYORP
+    acceleration at the Sun's distance d = a⊙ (1 − e⊙ cos E) of the moment (the Sun slot's
+    orbit of the block starting at column ``q``); 1 for the mean-distance form (Q_RAD 0).
+    Its average over a heliocentric orbit is 1."""
+    f = 1.0
+    k = p[i, q + Q_RAD]
+    if k != 0.0:
+        c = q + Q_SUN
+        e = p[i, c + T_E]
+        E = eccentric_anomaly(p[i, c + T_M0] + p[i, c + T_N] * t, e)
+        d = p[i, c + T_A] * (1.0 - e * ti.cos(E))
+        f = k / (d * d)
+    return f
+
+
+@ti.func
 def third_body_position(p: ti.template(), i, c: ti.template(), t):
     """A third body's position relative to the barycentre at scaled time t, inertial frame:
     x P + y Q on the conic of the slot at absolute column ``c`` of member i's row. Kepler's
@@ -132,14 +164,7 @@ def third_body_position(p: ti.template(), i, c: ti.template(), t):
     x = 0.0
     y = 0.0
     if e < 1.0:
-        two_pi = 6.283185307179586
-        M = M - two_pi * ti.floor(M / two_pi + 0.5)          # in [−π, π)
-        E = M + ti.select(M < 0.0, -0.85, 0.85) * e
-        for _ in range(KEPLER_ITERATIONS):
-            dE = (E - e * ti.sin(E) - M) / (1.0 - e * ti.cos(E))
-            E -= dE
-            if ti.abs(dE) <= 1e-15 * (1.0 + ti.abs(E)):   # the next would be below round-off
-                break
+        E = eccentric_anomaly(M, e)
         x = a * (ti.cos(E) - e)
         y = a * ti.sqrt((1.0 - e) * (1.0 + e)) * ti.sin(E)
     else:

@@ -259,11 +259,12 @@ def rhs_perturbed_mp(p: ti.template(), i, y, order: ti.template(), odd: ti.templ
     fr2, ft2 = perturb.tide_polar_of(p, i, q + perturb.Q_TIDE2, r, vr, ell, om2)
     Fr = fr1 + fr2
     Ft = ft1 + ft2
-    N1 = p[i, q + perturb.Q_YORP1] - r * ft1        # each body takes its own tide's torque
-    N2 = p[i, q + perturb.Q_YORP2] - r * ft2
+    rad = perturb.radiation_factor(p, i, q, t)      # YORP, BYORP at the Sun's distance
+    N1 = rad * p[i, q + perturb.Q_YORP1] - r * ft1  # each body takes its own tide's torque
+    N2 = rad * p[i, q + perturb.Q_YORP2] - r * ft2
     vt = ell / r
     speed = ti.sqrt(vr * vr + vt * vt)
-    fb = p[i, q + perturb.Q_BYORP] / (pv[P_INV_M] * speed)   # m a_B / |V|
+    fb = rad * p[i, q + perturb.Q_BYORP] / (pv[P_INV_M] * speed)   # m a_B / |V|
     Fr += fb * vr
     Ft += fb * vt
     for c in ti.static(perturb.THIRD_BODIES):   # the Sun, a passing planet

@@ -121,7 +121,7 @@ def test_the_documented_examples_stay_inside_the_strength_limits():
 def test_yorp_spin_change_per_orbit_is_the_torque_the_run_delivers():
     """change_per_orbit's YORP figure against the external angular momentum the kernels
     integrate over one orbit: ΔL = T P, so ΔL / (C n) = 2π T / (C n²)."""
-    yorp = tso.YORP(strength=1e6)
+    yorp = tso.YORP(strength=1e6, distance="mean")     # change_per_orbit's mean distance
     (_, predicted, _, _), = perturbations.change_per_orbit(yorp, VH)
     ts = tso.time_series(VH, [30.0], [0.8], orbits=1, samples_per_orbit=8, rtol=1e-12,
                          perturbations=[yorp])

@@ -29,7 +29,10 @@ EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__fil
 
 # the constants spelled out, independently of ti_spinorbit.constants
 L_SUN, C_LIGHT, AU = 3.828e26, 299792458.0, 1.495978707e11
-HELIO = dict(heliocentric_a_au=1.5, heliocentric_e=0.2)
+# YORP and BYORP at their mean-distance value, the form the analytic rates these tests check
+# against give (the Sun's distance of the moment: test_radiation_at_the_suns_distance in
+# tests/test_heliocentric.py); SolarTide is not given it
+HELIO = dict(heliocentric_a_au=1.5, heliocentric_e=0.2, distance="mean")
 
 
 def spheres():

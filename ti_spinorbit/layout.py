@@ -126,7 +126,11 @@ class perturbation:
     Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0 = Q_SUN + T_A, Q_SUN + T_E, Q_SUN + T_N, Q_SUN + T_M0
     Q_SUN_P, Q_SUN_Q, Q_SUN_NU = Q_SUN + T_P, Q_SUN + T_Q, Q_SUN + T_NU
     Q_SUN_J1, Q_SUN_J2 = Q_SUN + T_J1, Q_SUN + T_J2
-    NPERT = Q_FLYBY + NTHIRD
+    # YORP and BYORP at the Sun's distance of the moment: a⊙² sqrt(1 − e⊙²) (scaled), the
+    # factor that turns their mean-distance values into (a⊙² sqrt(1 − e⊙²)) / d(t)² of the
+    # Sun slot's orbit; 0: the mean-distance form
+    Q_RAD = Q_FLYBY + NTHIRD
+    NPERT = Q_RAD + 1
     NACC = 4           # accumulators after the state: W, then L_ext (x, y, z)
     #: Floor of the bulge's relative angular rate in the constant-Q lag (units of n).
     Q_RATE_FLOOR = 1e-3

@@ -46,11 +46,14 @@ from typing import Optional
 
 import numpy as np
 
-from ..constants import AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, GM_SUN, K2_MODELS, L_SUN
+from ..constants import (AU, C_LIGHT, DEFAULT_F_YORP, DEFAULT_Q, GM_SUN, K2_MODELS, L_SUN,
+                         PLANETS)
 from .._validate import HELIOCENTRIC_A_RANGE as _HELIOCENTRIC_A_RANGE
 from .._validate import (check_heliocentric, require_positive_scalar, require_range, require_real,
                          show)
 from ..layout import perturbation as _layout
+from ..system.heliocentric import (ANGLE_RANGE, INCLINATION_RANGE, HeliocentricOrbit, check_angle,
+                                   conic_position, orbit_directions)
 from ..system.systems import BinarySystem, G
 from ..units import plain_fields as _plain_fields
 
@@ -65,6 +68,10 @@ Q_SUN, Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0, Q_SUN_P, Q_SUN_Q, Q_SUN_NU = (
     _layout.Q_SUN, _layout.Q_SUN_A, _layout.Q_SUN_E, _layout.Q_SUN_N, _layout.Q_SUN_M0,
     _layout.Q_SUN_P, _layout.Q_SUN_Q, _layout.Q_SUN_NU)
 Q_SUN_J1, Q_SUN_J2 = _layout.Q_SUN_J1, _layout.Q_SUN_J2
+Q_FLYBY, THIRD_BODIES, Q_RAD = _layout.Q_FLYBY, _layout.THIRD_BODIES, _layout.Q_RAD
+T_MU, T_A, T_E, T_N, T_M0, T_P, T_Q, T_NU, T_J1, T_J2 = (
+    _layout.T_MU, _layout.T_A, _layout.T_E, _layout.T_N, _layout.T_M0, _layout.T_P, _layout.T_Q,
+    _layout.T_NU, _layout.T_J1, _layout.T_J2)
 BODIES = ("primary", "secondary")
 #: Allowed ranges (closed), shared with the command line's flags.
 K2_RANGE = (1e-12, 10.0)
@@ -85,9 +92,7 @@ TIDE_FORCE_LIMIT = 0.1                # conservative tide / mutual gravity at pe
 #: The Sun's tide over the mutual gravity (at apoapsis and perihelion) beyond which it is
 #: the dynamics, not a perturbation: (a/r_Hill)³ = 3 × this, a ≈ 0.3 of the Hill radius.
 SOLAR_TIDE_LIMIT = 0.01
-#: Angles of the heliocentric orbit, degrees (closed): i in [0, 180], the others [-360, 360].
-INCLINATION_RANGE = (0.0, 180.0)
-ANGLE_RANGE = (-360.0, 360.0)
+# Angles of the heliocentric orbit (INCLINATION_RANGE, ANGLE_RANGE): system/heliocentric.py
 HELIOCENTRIC_A_RANGE = _HELIOCENTRIC_A_RANGE   # AU (ti_spinorbit._validate)
 #: YORP torque conventions: name -> (k, turns). The torque is T = f_Y R³ L_⊙ /
 #: (k c d² sqrt(1 − e_⊙²)) and ``turns`` the rotations of the body per mutual orbit whose
@@ -97,8 +102,14 @@ YORP_CONVENTIONS = {"paper": (6.0, 2), "one-turn": (3.0, 1)}
 YORP_CONVENTION = "paper"
 #: The convention of a saved YORP that records none (written before the choice existed).
 YORP_LEGACY_CONVENTION = "one-turn"
+#: Where YORP and BYORP take the Sun's distance: on the heliocentric orbit at every step, or
+#: its mean-distance form (docs/physics.md §13.12); the default, and that of a saved object
+#: written before the choice existed.
+DISTANCES = ("orbit", "mean")
+DISTANCE = "orbit"
+DISTANCE_LEGACY = "mean"
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
-UNIT = "objects: Tides / YORP / BYORP / SolarTide with SI parameters (ti_spinorbit.model.perturbations)"
+UNIT = "objects: Tides / YORP / BYORP / SolarTide / Flyby with SI parameters (ti_spinorbit.model.perturbations)"
 
 
 def solar_radiation_constant():
@@ -166,14 +177,70 @@ def _heliocentric(system, a_au, e):
         if orbit is None:
             raise ValueError(f"{system.name!r} has no heliocentric orbit: pass "
                              "heliocentric_a_au (AU) and heliocentric_e to YORP / BYORP, or "
-                             "give the system heliocentric_orbit=(a_AU, e)")
-        a_au, e = orbit
+                             "give the system heliocentric_orbit=HeliocentricOrbit(a_AU, e, ...)")
+        a_au, e = orbit.a_au, orbit.e
     return a_au * AU, (0.0 if e is None else e)
 
 
 def _scales(system):
     """(mass, length, time) units of a member: m1 + m2 (kg), a (m), 1/n (s)."""
     return system.total_mass, system.a, 1.0 / system.mean_motion
+
+
+def _check_distance(distance):
+    if distance not in DISTANCES:
+        raise ValueError(f"distance must be one of {', '.join(DISTANCES)} (got {show(distance)}): "
+                         "'orbit' for the Sun's distance of the moment, 'mean' for the "
+                         "mean-distance form")
+
+
+def _sun_orbit_columns(out, system, a, e, M0, L, T):
+    """The Sun slot's orbit columns of ``out`` (a, e in m and -, M0 rad): a/L, e, the
+    heliocentric mean motion × T, M0 (the Sun's tide and YORP/BYORP read the same ones)."""
+    out[Q_SUN_A] = a / L
+    out[Q_SUN_E] = e
+    out[Q_SUN_N] = math.sqrt((GM_SUN + G * system.total_mass) / a ** 3) * T
+    out[Q_SUN_M0] = M0
+
+
+def _radiation_orbit(p, system):
+    """A block with the Sun's orbit and the distance factor a⊙² sqrt(1 − e⊙²) / L² of a YORP
+    or BYORP ``p`` with ``distance="orbit"`` (zeros for ``"mean"``)."""
+    out = np.zeros(NPERT)
+    if p.distance == "orbit":
+        _, L, T = _scales(system)
+        a, e = _heliocentric(system, p.heliocentric_a_au, p.heliocentric_e)
+        orbit = getattr(system, "heliocentric_orbit", None)
+        M0 = math.radians(orbit.mean_anomaly_deg) if (
+            p.heliocentric_a_au is None and orbit is not None) else 0.0
+        _sun_orbit_columns(out, system, a, e, M0, L, T)
+        out[Q_RAD] = (a / L) ** 2 * math.sqrt(1.0 - e * e)
+    return out
+
+
+#: Columns of a block that describe one thing (the Sun's orbit, the distance factor): several
+#: perturbations may set them, to the same values, and they are not summed.
+SHARED_COLUMNS = (Q_SUN_A, Q_SUN_E, Q_SUN_N, Q_SUN_M0, Q_RAD)
+
+
+def _combine(blocks, names):
+    """The sum of ``blocks``, except the shared columns: set once, and a ValueError when two
+    perturbations (``names``) give them different values (two heliocentric orbits)."""
+    out = np.zeros(NPERT)
+    shared = list(SHARED_COLUMNS)
+    owner = {}
+    for block, name in zip(blocks, names):
+        for c in shared:
+            if block[c] != 0.0:
+                if out[c] != 0.0 and not math.isclose(out[c], block[c], rel_tol=1e-12):
+                    raise ValueError(f"{owner[c]} and {name} are on different heliocentric "
+                                     "orbits: give them the same one (the system's, or the "
+                                     "same heliocentric_a_au and heliocentric_e)")
+                out[c], owner[c] = block[c], name
+        rest = block.copy()
+        rest[shared] = 0.0
+        out += rest
+    return out
 
 
 def _constructor_radius(name, body, radius_m, system):
@@ -305,6 +372,11 @@ class YORP:
     convention : {"paper", "one-turn"}
         Which torque f_Y stands for (:data:`YORP_CONVENTIONS`; default ``"paper"``). Saved
         with the object; a saved YORP without it is read back as ``"one-turn"``.
+    distance : {"orbit", "mean"}
+        ``"orbit"`` (default): the torque at the Sun's distance d(t) of the moment, on the
+        heliocentric orbit, T (a⊙² sqrt(1 − e⊙²)) / d(t)², whose orbit average is T;
+        ``"mean"``: T at all times (the paper's form). A saved YORP without it is read back
+        as ``"mean"``, the torque it was run with.
     """
 
     body: str = "secondary"
@@ -314,6 +386,7 @@ class YORP:
     radius: Optional[float] = None
     strength: float = 1.0
     convention: str = YORP_CONVENTION
+    distance: str = DISTANCE
 
     kind = "yorp"
 
@@ -325,6 +398,7 @@ class YORP:
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         _check_radius_and_strength(self)
         _check_yorp_convention(self.convention)
+        _check_distance(self.distance)
 
     def torque(self, system):
         """T × strength, N m (signed), in this object's ``convention``."""
@@ -340,7 +414,7 @@ class YORP:
 
     def block(self, system):
         M, L, T = _scales(system)
-        out = np.zeros(NPERT)
+        out = _radiation_orbit(self, system)
         out[Q_YORP1 if self.body == "primary" else Q_YORP2] = self.torque(system) / (M * L ** 2 / T ** 2)
         return out
 
@@ -370,6 +444,9 @@ class BYORP:
         The secondary's radius R_s, m; default its volume-equivalent radius.
     strength : float
         Factor on the force (default 1).
+    distance : {"orbit", "mean"}
+        As for :class:`YORP`: the force at the Sun's distance of the moment (default), or
+        its mean-distance value at all times.
     """
 
     coefficient: float = 1e-3
@@ -377,6 +454,7 @@ class BYORP:
     heliocentric_e: Optional[float] = None
     radius: Optional[float] = None
     strength: float = 1.0
+    distance: str = DISTANCE
 
     kind = "byorp"
     body = "secondary"
@@ -387,6 +465,7 @@ class BYORP:
         _check_signed("BYORP coefficient (B)", self.coefficient, COEFFICIENT_LIMIT)
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         _check_radius_and_strength(self)
+        _check_distance(self.distance)
 
     def force(self, system):
         """F_B × strength, N (signed)."""
@@ -401,7 +480,7 @@ class BYORP:
 
     def block(self, system):
         M, L, T = _scales(system)
-        out = np.zeros(NPERT)
+        out = _radiation_orbit(self, system)
         out[Q_BYORP] = self.acceleration(system) / (L / T ** 2)
         return out
 
@@ -417,22 +496,24 @@ class SolarTide:
     gravity-gradient torque on both bodies (docs/physics.md §13.11). The Sun moves on the
     barycentre's heliocentric Kepler orbit, solved in the kernels at every stage.
 
-    The orbit's angles are relative to the package's inertial frame, which for the standard
-    start (docs/physics.md §6.4) is the mutual orbit's initial frame: x to the initial
-    pericentre (the line of centres), z the initial orbit normal (a start given as an
-    ``InitialState`` uses its own inertial frame). The defaults put the Sun in the mutual
-    orbit plane (i = 0, Ω = ω = 0) with the barycentre at perihelion at t = 0 (M = 0), the
-    Sun then on the −x axis.
+    By default the orbit is the system's own ``heliocentric_orbit`` (a
+    :class:`~ti_spinorbit.HeliocentricOrbit`: all six elements, relative to the binary or to
+    the ecliptic with the binary's pole). Any orbit field given here replaces it: the fields
+    left out then take the system's a and e and zero angles, relative to the package's
+    inertial frame, which for the standard start (docs/physics.md §6.4) is the mutual orbit's
+    initial frame: x to the initial pericentre (the line of centres), z the initial orbit
+    normal (a start given as an ``InitialState`` uses its own inertial frame). Zero angles
+    put the Sun in the mutual orbit plane (i = 0, Ω = ω = 0) with the barycentre at
+    perihelion at t = 0 (M = 0), the Sun then on the −x axis.
 
     Parameters
     ----------
     heliocentric_a_au, heliocentric_e : float or Quantity, optional
-        The barycentre's heliocentric semimajor axis (AU) and eccentricity; default the
-        system's ``heliocentric_orbit``.
-    inclination_deg : float or Quantity
-        i, degrees in [0, 180] (default 0: the Sun in the mutual orbit plane).
-    node_deg, periapsis_deg, mean_anomaly_deg : float or Quantity
-        Ω, ω and the mean anomaly at t = 0, degrees in [−360, 360] (default 0).
+        The barycentre's heliocentric semimajor axis (AU) and eccentricity.
+    inclination_deg : float or Quantity, optional
+        i, degrees in [0, 180].
+    node_deg, periapsis_deg, mean_anomaly_deg : float or Quantity, optional
+        Ω, ω and the mean anomaly at t = 0, degrees in [−360, 360].
     strength : float
         Factor on the Sun's mass in the force and torques (default 1); the Sun's motion
         keeps the real mass.
@@ -440,15 +521,16 @@ class SolarTide:
 
     heliocentric_a_au: Optional[float] = None
     heliocentric_e: Optional[float] = None
-    inclination_deg: float = 0.0
-    node_deg: float = 0.0
-    periapsis_deg: float = 0.0
-    mean_anomaly_deg: float = 0.0
+    inclination_deg: Optional[float] = None
+    node_deg: Optional[float] = None
+    periapsis_deg: Optional[float] = None
+    mean_anomaly_deg: Optional[float] = None
     strength: float = 1.0
 
     kind = "solar_tide"
     body = "both"
     radius = None
+    ANGLES = ("inclination_deg", "node_deg", "periapsis_deg", "mean_anomaly_deg")
 
     def __post_init__(self):
         _plain_fields(self, heliocentric_a_au="AU", heliocentric_e="", inclination_deg="deg",
@@ -456,33 +538,55 @@ class SolarTide:
         _check_heliocentric(self.heliocentric_a_au, self.heliocentric_e)
         if self.heliocentric_e is not None and not self.heliocentric_e < 1.0:
             raise ValueError(f"heliocentric_e must be in [0, 1) (got {show(self.heliocentric_e)})")
-        require_real("inclination_deg", self.inclination_deg)
-        require_range("inclination_deg", self.inclination_deg, *INCLINATION_RANGE,
-                      high_open=False)
-        for name in ("node_deg", "periapsis_deg", "mean_anomaly_deg"):
-            require_real(name, getattr(self, name))
-            require_range(name, getattr(self, name), *ANGLE_RANGE, high_open=False)
+        for name in self.ANGLES:
+            if getattr(self, name) is not None:
+                check_angle(name, getattr(self, name),
+                            INCLINATION_RANGE if name == "inclination_deg" else ANGLE_RANGE)
         require_positive_scalar("strength", self.strength, *STRENGTH_RANGE)
 
-    def orbit(self, system):
-        """(a in m, e) of the barycentre's heliocentric orbit: given, else the system's."""
-        a, e = _heliocentric(system, self.heliocentric_a_au, self.heliocentric_e)
-        if not e < 1.0:
-            raise ValueError(f"SolarTide needs a bound heliocentric orbit, e < 1 (got {e!r})")
-        return a, e
+    @property
+    def own_orbit(self):
+        """Whether this object gives (part of) the orbit itself, replacing the system's."""
+        return self.heliocentric_a_au is not None or any(
+            getattr(self, name) is not None for name in self.ANGLES)
 
-    def directions(self):
+    def heliocentric(self, system):
+        """The :class:`~ti_spinorbit.HeliocentricOrbit` the Sun moves on for ``system``."""
+        if not self.own_orbit:
+            orbit = getattr(system, "heliocentric_orbit", None)
+            if orbit is None:
+                raise ValueError(f"{system.name!r} has no heliocentric orbit: give the system "
+                                 "heliocentric_orbit=HeliocentricOrbit(a_AU, e, ...), or "
+                                 "SolarTide(heliocentric_a_au=..., heliocentric_e=...)")
+            return orbit
+        a_au, e = self.heliocentric_a_au, self.heliocentric_e
+        if a_au is None:
+            orbit = getattr(system, "heliocentric_orbit", None)
+            if orbit is None:
+                raise ValueError(f"{system.name!r} has no heliocentric orbit: pass "
+                                 "heliocentric_a_au (AU) and heliocentric_e to SolarTide")
+            a_au, e = orbit.a_au, orbit.e
+        return HeliocentricOrbit(a_au, e, **{name: getattr(self, name) or 0.0
+                                             for name in self.ANGLES})
+
+    def orbit(self, system):
+        """(a in m, e) of the barycentre's heliocentric orbit."""
+        orbit = self.heliocentric(system)
+        if not orbit.e < 1.0:
+            raise ValueError(f"SolarTide needs a bound heliocentric orbit, e < 1 (got {orbit.e!r})")
+        return orbit.a_au * AU, orbit.e
+
+    def directions(self, system=None):
         """(P, Q): unit vectors to the heliocentric perihelion and 90° ahead of it in the
-        orbit's plane, in the inertial frame (rotation Rz(Ω) Rx(i) Rz(ω))."""
-        i, O, w = (math.radians(x) for x in (self.inclination_deg, self.node_deg,
-                                             self.periapsis_deg))
-        cO, sO, ci, si, cw, sw = (math.cos(O), math.sin(O), math.cos(i), math.sin(i),
-                                  math.cos(w), math.sin(w))
-        if self.inclination_deg == 180.0:          # exactly in the plane, retrograde
-            ci, si = -1.0, 0.0
-        P = np.array([cO * cw - sO * sw * ci, sO * cw + cO * sw * ci, sw * si])
-        Q = np.array([-cO * sw - sO * cw * ci, -sO * sw + cO * cw * ci, cw * si])
-        return P, Q
+        orbit's plane, in the inertial frame (rotation Rz(Ω) Rx(i) Rz(ω); from the ecliptic
+        with the binary's pole for a system's ecliptic orbit). ``system`` may be left out
+        when this object gives the orbit's angles itself."""
+        if system is None and not self.own_orbit:
+            raise ValueError("the Sun's direction comes from the system's heliocentric orbit: "
+                             "pass the system")
+        if system is None:
+            return orbit_directions(*(getattr(self, name) or 0.0 for name in self.ANGLES[:3]))
+        return self.heliocentric(system).directions()
 
     def mean_motion(self, system):
         """The heliocentric mean motion sqrt(G (M_⊙ + m1 + m2) / a³), rad s⁻¹."""
@@ -493,15 +597,8 @@ class SolarTide:
         """The Sun's position relative to the barycentre at time t (s), m, inertial frame
         (NumPy; the kernels solve the same Kepler equation)."""
         a, e = self.orbit(system)
-        M = math.radians(self.mean_anomaly_deg) + self.mean_motion(system) * t
-        E = M
-        for _ in range(100):
-            dE = (E - e * math.sin(E) - M) / (1.0 - e * math.cos(E))
-            E -= dE
-            if abs(dE) < 1e-15:
-                break
-        P, Q = self.directions()
-        return -(a * (math.cos(E) - e) * P + a * math.sqrt(1.0 - e * e) * math.sin(E) * Q)
+        M = math.radians(self.heliocentric(system).mean_anomaly_deg) + self.mean_motion(system) * t
+        return -conic_position(a, e, M, *self.directions(system))
 
     def tide_ratio(self, system):
         """The Sun's tide over the mutual gravity, G M_⊙ r / d³ over G (m1 + m2) / r², at the
@@ -513,32 +610,204 @@ class SolarTide:
     def block(self, system):
         M, L, T = _scales(system)
         a, e = self.orbit(system)
-        P, Q = self.directions()
+        P, Q = self.directions(system)
         out = np.zeros(NPERT)
         out[Q_SUN] = self.strength * GM_SUN / (L ** 3 / T ** 2)
-        out[Q_SUN_A] = a / L
-        out[Q_SUN_E] = e
-        out[Q_SUN_N] = self.mean_motion(system) * T
-        out[Q_SUN_M0] = math.radians(self.mean_anomaly_deg)
-        out[Q_SUN_P:Q_SUN_P + 3] = P
-        out[Q_SUN_Q:Q_SUN_Q + 3] = Q
+        _sun_orbit_columns(out, system, a, e, math.radians(self.heliocentric(system).mean_anomaly_deg),
+                           L, T)
+        # the kernels put a third body at +(x P + y Q) of its conic: the Sun is at minus the
+        # barycentre's heliocentric position
+        out[Q_SUN_P:Q_SUN_P + 3] = -P
+        out[Q_SUN_Q:Q_SUN_Q + 3] = -Q
         out[Q_SUN_NU] = system.secondary.mass / system.total_mass
         for col, body in ((Q_SUN_J1, system.primary), (Q_SUN_J2, system.secondary)):
             A, B, _ = body.moments         # J_xx − J_yy = I_yy − I_xx (principal frame)
             out[col] = (B - A) / (M * L ** 2)
         return out
 
-    @property
-    def in_plane(self):
-        """Whether the Sun stays in the start's orbit plane (i = 0 or 180)."""
-        return self.inclination_deg in (0.0, 180.0)
+    def in_plane(self, system=None):
+        """Whether the Sun stays in the start's orbit plane (its orbit's P and Q without a z
+        component). Without ``system``, for an orbit the system gives: False (unknown)."""
+        if system is None and not self.own_orbit:
+            return False
+        P, Q = self.directions(system)
+        return P[2] == 0.0 and Q[2] == 0.0
 
     @property
     def slot(self):
         return ("solar_tide", "both")
 
 
-KINDS = {"tides": Tides, "yorp": YORP, "byorp": BYORP, "solar_tide": SolarTide}
+def _per_member(name, value, low, high, unit=""):
+    """A Flyby field as a tuple of floats (one value, or one per member), each finite and in
+    [low, high]; ValueError naming the field and the range."""
+    values = np.atleast_1d(np.asarray(value, dtype=object))
+    if values.ndim != 1 or values.size == 0:
+        raise ValueError(f"{name} must be a number or a 1-D sequence of numbers, one per member "
+                         f"(got {show(value)})")
+    out = []
+    for v in values:
+        require_real(name, v)
+        require_range(name, v, low, high, low_open=False, high_open=False)
+        out.append(float(v))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class Flyby:
+    """A planet passing the binary on a hyperbola relative to its barycentre: its tidal
+    acceleration of the mutual orbit and its quadrupole torques on both bodies, the same
+    terms as the Sun's (docs/physics.md §13.12). The planet's hyperbola is that of the
+    two-body problem planet–barycentre (μ = G (M + m1 + m2)); the binary does not deflect it.
+
+    Every orbit field may be one number or a sequence with one value per member of the
+    ensemble (member k takes element k), so that an ensemble over q, orientation and time
+    runs in one launch, one flyby per member.
+
+    Parameters
+    ----------
+    planet : {"Earth", "Venus", "Mars", "Moon"}, optional
+        The passing body, by name (``constants.PLANETS``: GM and radius); or None with
+        ``mass_kg``.
+    v_inf_km_s : float or sequence
+        Speed at infinity relative to the barycentre, km/s in [0.01, 100].
+    q_km : float or sequence
+        Closest distance of the planet from the barycentre, km in [1, 1e9]; at least the
+        named planet's radius (closer, the binary hits it).
+    inclination_deg, node_deg, periapsis_deg : float or sequence
+        Orientation of the hyperbola relative to the package's inertial frame (the mutual
+        orbit's initial frame for the standard start): i in [0, 180] and Ω, ω in
+        [−360, 360] degrees, as for :class:`SolarTide`; ω places the planet's closest
+        approach within the hyperbola's plane (default 0: in the mutual orbit plane, along
+        the initial line of centres).
+    t_closest_h : float or sequence
+        Time of closest approach after t = 0, hours in [−1e6, 1e6] (negative: before the
+        start, the planet receding).
+    mass_kg : float, optional
+        The passing body's mass, kg, instead of ``planet`` (no radius check then).
+    strength : float
+        Factor on the planet's mass in the force and torques (default 1); its motion keeps
+        the real mass.
+    """
+
+    planet: Optional[str] = "Earth"
+    v_inf_km_s: object = 10.0
+    q_km: object = 1e5
+    inclination_deg: object = 0.0
+    node_deg: object = 0.0
+    periapsis_deg: object = 0.0
+    t_closest_h: object = 0.0
+    mass_kg: Optional[float] = None
+    strength: float = 1.0
+
+    kind = "flyby"
+    body = "both"
+    radius = None
+    FIELDS = ("v_inf_km_s", "q_km", "inclination_deg", "node_deg", "periapsis_deg",
+              "t_closest_h")
+
+    def __post_init__(self):
+        if (self.planet is None) == (self.mass_kg is None):
+            raise ValueError("Flyby needs planet= (one of " + ", ".join(PLANETS) +
+                             ") or mass_kg=, not both and not neither")
+        if self.planet is not None and self.planet not in PLANETS:
+            raise ValueError(f"Flyby planet must be one of {', '.join(PLANETS)} (got "
+                             f"{show(self.planet)}), or give mass_kg=")
+        if self.mass_kg is not None:
+            require_positive_scalar("mass_kg", self.mass_kg, 1e3, 1e31, "kg")
+        ranges = {"v_inf_km_s": (0.01, 100.0), "q_km": (1.0, 1e9),
+                  "inclination_deg": INCLINATION_RANGE, "node_deg": ANGLE_RANGE,
+                  "periapsis_deg": ANGLE_RANGE, "t_closest_h": (-1e6, 1e6)}
+        sizes = set()
+        for name in self.FIELDS:
+            values = _per_member(name, getattr(self, name), *ranges[name])
+            object.__setattr__(self, name, values[0] if len(values) == 1 else values)
+            if len(values) > 1:
+                sizes.add(len(values))
+        if len(sizes) > 1:
+            raise ValueError("Flyby fields given per member must all have the same length "
+                             f"(got lengths {sorted(sizes)})")
+        if self.planet is not None:
+            radius = PLANETS[self.planet][1]
+            if min(np.atleast_1d(self.q_km)) < radius:
+                raise ValueError(f"q_km must be at least {self.planet}'s radius {radius:g} km "
+                                 f"(got {min(np.atleast_1d(self.q_km)):g} km: the binary would hit it)")
+        require_positive_scalar("strength", self.strength, *STRENGTH_RANGE)
+
+    @property
+    def members(self):
+        """How many members the per-member fields are for (1: one flyby for all)."""
+        return max(np.size(getattr(self, name)) for name in self.FIELDS)
+
+    def field(self, name, k=0):
+        """Field ``name`` for member ``k``."""
+        value = getattr(self, name)
+        return value[k] if isinstance(value, tuple) else value
+
+    @property
+    def gm(self):
+        """G M of the passing body, m³ s⁻²."""
+        return PLANETS[self.planet][0] if self.planet is not None else G * self.mass_kg
+
+    def hyperbola(self, system, k=0):
+        """(a in m, e, mean motion in rad/s, mean anomaly at t = 0 in rad) of member ``k``'s
+        hyperbola: a = μ / v∞², e = 1 + q v∞² / μ, n = sqrt(μ / a³), M(0) = −n t_closest."""
+        mu = self.gm + G * system.total_mass
+        v = self.field("v_inf_km_s", k) * 1e3
+        a = mu / v ** 2
+        e = 1.0 + self.field("q_km", k) * 1e3 * v ** 2 / mu
+        n = math.sqrt(mu / a ** 3)
+        return a, e, n, -n * self.field("t_closest_h", k) * 3600.0
+
+    def directions(self, k=0):
+        """(P, Q) of member ``k``'s hyperbola: to the closest approach, and the planet's
+        direction of motion there, inertial frame."""
+        return orbit_directions(*(self.field(name, k) for name in
+                                  ("inclination_deg", "node_deg", "periapsis_deg")))
+
+    def position(self, system, t, k=0):
+        """The planet's position relative to the barycentre at time t (s), m, inertial frame
+        (NumPy; the kernels solve the same hyperbolic Kepler equation)."""
+        a, e, n, M0 = self.hyperbola(system, k)
+        return conic_position(a, e, M0 + n * t, *self.directions(k))
+
+    def in_plane(self, system=None):
+        """Whether every member's planet stays in the start's orbit plane."""
+        return all(p[2] == 0.0 and q[2] == 0.0 for p, q in
+                   (self.directions(k) for k in range(self.members)))
+
+    def tide_ratio(self, system, k=0):
+        """The planet's tide over the mutual gravity at closest approach and the mutual
+        apoapsis, G M r / q³ over G (m1 + m2) / r²."""
+        r = system.a * (1.0 + system.e)
+        q = self.field("q_km", k) * 1e3
+        return self.strength * self.gm * r ** 3 / (G * system.total_mass * q ** 3)
+
+    def block(self, system, k=0):
+        M, L, T = _scales(system)
+        a, e, n, M0 = self.hyperbola(system, k)
+        P, Q = self.directions(k)
+        out = np.zeros(NPERT)
+        c = Q_FLYBY
+        out[c + T_MU] = self.strength * self.gm / (L ** 3 / T ** 2)
+        out[c + T_A] = a / L
+        out[c + T_E] = e
+        out[c + T_N] = n * T
+        out[c + T_M0] = M0
+        out[c + T_P:c + T_P + 3] = P          # the planet at +(x P + y Q) of its hyperbola
+        out[c + T_Q:c + T_Q + 3] = Q
+        out[c + T_NU] = system.secondary.mass / system.total_mass
+        for col, body in ((c + T_J1, system.primary), (c + T_J2, system.secondary)):
+            A, B, _ = body.moments
+            out[col] = (B - A) / (M * L ** 2)
+        return out
+
+    @property
+    def slot(self):
+        return ("flyby", "both")
+
+
+KINDS = {"tides": Tides, "yorp": YORP, "byorp": BYORP, "solar_tide": SolarTide, "flyby": Flyby}
 
 
 def _check_signed(name, value, limit):
@@ -551,8 +820,9 @@ def _check_heliocentric(a_au, e):
 
 
 def check_perturbations(perturbations):
-    """``perturbations`` (None, one object, or a sequence of Tides / YORP / BYORP / SolarTide) as a
-    tuple; a TypeError names anything else, a ValueError a repeated kind on one body."""
+    """``perturbations`` (None, one object, or a sequence of Tides / YORP / BYORP / SolarTide /
+    Flyby) as a tuple; a TypeError names anything else, a ValueError a repeated kind on one
+    body."""
     if perturbations is None:
         return ()
     if isinstance(perturbations, tuple(KINDS.values())):
@@ -560,13 +830,13 @@ def check_perturbations(perturbations):
     try:
         items = tuple(perturbations)
     except TypeError:
-        raise TypeError("perturbations must be a list of ti_spinorbit.Tides, YORP, BYORP or SolarTide "
-                        f"objects (got {show(perturbations)})") from None
+        raise TypeError("perturbations must be a list of ti_spinorbit.Tides, YORP, BYORP, "
+                        f"SolarTide or Flyby objects (got {show(perturbations)})") from None
     seen = set()
     for k, p in enumerate(items):
         if not isinstance(p, tuple(KINDS.values())):
-            raise TypeError(f"perturbations[{k}] must be a Tides, YORP, BYORP or SolarTide object "
-                            f"(got {show(p)})")
+            raise TypeError(f"perturbations[{k}] must be a Tides, YORP, BYORP, SolarTide or "
+                            f"Flyby object (got {show(p)})")
         if p.slot in seen:
             raise ValueError(f"perturbations[{k}]: a second {p.kind}"
                              f"{'' if p.body == 'both' else ' on the ' + p.body}; combine "
@@ -599,6 +869,8 @@ def change_per_orbit(p, system):
     if isinstance(p, SolarTide):
         return [("the Sun's tide over the mutual gravity at apoapsis and perihelion",
                  p.tide_ratio(system), SOLAR_TIDE_LIMIT, "")]
+    if isinstance(p, Flyby):     # a close flyby may be the dynamics: it can split a binary
+        return []
     if isinstance(p, YORP):
         spin = 2.0 * math.pi * abs(p.torque(system)) / (_largest_moment(system, p.body) * n ** 2)
         return [(f"the {p.body}'s spin", spin, SPIN_CHANGE_LIMIT, "n per orbit")]
@@ -610,6 +882,8 @@ def _check_strength(k, p, system):
     """ValueError when ``p`` (perturbations[k]) is too strong to be a perturbation of
     ``system`` (:func:`change_per_orbit`), naming the largest strength that is."""
     changes = change_per_orbit(p, system)
+    if not changes:
+        return
     largest = min(p.strength * limit / value if value > 0 else math.inf
                   for _, value, limit, _ in changes)
     for quantity, value, limit, unit_text in changes:
@@ -634,20 +908,31 @@ def perturbation_rows(systems, perturbations):
     if not items:
         return None
     rows = np.zeros((len(systems), NPERT))
+    shared = [p for p in items if not isinstance(p, Flyby)]
+    flybys = [p for p in items if isinstance(p, Flyby)]
+    for p in flybys:
+        if p.members not in (1, len(systems)):
+            raise ValueError(f"Flyby fields are given for {p.members} members, but the ensemble "
+                             f"has {len(systems)}: give one value, or one per member")
     cache = {}
     for k, s in enumerate(systems):
         key = id(s)
         if key not in cache:
             for j, p in enumerate(items):
                 _check_strength(j, p, s)
-            cache[key] = sum((p.block(s) for p in items), np.zeros(NPERT))
+            cache[key] = _combine([p.block(s) for p in shared],
+                                  [f"perturbations[{items.index(p)}] ({p.kind})" for p in shared])
         rows[k] = cache[key]
+        for p in flybys:        # one flyby per member
+            rows[k] += p.block(s, k if p.members > 1 else 0)
     return rows
 
 
 def describe(perturbations):
     """JSON-ready list of dicts (``kind`` plus the fields) for saved files."""
-    return [{"kind": p.kind, **asdict(p)} for p in check_perturbations(perturbations)]
+    return [{"kind": p.kind, **{k: list(v) if isinstance(v, tuple) else v
+                                for k, v in asdict(p).items()}}
+            for p in check_perturbations(perturbations)]
 
 
 def from_description(items):
@@ -662,21 +947,32 @@ def from_description(items):
             raise ValueError(f"unknown perturbation kind {kind!r} (known: {', '.join(KINDS)})")
         if kind == "yorp":           # written before the convention was recorded
             d.setdefault("convention", YORP_LEGACY_CONVENTION)
+        if kind in ("yorp", "byorp"):    # written before the distance was recorded
+            d.setdefault("distance", DISTANCE_LEGACY)
         out.append(KINDS[kind](**d))
     return tuple(out)
 
 
-def needs_3d(perturbations):
+def needs_3d(perturbations, systems=None):
     """Whether ``perturbations`` hold a force the planar model does not carry: the Sun's
-    tide out of the start's orbit plane (``models.choose`` then takes the 3-D model)."""
-    return any(isinstance(p, SolarTide) and not p.in_plane
-               for p in check_perturbations(perturbations))
+    tide out of the start's orbit plane (``models.choose`` then takes the 3-D model), for
+    any of ``systems`` (a BinarySystem or a list; None: a Sun on the system's own orbit
+    counts as out of the plane, as for a memory estimate)."""
+    items = check_perturbations(perturbations)
+    if systems is not None and not isinstance(systems, (list, tuple)):
+        systems = [systems]
+    unique = list({id(s): s for s in systems}.values()) if systems is not None else [None]
+    return any(isinstance(p, (SolarTide, Flyby)) and not p.in_plane(s)
+               for p in items for s in unique)
 
 
 def out_of_plane_rows(rows):
-    """Per member of the (N, NPERT) ``rows`` (or None): a Sun out of the orbit plane (its
-    orbit's P or Q with a z component), which the planar model cannot carry."""
+    """Per member of the (N, NPERT) ``rows`` (or None): a third body (the Sun, a passing
+    planet) out of the orbit plane (its orbit's P or Q with a z component), which the planar
+    model cannot carry."""
     if rows is None:
         return None
     rows = np.asarray(rows)
-    return (rows[:, Q_SUN] != 0.0) & ((rows[:, Q_SUN_P + 2] != 0.0) | (rows[:, Q_SUN_Q + 2] != 0.0))
+    return np.logical_or.reduce([(rows[:, c + T_MU] != 0.0) & ((rows[:, c + T_P + 2] != 0.0) |
+                                                              (rows[:, c + T_Q + 2] != 0.0))
+                                 for c in THIRD_BODIES])

@@ -18,7 +18,7 @@ import math
 import os
 import warnings
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
+from typing import Optional
 
 import numpy as np
 
@@ -32,6 +32,7 @@ from . import shapes as _shapes
 from .integrals import _check_rotation
 from .. import display as _display
 from .initial import tilted_start as _tilted_start
+from .heliocentric import HeliocentricOrbit
 from ..layout import EXPONENTS_2, EXPONENTS_3, EXPONENTS_4
 
 #: Newtonian constant of gravitation, m^3 kg^-1 s^-2 (CODATA 2018).
@@ -84,12 +85,14 @@ class BinarySystem(_display.Readable):
         1e5 n (``MAX_PRIMARY_SPIN``): |P| >= orbital period / 1e5.
     name : str
         Label used in plots and saved files. Only a label: nothing is looked up by it.
-    heliocentric_orbit : (float, float), optional
-        (a in AU, e) of the binary's heliocentric orbit, a in [0.05, 1e4] AU
-        (``HELIOCENTRIC_A_RANGE``), 0 <= e < 1: the distance from the Sun that YORP and
-        BYORP use (:mod:`ti_spinorbit.model.perturbations`). The catalogue fills it where the
-        orbit is known (``catalog.heliocentric_orbit``); None (default) for a system of your
-        own, whatever its name, until you give it.
+    heliocentric_orbit : HeliocentricOrbit or (float, float), optional
+        The barycentre's heliocentric orbit: a :class:`~ti_spinorbit.HeliocentricOrbit`
+        (all six elements, relative to the binary's frame or to the ecliptic with the
+        binary's pole), or just (a in AU, e), a in [0.05, 1e4] AU (``HELIOCENTRIC_A_RANGE``),
+        0 <= e < 1, the other elements 0. YORP and BYORP read the Sun's distance from it,
+        SolarTide its direction too (:mod:`ti_spinorbit.model.perturbations`). The
+        catalogue fills it where the orbit is known (``catalog.heliocentric_orbit``); None
+        (default) for a system of your own, whatever its name, until you give it.
     orbital_period : float or Quantity, optional
         Observed orbital period of the mutual orbit, s (positive, finite), e.g. 11.92 h =
         42912 s for Didymos-Dimorphos. When given, both bodies' masses (hence densities; shapes
@@ -125,7 +128,7 @@ class BinarySystem(_display.Readable):
     e: float
     primary_spin_period: Optional[float] = None
     name: str = "binary"
-    heliocentric_orbit: Optional[Tuple[float, float]] = None
+    heliocentric_orbit: Optional[HeliocentricOrbit] = None
     density_scale: float = field(default=1.0, init=False, compare=False)
 
     def __post_init__(self):
@@ -139,13 +142,8 @@ class BinarySystem(_display.Readable):
         require_range("e", self.e, 0.0, 1.0)
         if not isinstance(self.name, str):
             raise TypeError(f"name must be a string (got {show(self.name)})")
-        if self.heliocentric_orbit is not None:
-            orbit = self.heliocentric_orbit
-            if not isinstance(orbit, (tuple, list)) or len(orbit) != 2:
-                raise TypeError(f"heliocentric_orbit must be (a in AU, e) or None (got "
-                                f"{show(orbit)})")
-            object.__setattr__(self, "heliocentric_orbit", check_heliocentric(
-                *orbit, names=("heliocentric_orbit a", "heliocentric_orbit e")))
+        object.__setattr__(self, "heliocentric_orbit",
+                           HeliocentricOrbit.coerce(self.heliocentric_orbit))
         ratio = self.primary.mass / self.secondary.mass
         if not 1.0 / MAX_MASS_RATIO <= ratio <= MAX_MASS_RATIO:
             raise ValueError(f"mass ratio m1/m2 must lie in [{1 / MAX_MASS_RATIO:g}, "
@@ -346,7 +344,7 @@ class BinarySystem(_display.Readable):
                 "mean_motion_rad_s": self.mean_motion, "mass_ratio": self.mass_ratio,
                 "omega0": self.omega0, "orbital_period_h": self.orbital_period / 3600.0,
                 **({} if self.heliocentric_orbit is None else
-                   dict(zip(("heliocentric_a_au", "heliocentric_e"), self.heliocentric_orbit)))}
+                   {"heliocentric_orbit": self.heliocentric_orbit.describe()})}
 
     @classmethod
     def from_description(cls, d: dict, *, directory=None) -> "BinarySystem":
@@ -417,9 +415,7 @@ class BinarySystem(_display.Readable):
                      primary_spin_period=None if period is None else
                      require_real("primary_spin_period_s", period),
                      name=d.get("name", "binary"),
-                     heliocentric_orbit=None if "heliocentric_a_au" not in d and
-                     "heliocentric_e" not in d else
-                     check_heliocentric(d.get("heliocentric_a_au"), d.get("heliocentric_e")))
+                     heliocentric_orbit=_heliocentric_from(d))
         _check_derived_entries(d, system, mismatches)
         if "density_scale" in d:
             scale = require_real("density_scale", d["density_scale"])
@@ -455,7 +451,8 @@ class BinarySystem(_display.Readable):
 #: earlier versions wrote it, 1) and of each of its bodies (io.describe_system adds
 #: "integrals"): any other key is refused, not ignored.
 SYSTEM_KEYS = ("name", "primary", "secondary", "a_m", "e", "primary_spin_period_s",
-               "heliocentric_a_au", "heliocentric_e", "mean_motion_rad_s", "mass_ratio",
+               "heliocentric_orbit", "heliocentric_a_au", "heliocentric_e",
+               "mean_motion_rad_s", "mass_ratio",
                "omega0", "orbital_period_h", "density_scale")
 BODY_KEYS = ("name", "mass_kg", "bounding_radius_m", "semi_axes_m", "integrals", "order",
              "shape", "file", "facets", "unit", "format", "packaged", "density", "offset_m",
@@ -465,6 +462,23 @@ SHAPE_KEYS = ("shape", "file", "facets", "unit", "format", "packaged", "density"
 #: Relative tolerance of a derived entry against its value recomputed from the inputs: the
 #: package writes them unrounded (JSON keeps every bit), so only an edit differs.
 DERIVED_RTOL = 1e-9
+
+
+def _heliocentric_from(d):
+    """The heliocentric orbit of a system description: its ``heliocentric_orbit`` dict, or
+    the (a, e) pair ``heliocentric_a_au``, ``heliocentric_e`` that earlier versions wrote."""
+    if "heliocentric_orbit" in d:
+        if "heliocentric_a_au" in d or "heliocentric_e" in d:
+            raise ValueError("give heliocentric_orbit or heliocentric_a_au and heliocentric_e, "
+                             "not both")
+        orbit = d["heliocentric_orbit"]
+        if not isinstance(orbit, dict):
+            raise TypeError(f"heliocentric_orbit must be a dict of HeliocentricOrbit fields "
+                            f"(a_au, e, inclination_deg, ...) (got {show(orbit)})")
+        return HeliocentricOrbit(**orbit)
+    if "heliocentric_a_au" not in d and "heliocentric_e" not in d:
+        return None
+    return HeliocentricOrbit(*check_heliocentric(d.get("heliocentric_a_au"), d.get("heliocentric_e")))
 
 
 def _body_from(b, label, mismatches, directory=None):
