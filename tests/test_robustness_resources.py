@@ -313,3 +313,37 @@ def test_platformdirs_is_a_dependency():
         text = f.read()
     deps = text.split("dependencies = [", 1)[1].split("]", 1)[0]
     assert '"platformdirs' in deps
+
+
+# ---- available memory: psutil when installed, the package's own reading otherwise ----------
+def test_psutil_and_the_fallback_agree_on_the_available_memory():
+    psutil = pytest.importorskip("psutil")
+    own = _validate._os_available_memory()
+    via_psutil = psutil.virtual_memory().available
+    assert own is not None and via_psutil > 0
+    # two reads of a moving number (other processes allocate meanwhile): roughly equal
+    assert own == pytest.approx(via_psutil, rel=0.1)
+    assert _validate.available_memory() == pytest.approx(via_psutil, rel=0.1)
+
+
+def test_available_memory_uses_psutil_when_installed_and_falls_back_without(monkeypatch):
+    psutil = pytest.importorskip("psutil")
+
+    class Memory:
+        available = 123 * 2**20
+
+    monkeypatch.setattr(psutil, "virtual_memory", lambda: Memory())
+    assert _validate.available_memory() == 123 * 2**20          # psutil's answer is taken
+    monkeypatch.setitem(sys.modules, "psutil", None)             # as if not installed
+    assert _validate._psutil_available_memory() is None
+    got = _validate.available_memory()
+    assert got != 123 * 2**20
+    assert got == pytest.approx(_validate._os_available_memory(), rel=0.1)   # /proc moves
+
+    def broken():
+        raise RuntimeError("cannot read memory here")
+
+    monkeypatch.setitem(sys.modules, "psutil", psutil)
+    monkeypatch.setattr(psutil, "virtual_memory", broken)       # psutil fails: fallback
+    assert _validate.available_memory() == pytest.approx(_validate._os_available_memory(),
+                                                         rel=0.1)

@@ -336,6 +336,8 @@ def test_available_memory_reads_meminfo():
 
 
 def test_available_memory_falls_back_to_sysconf_then_none(monkeypatch):
+    monkeypatch.setattr(_validate, "_psutil_available_memory", lambda: None)   # no psutil
+
     def no_file(*args, **kwargs):
         raise OSError("no /proc here")
 

@@ -286,9 +286,29 @@ def require_count(name, value, minimum=1, maximum=math.inf):
 
 
 def available_memory():
-    """Memory available to a new allocation without swapping, bytes: ``MemAvailable`` of
-    /proc/meminfo (Linux), else free physical pages × page size (``os.sysconf``), else None
-    when the platform says neither."""
+    """Memory available to a new allocation without swapping, bytes: psutil's
+    ``virtual_memory().available`` when psutil is installed (every platform), else
+    :func:`_os_available_memory`; None when neither says (ti_spinorbit.engine.resources
+    gives the decision)."""
+    got = _psutil_available_memory()
+    return got if got is not None else _os_available_memory()
+
+
+def _psutil_available_memory():
+    """psutil's available memory, bytes, or None without psutil (or where it cannot say)."""
+    try:
+        import psutil
+    except ImportError:
+        return None
+    try:
+        return int(psutil.virtual_memory().available)
+    except Exception:  # noqa: BLE001 - a platform psutil cannot read: the fallback decides
+        return None
+
+
+def _os_available_memory():
+    """Without psutil: ``MemAvailable`` of /proc/meminfo (Linux), else free physical pages ×
+    page size (``os.sysconf``), else None when the platform says neither."""
     try:
         with open("/proc/meminfo") as f:
             for line in f:

@@ -33,6 +33,16 @@ temporaries of the member being converted (:data:`STATES_MEMBER_ROW_BYTES` per r
 largest member). That third phase stays below the observables' peak (measured: the peak RSS
 of a states=True series is that of the same series without states), so the states are not
 counted as a second set of rows of ``ROW_BYTES`` each (that was 2.1 x the measured peak).
+
+The memory available is read by :func:`ti_spinorbit._validate.available_memory`, the one
+place every check asks. Decision: psutil (``psutil.virtual_memory().available``) when it is
+installed, since it is the well-kept standard helper and says it right on every platform
+(on macOS free pages alone understate what can be had; on Windows neither /proc nor
+``sysconf`` exists, so no check would be made); without psutil the package's own reading
+stays (``MemAvailable`` of /proc/meminfo on Linux, where it is the same number psutil gives,
+else free pages × page size, else no check). psutil is not a dependency: the fallback covers
+Linux, where long runs are made, exactly, and one compiled package fewer keeps installs light;
+the test extra carries it, and a test checks the two readings agree.
 """
 
 import math
