@@ -391,6 +391,10 @@ def test_warmup_refuses_an_unknown_method(capsys):
      "sos_1991VH_tide-secondary_Rtide150"),
     (["section", "--sun", "--sun-inclination", "30", "--sun-mean-anomaly", "90"],
      "sos_1991VH_sun_suni30_sunM90"),
+    (["section", "--flyby", "Earth", "--flyby-q", "2e5", "--flyby-time", "10"],
+     "sos_1991VH_flyby-Earth_q200000_tq10"),
+    (["section", "--yorp", "1e-3", "--radiation-distance", "mean"],
+     "sos_1991VH_yorp0.001_rad-mean"),
 ])
 def test_default_names_carry_the_perturbations(argv, stem):
     args = cli._parser().parse_args(argv)
@@ -409,7 +413,7 @@ def test_default_names_carry_the_perturbations(argv, stem):
     (["--yorp", "2"], "--yorp must lie in [-1, 1] (got 2)"),
     (["--byorp", "-1.5"], "--byorp must lie in [-1, 1] (got -1.5)"),
     (["--tide", "secondary", "--strength", "0"], "--strength must lie in [1e-12, 1e+15] (got 0)"),
-    (["--strength", "10"], "--strength needs --tide, --yorp or --byorp"),
+    (["--strength", "10"], "--strength needs --tide, --yorp, --byorp, --sun or --flyby"),
     (["--yorp-body", "primary"], "--yorp-body needs --yorp F_Y"),
     (["--heliocentric", "1", "0.1"], "--heliocentric needs --yorp or --byorp"),
     (["--yorp", "1e-3", "--heliocentric", "0.01", "0.1"],
@@ -418,7 +422,7 @@ def test_default_names_carry_the_perturbations(argv, stem):
      "--heliocentric E must lie in [0, 1) (got 1)"),
     (["--system", "test", "--yorp", "1e-3"],
      "--yorp: 'test' has no heliocentric orbit: pass --heliocentric A_AU E, or give the "
-     "system file heliocentric_a_au and heliocentric_e"),
+     "system file a heliocentric_orbit"),
     (["--tide", "both"], "argument --tide: invalid choice: 'both'"),
     (["--tide-radius", "150"], "--tide-radius needs --tide primary|secondary"),
     (["--yorp-radius", "150"], "--yorp-radius needs --yorp (the YORP coefficient)"),
@@ -429,6 +433,16 @@ def test_default_names_carry_the_perturbations(argv, stem):
     (["--sun", "--sun-periapsis", "400"], "--sun-periapsis must lie in [-360, 360] (got 400)"),
     (["--system", "test", "--sun"],
      "--sun: 'test' has no heliocentric orbit: pass --heliocentric A_AU E"),
+    (["--sun"], "--sun: this heliocentric orbit is given in the ecliptic without the binary's "
+                "pole, so the Sun's direction is unknown: give --sun-inclination DEG"),
+    (["--flyby", "Earth"], "--flyby needs --flyby-q KM, the closest distance (at least 6371 km"),
+    (["--flyby-q", "1e5"], "--flyby-q needs --flyby PLANET"),
+    (["--flyby", "Earth", "--flyby-q", "1000"],
+     "--flyby needs --flyby-q KM, the closest distance (at least 6371 km for Earth: closer, "
+     "the binary hits it); got 1000"),
+    (["--flyby", "Earth", "--flyby-q", "1e5", "--flyby-vinf", "0"],
+     "--flyby-vinf must lie in [0.01, 100] (got 0)"),
+    (["--radiation-distance", "mean"], "--radiation-distance needs --yorp or --byorp"),
 ])
 def test_bad_perturbation_flags_one_line_exit_2(flags, message, tmp_path, capsys):
     out = str(tmp_path / "x.png")
@@ -486,6 +500,19 @@ def test_section_with_the_sun_prints_and_saves_it(tmp_path, capsys):
                         "L - L_ext)")
     assert tso.load(tmp_path / "s.npz").perturbations == (tso.SolarTide(
         heliocentric_a_au=1.1, heliocentric_e=0.2, inclination_deg=20.0, strength=100.0),)
+
+
+def test_section_with_a_flyby_prints_and_saves_it(tmp_path, capsys):
+    out = str(tmp_path / "f.png")
+    assert cli.main(["section", "--thetadot", "0.83", "--orbits", "1", "--rtol", "1e-10",
+                     "--flyby", "Earth", "--flyby-q", "2e5", "--flyby-vinf", "5",
+                     "--flyby-time", "10", "--flyby-inclination", "30", "--out", out]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == ("perturbations: Earth flyby (q 200000 km, v_inf 5 km/s, closest at "
+                        "10 h, i 30°); strength 1 (docs/physics.md §13; drifts are those of "
+                        "E - W and L - L_ext)")
+    assert tso.load(tmp_path / "f.npz").perturbations == (tso.Flyby(
+        "Earth", q_km=2e5, v_inf_km_s=5.0, t_closest_h=10.0, inclination_deg=30.0),)
 
 
 def test_energy_with_a_tide_prints_the_work(tmp_path, capsys):

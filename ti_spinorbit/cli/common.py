@@ -275,7 +275,10 @@ NAME_TAGS = (("elongation", "ab"), ("density", "rho"), ("eccentricity", "e"),
              ("strength", "str"), ("heliocentric", "helio"), ("tide_radius", "Rtide"),
              ("yorp_radius", "Ryorp"), ("byorp_radius", "Rbyorp"), ("sun", "sun"),
              ("sun_inclination", "suni"), ("sun_node", "sunO"), ("sun_periapsis", "sunw"),
-             ("sun_mean_anomaly", "sunM"))
+             ("sun_mean_anomaly", "sunM"), ("radiation_distance", "rad-"),
+             ("flyby", "flyby-"), ("flyby_q", "q"), ("flyby_vinf", "vinf"),
+             ("flyby_time", "tq"), ("flyby_inclination", "flyi"), ("flyby_node", "flyO"),
+             ("flyby_periapsis", "flyw"))
 
 
 #: The whole command line's parser factory (``ti_spinorbit.cli._parser``), set by the cli

@@ -14,7 +14,8 @@ from .._validate import MAX_DENSITY, MAX_ORDER, MAX_SPIN, MIN_DENSITY  # the lib
 from ..engine.compiling import METHODS
 from ..model import models as _models  # the model requests (one registry)
 from ..model import perturbations as _pert  # tide, YORP and BYORP bounds and defaults, likewise
-from ..model.perturbations import BYORP, YORP, SolarTide, Tides
+from ..constants import PLANETS
+from ..model.perturbations import BYORP, YORP, Flyby, SolarTide, Tides
 from ..runtime import _KNOWN_ARCHS
 from ..studies.section import MAX_ORBITS  # orbits limit shared with the library
 from ..system import catalog
@@ -122,6 +123,9 @@ STRENGTH = Bounded(float, *_pert.STRENGTH_RANGE)
 RADIUS = Bounded(float, *_pert.RADIUS_RANGE)
 HELIOCENTRIC_A = Bounded(float, *HELIOCENTRIC_A_RANGE)
 HELIOCENTRIC_E = Bounded(float, 0.0, 1.0, high_open=True)
+FLYBY_Q = Bounded(float, 1.0, 1e9)                    # km: --flyby-q
+FLYBY_VINF = Bounded(float, 0.01, 100.0)              # km/s: --flyby-vinf
+FLYBY_TIME = Bounded(float, -1e6, 1e6)                # h: --flyby-time
 
 
 # ---- subcommand parsers -----------------------------------------------------------------
@@ -315,6 +319,29 @@ def perturbation_flags(s):
         g.add_argument(f"--sun-{dest}", type=ANGLE, default=None, metavar="DEG",
                        help=f"{what} of the --sun orbit, degrees in [-360, 360] (0 when "
                             "another --sun-* angle is given)")
+    g.add_argument("--radiation-distance", choices=_pert.DISTANCES, default=_pert.DISTANCE,
+                   help="where --yorp and --byorp take the Sun's distance: 'orbit' (default; "
+                        "on the heliocentric orbit at every step) or 'mean' (the paper's "
+                        "mean-distance form; docs/physics.md §13.12)")
+    g.add_argument("--flyby", choices=tuple(PLANETS), default=None,
+                   help="a planet passing on a hyperbola relative to the barycentre (Flyby, "
+                        "docs/physics.md §13.12): its tide and torques")
+    g.add_argument("--flyby-q", type=FLYBY_Q, default=None, metavar="KM",
+                   help="closest distance of the --flyby planet from the barycentre, km "
+                        "(at least the planet's radius; required with --flyby)")
+    g.add_argument("--flyby-vinf", type=FLYBY_VINF, default=None, metavar="KM_S",
+                   help="speed at infinity of the --flyby planet, km/s in [0.01, 100] "
+                        "(default 10)")
+    g.add_argument("--flyby-time", type=FLYBY_TIME, default=None, metavar="H",
+                   help="time of closest approach after the start, hours (default 0)")
+    g.add_argument("--flyby-inclination", type=SUN_INCLINATION, default=None, metavar="DEG",
+                   help="inclination of the --flyby hyperbola to the mutual orbit's initial "
+                        "plane, degrees in [0, 180] (default 0)")
+    for dest, what in (("node", "longitude of the ascending node"),
+                       ("periapsis", "argument of the closest approach")):
+        g.add_argument(f"--flyby-{dest}", type=ANGLE, default=None, metavar="DEG",
+                       help=f"{what} of the --flyby hyperbola, degrees in [-360, 360] "
+                            "(default 0)")
 
 
 def perturbations(args):
@@ -330,10 +357,11 @@ def perturbations(args):
                          radius=args.tide_radius, strength=args.strength))
     if args.yorp is not None:
         out.append(YORP(body=args.yorp_body, coefficient=args.yorp, radius=args.yorp_radius,
-                        strength=args.strength, convention=args.yorp_convention, **sun))
+                        strength=args.strength, convention=args.yorp_convention,
+                        distance=args.radiation_distance, **sun))
     if args.byorp is not None:
         out.append(BYORP(coefficient=args.byorp, radius=args.byorp_radius,
-                         strength=args.strength, **sun))
+                         strength=args.strength, distance=args.radiation_distance, **sun))
     if args.sun:
         # the angles given replace the system's orbit (the others then 0); none given: the
         # system's own heliocentric orbit, oriented by its pole
@@ -342,6 +370,12 @@ def perturbations(args):
             ("periapsis", args.sun_periapsis), ("mean_anomaly", args.sun_mean_anomaly))
             if value is not None}
         out.append(SolarTide(strength=args.strength, **angles, **sun))
+    if args.flyby is not None:
+        given = {name: value for name, value in (
+            ("v_inf_km_s", args.flyby_vinf), ("t_closest_h", args.flyby_time),
+            ("inclination_deg", args.flyby_inclination), ("node_deg", args.flyby_node),
+            ("periapsis_deg", args.flyby_periapsis)) if value is not None}
+        out.append(Flyby(args.flyby, q_km=args.flyby_q, strength=args.strength, **given))
     return out
 
 
@@ -370,6 +404,17 @@ def check_perturbation_flags(args):
         for dest in ("sun_inclination", "sun_node", "sun_periapsis", "sun_mean_anomaly"):
             if getattr(args, dest) is not None:
                 raise ValueError(f"--{dest.replace('_', '-')} needs --sun (the Sun's tide)")
+    if args.flyby is None:
+        for dest in ("flyby_q", "flyby_vinf", "flyby_time", "flyby_inclination", "flyby_node",
+                     "flyby_periapsis"):
+            if getattr(args, dest) is not None:
+                raise ValueError(f"--{dest.replace('_', '-')} needs --flyby PLANET")
+    elif args.flyby_q is None or args.flyby_q < PLANETS[args.flyby][1]:
+        raise ValueError(f"--flyby needs --flyby-q KM, the closest distance (at least "
+                         f"{PLANETS[args.flyby][1]:g} km for {args.flyby}: closer, the binary "
+                         f"hits it){'' if args.flyby_q is None else f'; got {args.flyby_q:g}'}")
+    if args.yorp is None and args.byorp is None and args.radiation_distance != _pert.DISTANCE:
+        raise ValueError("--radiation-distance needs --yorp or --byorp")
     if args.heliocentric is not None:
         a_au, e = args.heliocentric
         HELIOCENTRIC_A.check("--heliocentric A_AU", a_au)
@@ -380,8 +425,8 @@ def check_perturbation_flags(args):
     items = perturbations(args)
     if not items:
         if args.strength != 1.0:
-            raise ValueError("--strength needs --tide, --yorp or --byorp, or --sun (it scales "
-                             "them)")
+            raise ValueError("--strength needs --tide, --yorp, --byorp, --sun or --flyby (it "
+                             "scales them)")
         return
     if args.command == "overlap":
         system = catalog.system(args.system, eccentricity=args.eccentricity)
@@ -389,7 +434,7 @@ def check_perturbation_flags(args):
         system = build_system(args)
     for p in items:
         flag = {"tides": "--tide", "yorp": "--yorp", "byorp": "--byorp",
-                "solar_tide": "--sun"}[p.kind]
+                "solar_tide": "--sun", "flyby": "--flyby"}[p.kind]
         try:
             p.block(system)
         except ValueError as exc:
@@ -422,7 +467,8 @@ def perturbation_summary(items, system=None):
             rubble = " (rubble pile)" if p.k2 is None else ""
             parts.append(f"tide on the {p.body} (k2 {k2:.3g}{rubble}, {lag})")
         elif p.kind == "yorp":
-            parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g}, {p.convention} torque)")
+            parts.append(f"YORP on the {p.body} (f_Y {p.coefficient:g}, {p.convention} torque, "
+                         f"{p.distance} distance)")
         elif p.kind == "solar_tide":
             if p.own_orbit:
                 i, node, peri, m0 = (getattr(p, name) or 0.0 for name in p.ANGLES)
@@ -430,6 +476,9 @@ def perturbation_summary(items, system=None):
                              f"M0 {m0:g}°)")
             else:
                 parts.append("the Sun's tide (on the system's heliocentric orbit)")
+        elif p.kind == "flyby":
+            parts.append(f"{p.planet} flyby (q {p.q_km:g} km, v_inf {p.v_inf_km_s:g} km/s, "
+                         f"closest at {p.t_closest_h:g} h, i {p.inclination_deg:g}°)")
         else:
             parts.append(f"BYORP (B {p.coefficient:g})")
     if not parts:
