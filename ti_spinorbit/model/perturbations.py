@@ -667,8 +667,8 @@ class Flyby:
     Parameters
     ----------
     planet : {"Earth", "Venus", "Mars", "Moon"}, optional
-        The passing body, by name (``constants.PLANETS``: GM and radius); or None with
-        ``mass_kg``.
+        The passing body, by name (``constants.PLANETS``: GM and radius); default Earth,
+        unless ``mass_kg`` is given.
     v_inf_km_s : float or sequence
         Speed at infinity relative to the barycentre, km/s in [0.01, 100].
     q_km : float or sequence
@@ -690,7 +690,7 @@ class Flyby:
         the real mass.
     """
 
-    planet: Optional[str] = "Earth"
+    planet: Optional[str] = None
     v_inf_km_s: object = 10.0
     q_km: object = 1e5
     inclination_deg: object = 0.0
@@ -707,9 +707,11 @@ class Flyby:
               "t_closest_h")
 
     def __post_init__(self):
-        if (self.planet is None) == (self.mass_kg is None):
-            raise ValueError("Flyby needs planet= (one of " + ", ".join(PLANETS) +
-                             ") or mass_kg=, not both and not neither")
+        if self.planet is None and self.mass_kg is None:
+            object.__setattr__(self, "planet", "Earth")
+        if self.planet is not None and self.mass_kg is not None:
+            raise ValueError("Flyby takes planet= (one of " + ", ".join(PLANETS) +
+                             ") or mass_kg=, not both")
         if self.planet is not None and self.planet not in PLANETS:
             raise ValueError(f"Flyby planet must be one of {', '.join(PLANETS)} (got "
                              f"{show(self.planet)}), or give mass_kg=")
