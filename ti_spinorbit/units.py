@@ -7,7 +7,8 @@ orbital periods), exactly as before this module existed. Wherever a docstring sa
 converts it to the documented unit and checks its dimension (a length where a mass is
 taken is refused in one line naming the parameter, the unit given and the unit expected).
 Results give their fields back with units through ``result.quantity(name)``
-(:func:`as_quantity`). docs/physics.md, "Units", has the table.
+(:func:`as_quantity`). The units of every parameter and field: docs/units.md; the
+design of this module: docs/design.md, "Units at the interface".
 
 Decisions
 ---------
