@@ -389,17 +389,28 @@ def test_warmup_refuses_unknown_variants(kwargs, message):
         tso.warmup(**kwargs)
 
 
-def test_the_command_in_a_terminal_draws_no_bar_for_a_short_run(tmp_path):
-    """End to end in a pseudo-terminal (stderr a tty, so the bar would be drawn): a short
-    section run prints its compile notices and summary, each on its own line, and no bar."""
+@pytest.mark.parametrize("delay", [120.0, 0.0])
+def test_the_command_in_a_terminal_ends_the_bars_line(tmp_path, delay):
+    """End to end in a pseudo-terminal (stderr a tty, so a bar can be drawn), the command's
+    delay set so that the outcome does not depend on the machine's speed: a run shorter than
+    the delay draws no bar at all; one past it draws the bar and ends its line, so the
+    summary starts a line of its own (it ran on after the bar: ``ETA 00:001991 VH: ...``)."""
     import os
     import pty
     import subprocess
 
+    code = ("import sys; from ti_spinorbit.engine import progress; "
+            f"progress.DELAY_S = {delay}; from ti_spinorbit import cli; "
+            "sys.exit(cli.main(['section', '--orbits', '2', '--thetadot', '0.83', "
+            "'--out', 's.png']))")
+    import fcntl
+    import struct
+    import termios
+
     master, slave = pty.openpty()
-    env = {**os.environ, "MPLBACKEND": "Agg", "COLUMNS": "100"}
-    p = subprocess.Popen([sys.executable, "-m", "ti_spinorbit", "section", "--orbits", "2",
-                          "--thetadot", "0.83", "--out", "s.png"], cwd=tmp_path, env=env,
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))   # 100 columns
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    p = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, env=env,
                          stdin=slave, stdout=slave, stderr=slave)
     os.close(slave)
     chunks = []
@@ -412,10 +423,12 @@ def test_the_command_in_a_terminal_draws_no_bar_for_a_short_run(tmp_path):
             break
         chunks.append(chunk)
     os.close(master)
-    assert p.wait(timeout=600) == 0
     text = b"".join(chunks).decode(errors="replace")
-    assert "1991 VH: mass ratio" in text and "wrote s.png" in text
-    assert "%|" not in text and "ETA" not in text, text          # no bar for a short run
-    assert all(line.startswith(("1991 VH:", "  thetadot", "wrote", "section:"))
-               or "Warning" in line or line.startswith("  ") for line in text.splitlines()
-               if line.strip()), text
+    assert p.wait(timeout=600) == 0, text
+    assert "wrote s.png" in text, text
+    if delay:
+        assert "%|" not in text and "ETA" not in text, text          # no bar at all
+    else:
+        assert "section: 100%|" in text, text
+    summary = text.index("1991 VH: mass ratio")
+    assert summary == 0 or text[summary - 1] == "\n", text          # on a line of its own
