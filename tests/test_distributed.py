@@ -271,3 +271,18 @@ def test_tilted_and_explicit_starts_go_to_the_cluster(client, vh):
     split = sections(client, vh, None, None, 2, chunk_size=1, rtol=RTOL,
                              initial_states=starts)
     assert_sections_equal(split, alone)
+
+
+def test_third_bodies_go_to_the_cluster_one_flyby_per_member(client, vh):
+    """The Sun (inclined: the 3-D model) and a flyby whose closest distance differs per
+    member: chunks of the member table carry each member's own flyby, so the cluster's
+    section equals the single-process one bit for bit (work and indicators included)."""
+    q = np.linspace(2e5, 6e5, 6)
+    perturbations = [tso.SolarTide(inclination_deg=20.0, strength=300.0),
+                     tso.Flyby("Earth", v_inf_km_s=5.0, q_km=q, inclination_deg=30.0,
+                               t_closest_h=10.0)]
+    kw = dict(rtol=RTOL, perturbations=perturbations, indicators=True)
+    alone = tso.surface_of_section(vh, 0.0, np.linspace(0.6, 1.6, 6), 2, **kw)
+    split = sections(client, vh, 0.0, np.linspace(0.6, 1.6, 6), 2, chunk_size=4, **kw)
+    assert_sections_equal(split, alone)
+    assert split.perturbations == tuple(perturbations)
