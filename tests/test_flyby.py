@@ -280,3 +280,24 @@ def test_every_method_carries_the_third_bodies(method):
     assert accuracy.usable(other.status).all() and accuracy.usable(ck.status).all()
     R0, R1 = ck.states[0][:, 0:3], other.states[0][:, 0:3]
     assert np.abs(R1 - R0).max() < 1e-8 * np.linalg.norm(R0, axis=1).max()
+
+
+def test_resumed_run_with_a_flyby_equals_an_uninterrupted_one(tmp_path):
+    """A flyby during a run killed after two windows and resumed from its checkpoint equals
+    the uninterrupted run bit for bit (the clock, hence the planet, restored: its closest
+    approach, at 300 h = 9.2 orbits, comes after the resume at 8)."""
+    from test_checkpoint import killed_run
+    from test_perturbation_plumbing import assert_same
+
+    vh = tso.catalog.system("1991 VH")
+    ckpt = tmp_path / "ts.ckpt"
+    kw = dict(orbits=12, rtol=1e-10, samples_per_orbit=8)
+    flyby = "tso.Flyby(q_km=1.5e5, v_inf_km_s=3.0, inclination_deg=0.0, t_closest_h=300.0)"
+    killed_run(tmp_path, ckpt, kill_after=2, kind="series", starts=[0.83], args=kw,
+               extra=f"perturbations=[{flyby}],")
+    kw["perturbations"] = [eval(flyby)]
+    resumed = tso.time_series(vh, 0.0, [0.83], **kw,
+                              run=tso.Run(checkpoint=ckpt, resume=True, window_orbits=4))
+    whole = tso.time_series(vh, 0.0, [0.83], **kw, run=tso.Run(window_orbits=4))
+    assert_same(resumed, whole)
+    assert np.all(whole.work[:, -1] != 0)
