@@ -129,7 +129,7 @@ _LITERAL = re.compile(r"(``.+?``)")
 # Docstrings cite the Markdown pages as "docs/physics.md §8.6" (tests/test_readme_links.py
 # checks that every cited section exists): on the site those become links to the page and to
 # each section's heading anchor (myst_heading_anchors, GitHub-style slugs).
-_PAGES = ("physics", "design", "dask")
+_PAGES = ("physics", "design", "dask", "statuses", "units", "cli", "install", "extending")
 _CITATION = re.compile(r"docs/(%s)\.md((?:[ ,;]*§[\d.]+(?:[–-][\d.]+)?)*)" % "|".join(_PAGES))
 _SECTION = re.compile(r"§([\d.]+)(?:[–-][\d.]+)?")
 
@@ -278,8 +278,8 @@ def _resolve_by_object(app, env, node, contnode):
     objects = env.domains["py"].objects
     candidates = _candidates(node)
     public = next((c for c in candidates if c in objects and c != node["reftarget"]), None)
-    if public is None and "." not in node["reftarget"].lstrip("~."):
-        # a bare name documented exactly once, wherever it is
+    if public is None and not node["reftarget"].lstrip("~.").startswith("ti_spinorbit."):
+        # a name (or Class.member) documented exactly once, wherever it is
         tail = "." + node["reftarget"].lstrip("~.")
         ends = [name for name in objects if name.endswith(tail)]
         public = ends[0] if len(ends) == 1 else None
