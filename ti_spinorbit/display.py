@@ -4,6 +4,15 @@ One place for the formatting every class uses: :func:`text` gives a ``__repr__``
 few lines (no arrays, however many members), :func:`html` a small ``<table>`` for Jupyter's
 ``_repr_html_``. Both are built from :func:`summary`, a title and lines of (label, value)
 pairs, so the two views always say the same thing.
+
+The same helpers serve the helper results (``classify_section()``'s SectionClassification,
+an OverlapDecision, ``ts.conservation()``'s Conservation), ``status_names`` (:class:`Names`,
+a list that prints on one line) and the command line's summaries (:func:`counts`,
+:func:`fields`), so nothing printed is a Python dict, list or array repr.
+
+Round-off prints as 0 (:func:`negligible`): a value below ``ROUNDOFF`` (1e-12) times the
+largest of the values printed beside it, or times its body's size for a length. The data
+keep what was computed; only the printing rounds.
 """
 
 import html as _html
