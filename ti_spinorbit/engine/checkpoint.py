@@ -408,9 +408,11 @@ def claim(path, resume=False, overwrite=False, keep=True):
     finally:
         with contextlib.suppress(OSError):
             os.remove(os.path.join(path, OWNER))
-        if finished and not keep:     # under the lock: no other run can take it meanwhile
-            finish(path, held=True)
-        lock.release()
+        try:
+            if finished and not keep:     # under the lock: no other run can take it meanwhile
+                finish(path, held=True)
+        finally:
+            lock.release()
         if finished and not keep and os.path.isdir(path):
             with contextlib.suppress(OSError):   # where the OS kept the held lock file
                 if os.name == "nt":
