@@ -16,6 +16,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -172,6 +173,7 @@ def test_parameter_map_interrupted_in_its_evidence_resumes_bit_identical(tmp_pat
     resumed = tso.parameter_map("1991 VH", **kw,
                                 run=tso.Run(checkpoint=ckpt, resume=True, progress=False))
     assert_same(resumed, whole)
+    assert not ckpt.exists()                 # finished after its last stage: removed
 
 
 def test_overlap_doubling_interrupted_in_a_longer_length_resumes(tmp_path, saves):
@@ -194,6 +196,7 @@ def test_overlap_doubling_interrupted_in_a_longer_length_resumes(tmp_path, saves
                                     run=tso.Run(checkpoint=ckpt, resume=True, progress=False))
     assert "launch-000" not in saves
     assert_same(resumed, whole)
+    assert not ckpt.exists()                 # finished after its last doubling: removed
     np.testing.assert_array_equal(resumed.overlaps_by_length, whole.overlaps_by_length)
 
 
@@ -297,3 +300,21 @@ def test_a_single_run_and_a_staged_checkpoint_are_not_confused(vh, tmp_path):
     with pytest.raises(C.CheckpointError, match=r"holds the launches \(launch-kkk\)"):
         tso.surface_of_section(vh, 0.0, [1.0], orbits=2, rtol=1e-8,
                                run=tso.Run(checkpoint=staged, resume=True, progress=False))
+
+
+def test_a_finished_libration_search_removes_its_folder_and_an_interrupted_one_keeps_it(
+        vh, tmp_path):
+    kw = dict(orbits=2, candidates=np.linspace(0.2, 1.3, 7), zoom_candidates=5,
+              max_iterations=1, samples_per_orbit=8, converge=False)
+    ckpt = tmp_path / "ck"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        with pytest.raises(KeyboardInterrupt):
+            tso.relaxed_libration(vh, **kw, run=tso.Run(checkpoint=ckpt, progress=Interrupt(2)))
+        assert C.holds_checkpoint(ckpt)                  # interrupted: kept for the resume
+        resumed = tso.relaxed_libration(vh, **kw, run=tso.Run(checkpoint=ckpt, resume=True,
+                                                              progress=False))
+        assert not ckpt.exists()                         # finished: removed
+        whole = tso.relaxed_libration(vh, **kw, run=tso.Run(progress=False))
+    assert resumed.centre_thetadot_p == whole.centre_thetadot_p
+    assert resumed.amplitude == whole.amplitude
