@@ -198,7 +198,7 @@ MAX_DISTINCT = 8
 
 class Names(list):
     """A list (of status names, labels) whose repr stays one line however long it is: the
-    first and last items and the count of each distinct value (:func:`items`). It is a
+    first and last items and the count of each distinct value (``display.items``). It is a
     plain ``list`` in every other way (equality, indexing, ``json``, ``numpy.array``)."""
 
     def __repr__(self):

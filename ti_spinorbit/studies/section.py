@@ -450,7 +450,8 @@ def _state_property(name, shape, doc):
 
 @dataclass(repr=False, eq=False)
 class Conservation(_display.Readable):
-    """Conservation check of one member of a time series (:meth:`TimeSeriesResult.conservation`):
+    """Conservation check of one member of a time series
+    (:meth:`ti_spinorbit.TimeSeriesResult.conservation`):
     prints as a few lines, draws with :meth:`plot`, and unpacks as the ``(numbers, series)``
     pair it replaces (``numbers, (t, de, dl, parts) = ts.conservation(0)``).
 
@@ -460,7 +461,7 @@ class Conservation(_display.Readable):
     each energy part relative to |E0|; ``samples`` the samples used; ``t`` their times (s),
     ``de``, ``dl`` the drifts and ``parts`` {part: ΔE_part/|E0|} per sample; ``numbers`` and
     ``series`` the dict and tuple of before. Printed, an exchange below 1e-12 of the largest
-    one is round-off and shows as 0 (:func:`ti_spinorbit.display.negligible`); the numbers
+    one is round-off and shows as 0 (``ti_spinorbit.display.negligible``); the numbers
     themselves are kept as computed."""
 
     member: int
@@ -639,8 +640,9 @@ class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
         each energy part relative to |E0| (the orbit/spin exchange). With perturbations the
         totals are E − W and L − L_ext (``work``, ``external_angmom``; docs/physics.md §13.4).
 
-        Returns a :class:`Conservation`: a few lines when printed, ``.plot()`` draws
-        :meth:`plot_conservation`; the numbers are attributes (``energy_drift``,
+        Returns a :class:`~ti_spinorbit.studies.section.Conservation`: a few lines when
+        printed, ``.plot()`` draws :meth:`~ti_spinorbit.TimeSeriesResult.plot_conservation`;
+        the numbers are attributes (``energy_drift``,
         ``angmom_drift``, ``exchange_orbit``, ``exchange_primary``, ``exchange_secondary``,
         ``samples``) and it unpacks as ``numbers, (t, de, dl, parts)``: a dict of those and
         (t s, ΔE/|E0|, |ΔL|/|L0|, {part: ΔE_part/|E0|}) per sample."""
