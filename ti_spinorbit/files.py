@@ -382,4 +382,5 @@ def claim(outputs, command=None):
 
 
 __all__ = ["OutputExists", "refuse_existing", "atomic_write", "write_text", "write_json",
-           "claim", "Claim", "OutputBusy", "check_name", "safe_part", "lock_path", "name_max", "target"]
+           "claim", "Claim", "OutputBusy", "check_name", "safe_part", "lock_path", "name_max",
+           "target"]
