@@ -77,8 +77,9 @@ def python_error(path, error=ValueError):
      "did you mean 'e'?"),
     (lambda d: d.update(zzz=0.1), "zzz", "the system description",
      "the keys are 'name', 'primary', 'secondary', 'a_m', 'e', 'primary_spin_period_s', "
-     "'heliocentric_a_au', 'heliocentric_e', 'mean_motion_rad_s', 'mass_ratio', 'omega0', "
-     "'orbital_period_h', 'density_scale'"),
+     "'observed_orbital_period_h', 'period_match', 'heliocentric_orbit', 'heliocentric_a_au', "
+     "'heliocentric_e', 'mean_motion_rad_s', 'mass_ratio', 'omega0', 'orbital_period_h', "
+     "'density_scale'"),
     (lambda d: d["secondary"].update(mass=1e11), "mass", "'secondary'", "did you mean 'mass_kg'?"),
     (lambda d: d["primary"].update(semi_axes=[600, 600, 600]), "semi_axes", "'primary'",
      "did you mean 'semi_axes_m'?"),

@@ -260,11 +260,21 @@ def _body(b):
     return f"Body {name(b.name)}", lines
 
 
+def _circular_period(s):
+    """The system's circular period at order 4 (the figures' force), NaN where it cannot be
+    had (a body of lower order): a repr never fails."""
+    try:
+        return s.circular_period()
+    except (ValueError, TypeError, ZeroDivisionError):
+        return math.nan
+
+
 def _system(s):
     P = s.primary_spin_period
     lines = [[("a/b", number(elongation(s.secondary), ".4g")), ("e", number(s.e, ".4g")),
               ("M_p/M_s", number(s.mass_ratio, ".4g")), ("ω0", f"{number(s.omega0, '.4g')} n"),
-              ("P_orb", f"{number(s.orbital_period / 3600.0, '.4g')} h")],
+              ("P_orb", f"{number(s.orbital_period / 3600.0, '.4g')} h (circular "
+                        f"{number(_circular_period(s) / 3600.0, '.4g')} h)")],
              [("a", length(s.a)), ("primary", body_size(s.primary)),
               ("secondary", body_size(s.secondary))]]
     if P is not None:       # a spherical or non-spinning primary: nothing to say

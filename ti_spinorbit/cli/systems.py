@@ -48,6 +48,9 @@ def run(args):
         if not args.quiet:               # a table: nested entries indented, no dict reprs
             for line in fields(system.describe()):
                 print(line)
+            # what an observed period measures: the circular orbit under the figures' force
+            print(f"{'circular_period_h':24s} {system.circular_period() / 3600.0:.6g} "
+                  "(order 4; orbital_period_h is the Keplerian one)")
         return 0
     systems = [catalog.system(name) for name in catalog.names()]
     if args.out:

@@ -25,7 +25,8 @@ import numpy as np
 from .._validate import (MAX_BULK_DENSITY, MAX_MASS, MAX_MASS_RATIO, MAX_PRIMARY_SPIN,
                          MAX_SEMIMAJOR_AXIS, MIN_BULK_DENSITY, MIN_LENGTH, MIN_MASS,
                          MIN_MOMENT_RATIO, check_heliocentric, refuse_unknown_keys,
-                         require_finite, require_positive_scalar, require_range, require_real,
+                         require_count, require_finite, require_positive_scalar, require_range,
+                         require_real,
                          show)
 from .bodies import DATA_ORDER, MAX_ORDER, ROW_ORDER, Body, Ellipsoid, check_order
 from . import shapes as _shapes
@@ -96,9 +97,12 @@ class BinarySystem(_display.Readable):
     orbital_period : float or Quantity, optional
         Observed orbital period of the mutual orbit, s (positive, finite), e.g. 11.92 h =
         42912 s for Didymos-Dimorphos. When given, both bodies' masses (hence densities; shapes
-        unchanged) are multiplied by one factor ``density_scale`` = (P_Kepler / P)² so that
-        the Keplerian period 2π sqrt(a³ / (G (m1 + m2))) equals it; the mass ratio and ω0 are
-        unchanged. The period must imply a bulk density (m1 + m2) / (V1 + V2) in
+        unchanged) are multiplied by one factor ``density_scale`` = (P_match / P)² so that
+        the period ``period_match`` names equals it: by default the Keplerian period
+        2π sqrt(a³ / (G (m1 + m2))), with ``period_match="circular"`` the period of the
+        circular synchronous orbit under the figures' order-4 force
+        (:meth:`circular_period`), which is what an observed period measures (the two
+        differ by 0.8 % for Didymos); the mass ratio and ω0 are unchanged. The period must imply a bulk density (m1 + m2) / (V1 + V2) in
         [100, 25000] kg/m³ (``MIN_BULK_DENSITY``, ``MAX_BULK_DENSITY``: a tenth of water to
         just above osmium), so P lies in [2π sqrt(a³ / (G 25000 V)), 2π sqrt(a³ / (G 100 V))],
         V = V1 + V2; the error names that range and the implied density (a period in the wrong
@@ -204,6 +208,30 @@ class BinarySystem(_display.Readable):
     def orbital_period(self) -> float:
         """2π/n, s."""
         return 2.0 * math.pi / self.mean_motion
+
+    def circular_period(self, order: int = 4, phases: int = 32) -> float:
+        """The period, s, of a circular orbit at separation ``a`` under the mutual force of
+        the figures at truncation ``order`` (2 to the bodies' order; default 4, the paper's), the secondary
+        synchronous (its long, x axis on the line of centres) and the primary's figure
+        averaged over its rotation phase (``phases`` equally spaced; exact for a primary
+        symmetric about its z axis): 2π sqrt(m_red a / F_r), F_r the mean attraction along
+        the line of centres (docs/physics.md §7.5). The figures' extra attraction makes it
+        shorter than the Keplerian :attr:`orbital_period` (0.8 % for the catalogue's Didymos),
+        and it is what an observed period measures (to first order in e)."""
+        from ..model.multipole import multi_indices, mutual_force_torque   # NumPy only
+
+        order = require_count("order", order, 2, min(self.primary.order, self.secondary.order))
+        TA, TB = ({tuple(int(i) for i in k): body.integral(*(int(i) for i in k))
+                   for k in multi_indices(order)}
+                  for body in (self.primary, self.secondary))
+        reduced = self.primary.mass * self.secondary.mass / self.total_mass
+        attraction = 0.0
+        for phi in 2.0 * math.pi * np.arange(phases) / phases:
+            c, s_ = math.cos(phi), math.sin(phi)
+            turn = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+            _, force, _, _ = mutual_force_torque(TA, TB, self.a * turn[:, 0], turn, order, G=G)
+            attraction -= force @ turn[:, 0] / phases
+        return 2.0 * math.pi * math.sqrt(reduced * self.a / attraction)
 
     @property
     def mass_ratio(self) -> float:
@@ -411,11 +439,18 @@ class BinarySystem(_display.Readable):
         primary = _body_from(d["primary"], "primary", mismatches, directory)
         secondary = _body_from(d["secondary"], "secondary", mismatches, directory)
         period = d.get("primary_spin_period_s")
+        observed = d.get("observed_orbital_period_h")
+        if "period_match" in d and observed is None:
+            raise ValueError("period_match needs observed_orbital_period_h (the period the masses "
+                             "are scaled to)")
         system = cls(primary, secondary, require_real("a_m", d["a_m"]), require_real("e", d["e"]),
                      primary_spin_period=None if period is None else
                      require_real("primary_spin_period_s", period),
                      name=d.get("name", "binary"),
-                     heliocentric_orbit=_heliocentric_from(d))
+                     heliocentric_orbit=_heliocentric_from(d),
+                     orbital_period=None if observed is None else
+                     require_real("observed_orbital_period_h", observed) * 3600.0,
+                     period_match=d.get("period_match", "keplerian"))
         _check_derived_entries(d, system, mismatches)
         if "density_scale" in d:
             scale = require_real("density_scale", d["density_scale"])
@@ -451,6 +486,7 @@ class BinarySystem(_display.Readable):
 #: earlier versions wrote it, 1) and of each of its bodies (io.describe_system adds
 #: "integrals"): any other key is refused, not ignored.
 SYSTEM_KEYS = ("name", "primary", "secondary", "a_m", "e", "primary_spin_period_s",
+               "observed_orbital_period_h", "period_match",
                "heliocentric_orbit", "heliocentric_a_au", "heliocentric_e",
                "mean_motion_rad_s", "mass_ratio",
                "omega0", "orbital_period_h", "density_scale")
@@ -490,6 +526,8 @@ def _body_from(b, label, mismatches, directory=None):
     refuse_unknown_keys(b, BODY_KEYS, repr(label))
     if "shape" in b:
         return _shape_body_from(b, label, mismatches, directory)
+    if "density" in b and "semi_axes_m" in b and "integrals" not in b:
+        return _ellipsoid_of_density(b, label, mismatches)
     stray = [k for k in SHAPE_KEYS if k in b]
     if stray:
         raise ValueError(f"{label} {stray[0]!r} belongs to a body given by a shape file: add "
@@ -604,6 +642,32 @@ def _shape_body_from(b, label, mismatches, directory):
                 mismatches.append(f"{label} {key} is {show(given.tolist())} in the "
                                   f"description, but its shape file gives "
                                   f"{show(want.tolist())}")
+    return body
+
+
+def _ellipsoid_of_density(b, label, mismatches):
+    """A uniform ellipsoid given by semi_axes_m and density (kg/m^3); a mass_kg beside them is
+    derived, and checked."""
+    stray = [k for k in SHAPE_KEYS if k in b and k != "density"]
+    if stray:
+        raise ValueError(f"{label} {stray[0]!r} belongs to a body given by a shape file: add "
+                         "\"shape\": \"polyhedron\" and \"file\" (or \"packaged\"), or delete it")
+    axes = b["semi_axes_m"]
+    if not isinstance(axes, (list, tuple)) or len(axes) != 3:
+        raise TypeError(f"{label} semi_axes_m must be a list [a, b, c] of three lengths in m "
+                        f"(got {show(axes)})")
+    order = check_order(b["order"], f"{label} order") if "order" in b else MAX_ORDER
+    try:
+        body = Ellipsoid(*axes, require_real(f"{label} density", b["density"]),
+                         name=b.get("name", "body"), order=order)
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"{label}: {exc}") from None
+    for key, derived in (("mass_kg", body.mass), ("bounding_radius_m", body.bounding_radius)):
+        if key in b:
+            given = require_real(f"{label} {key}", b[key])
+            if not math.isclose(given, derived, rel_tol=DERIVED_RTOL):
+                mismatches.append(f"{label} {key} is {given:.12g} in the description, but its "
+                                  f"semi_axes_m and density give {derived:.12g}")
     return body
 
 
@@ -790,10 +854,22 @@ def _volume(body: Body) -> float:
     return 4.0 / 3.0 * math.pi * axes[0] * axes[1] * axes[2]
 
 
+#: What ``orbital_period=`` is matched to: the Keplerian period of the masses, or the period
+#: of the circular orbit under the figures' mutual force (:meth:`BinarySystem.circular_period`
+#: at order 4), which an observed period measures.
+PERIOD_MATCHES = ("keplerian", "circular")
+
+
 def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, name="binary",
-                      heliocentric_orbit=None, *, orbital_period=None):
+                      heliocentric_orbit=None, *, orbital_period=None, period_match="keplerian"):
     orbital_period = _to_plain("orbital_period", orbital_period, "s")
+    if period_match not in PERIOD_MATCHES:
+        raise ValueError(f"period_match must be one of {', '.join(PERIOD_MATCHES)} (got "
+                         f"{show(period_match)})")
     if orbital_period is None:
+        if period_match != "keplerian":
+            raise ValueError("period_match needs orbital_period= (the observed period the "
+                             "masses are scaled to)")
         return _dataclass_init(self, primary, secondary, a, e, primary_spin_period, name,
                                heliocentric_orbit)
     require_real("orbital_period", orbital_period)
@@ -805,6 +881,10 @@ def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, 
     a_m = require_positive_scalar("a", a, MIN_LENGTH, MAX_SEMIMAJOR_AXIS, "m")
     period, total = float(orbital_period), primary.mass + secondary.mass
     kepler = 2.0 * math.pi * math.sqrt(a_m ** 3 / (G * total))
+    if period_match == "circular":
+        # both masses × k: the force × k², the reduced mass × k, so the period × k^(-1/2),
+        # as the Keplerian one: the same factor rule
+        kepler = _dataclass_probe(primary, secondary, a_m, e).circular_period()
     ratio = kepler / period
     factor = ratio * ratio                    # a product overflows to inf, ** 2 would raise
     volume = _volume(primary) + _volume(secondary)
@@ -828,6 +908,13 @@ def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, 
     scaled = [_scaled_body(b, factor) for b in (primary, secondary)]
     _dataclass_init(self, *scaled, a, e, primary_spin_period, name, heliocentric_orbit)
     object.__setattr__(self, "density_scale", factor)
+
+
+def _dataclass_probe(primary, secondary, a, e):
+    """The unscaled system, for its circular period (no name, spin or orbit needed)."""
+    probe = object.__new__(BinarySystem)
+    _dataclass_init(probe, primary, secondary, a, e)
+    return probe
 
 
 _init_with_period.__doc__ = _dataclass_init.__doc__
