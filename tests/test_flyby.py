@@ -301,3 +301,16 @@ def test_resumed_run_with_a_flyby_equals_an_uninterrupted_one(tmp_path):
     whole = tso.time_series(vh, 0.0, [0.83], **kw, run=tso.Run(window_orbits=4))
     assert_same(resumed, whole)
     assert np.all(whole.work[:, -1] != 0)
+
+
+def test_quantities_are_taken_and_converted():
+    u = pytest.importorskip("astropy.units")
+    given = tso.Flyby(q_km=[30.0, 60.0] * u.Mm, v_inf_km_s=6000.0 * u.m / u.s,
+                      t_closest_h=1.0 * u.day, inclination_deg=0.5 * u.rad)
+    plain = tso.Flyby(q_km=[30000.0, 60000.0], v_inf_km_s=6.0, t_closest_h=24.0,
+                      inclination_deg=math.degrees(0.5))
+    assert given.q_km == plain.q_km and given.v_inf_km_s == plain.v_inf_km_s
+    assert given.t_closest_h == plain.t_closest_h
+    assert given.inclination_deg == pytest.approx(plain.inclination_deg, rel=1e-14)
+    with pytest.raises(ValueError, match="q_km must be in"):
+        tso.Flyby(q_km=1e4 * u.s)

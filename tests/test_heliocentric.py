@@ -133,3 +133,16 @@ def test_yorp_and_a_sun_on_different_orbits_are_refused():
     with pytest.raises(ValueError, match="on different heliocentric orbits"):
         tso.model.perturbations.perturbation_rows(
             [vh], [tso.YORP(), tso.SolarTide(heliocentric_a_au=2.0, heliocentric_e=0.1)])
+
+
+def test_quantities_are_taken_and_converted():
+    u = pytest.importorskip("astropy.units")
+    given = tso.HeliocentricOrbit(1.644 * u.AU, 0.384, inclination_deg=3.41 * u.deg,
+                                  node_deg=(73.2 * u.deg).to(u.rad), frame="ecliptic",
+                                  pole=(310.0 * u.deg, -84.0 * u.deg))
+    plain = tso.HeliocentricOrbit(1.644, 0.384, inclination_deg=3.41, node_deg=73.2,
+                                  frame="ecliptic", pole=(310.0, -84.0))
+    assert given.a_au == plain.a_au and given.pole == plain.pole
+    assert given.node_deg == pytest.approx(73.2, rel=1e-14)
+    with pytest.raises(ValueError, match="inclination_deg must be in"):
+        tso.HeliocentricOrbit(1.0, 0.1, inclination_deg=3.0 * u.m)

@@ -91,7 +91,8 @@ _TEXT = {"m": "m", "kg": "kg", "kg/m^3": "kg / m3", "s": "s", "AU": "AU", "deg":
          "kg m^2 s^-1": "kg m2 / s", "kg m^2": "kg m2", "N m": "N m", "1": "",
          "": "", "n": "n", "(units of n)": "n", "units of n": "n", "mean motion n": "n",
          "orbit": "orbit", "orbits": "orbit", "orbital periods": "orbit",
-         "1/orbit": "1 / orbit", "member x orbital periods": "orbit"}
+         "1/orbit": "1 / orbit", "member x orbital periods": "orbit",
+         "km": "km", "km/s": "km / s", "h": "h"}
 #: Result unit texts that count things: dimensionless numbers.
 _COUNTS = ("members", "calls", "steps", "crossings", "launches", "potential truncation order")
 #: What each package unit is called in messages.

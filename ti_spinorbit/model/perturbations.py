@@ -56,6 +56,7 @@ from ..system.heliocentric import (ANGLE_RANGE, INCLINATION_RANGE, HeliocentricO
                                    conic_position, orbit_directions)
 from ..system.systems import BinarySystem, G
 from ..units import plain_fields as _plain_fields
+from ..units import to_plain as _to_plain
 
 #: The kernels' perturbation block, its accumulators (work, L_ext x, y, z) and the
 #: constant-Q rate floor (units of the system's n; the analytic rates use it too), from
@@ -641,6 +642,7 @@ class SolarTide:
 def _per_member(name, value, low, high, unit=""):
     """A Flyby field as a tuple of floats (one value, or one per member), each finite and in
     [low, high]; ValueError naming the field and the range."""
+    value = _to_plain(name, value, unit)
     values = np.atleast_1d(np.asarray(value, dtype=object))
     if values.ndim != 1 or values.size == 0:
         raise ValueError(f"{name} must be a number or a 1-D sequence of numbers, one per member "
@@ -669,18 +671,18 @@ class Flyby:
     planet : {"Earth", "Venus", "Mars", "Moon"}, optional
         The passing body, by name (``constants.PLANETS``: GM and radius); default Earth,
         unless ``mass_kg`` is given.
-    v_inf_km_s : float or sequence
+    v_inf_km_s : float, sequence or Quantity
         Speed at infinity relative to the barycentre, km/s in [0.01, 100].
-    q_km : float or sequence
+    q_km : float, sequence or Quantity
         Closest distance of the planet from the barycentre, km in [1, 1e9]; at least the
         named planet's radius (closer, the binary hits it).
-    inclination_deg, node_deg, periapsis_deg : float or sequence
+    inclination_deg, node_deg, periapsis_deg : float, sequence or Quantity
         Orientation of the hyperbola relative to the package's inertial frame (the mutual
         orbit's initial frame for the standard start): i in [0, 180] and Ω, ω in
         [−360, 360] degrees, as for :class:`SolarTide`; ω places the planet's closest
         approach within the hyperbola's plane (default 0: in the mutual orbit plane, along
         the initial line of centres).
-    t_closest_h : float or sequence
+    t_closest_h : float, sequence or Quantity
         Time of closest approach after t = 0, hours in [−1e6, 1e6] (negative: before the
         start, the planet receding).
     mass_kg : float, optional
@@ -717,9 +719,12 @@ class Flyby:
                              f"{show(self.planet)}), or give mass_kg=")
         if self.mass_kg is not None:
             require_positive_scalar("mass_kg", self.mass_kg, 1e3, 1e31, "kg")
-        ranges = {"v_inf_km_s": (0.01, 100.0), "q_km": (1.0, 1e9),
-                  "inclination_deg": INCLINATION_RANGE, "node_deg": ANGLE_RANGE,
-                  "periapsis_deg": ANGLE_RANGE, "t_closest_h": (-1e6, 1e6)}
+        ranges = {"v_inf_km_s": (0.01, 100.0, "km/s"), "q_km": (1.0, 1e9, "km"),
+                  "inclination_deg": (*INCLINATION_RANGE, "deg"),
+                  "node_deg": (*ANGLE_RANGE, "deg"), "periapsis_deg": (*ANGLE_RANGE, "deg"),
+                  "t_closest_h": (-1e6, 1e6, "h")}
+        if self.mass_kg is not None:
+            object.__setattr__(self, "mass_kg", _to_plain("mass_kg", self.mass_kg, "kg"))
         sizes = set()
         for name in self.FIELDS:
             values = _per_member(name, getattr(self, name), *ranges[name])

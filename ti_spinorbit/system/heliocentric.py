@@ -32,7 +32,8 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from .._validate import HELIOCENTRIC_A_RANGE, require_positive_scalar, require_range, require_real, show
+from .._validate import (HELIOCENTRIC_A_RANGE, require_positive_scalar, require_range, require_real,
+                         require_scalar, show)
 
 #: Angles of an orbit, degrees (closed): inclinations in [0, 180], the others in [-360, 360].
 INCLINATION_RANGE = (0.0, 180.0)
@@ -45,9 +46,7 @@ FRAMES = ("binary", "ecliptic")
 def check_angle(name, value, limits=ANGLE_RANGE):
     """``value`` (degrees) as a float, finite and within ``limits`` (closed), or ValueError
     naming ``name`` and the range."""
-    require_real(name, value)
-    require_range(name, value, *limits, low_open=False, high_open=False)
-    return float(value)
+    return require_scalar(name, value, *limits, unit="deg")
 
 
 def orbit_directions(inclination_deg, node_deg, periapsis_deg):
@@ -118,13 +117,13 @@ class HeliocentricOrbit:
 
     Parameters
     ----------
-    a_au : float
+    a_au : float or Quantity
         Semimajor axis, AU, in [0.05, 1e4].
     e : float
         Eccentricity, 0 <= e < 1.
-    inclination_deg : float
+    inclination_deg : float or Quantity
         i, degrees in [0, 180] (default 0).
-    node_deg, periapsis_deg, mean_anomaly_deg : float
+    node_deg, periapsis_deg, mean_anomaly_deg : float or Quantity
         Ω, ω and the mean anomaly at t = 0, degrees in [−360, 360] (default 0: the
         barycentre at perihelion at t = 0).
     frame : {"binary", "ecliptic"}
