@@ -95,7 +95,7 @@ def system():
 def integral_rows(sys_, order, degrees):
     """(1, width) scaled order-N row of the pair from the closed form."""
     from ti_spinorbit.engine import multipole_tables as MT
-    from ti_spinorbit.model.multipole import multi_indices
+    from ti_spinorbit.multipole import multi_indices
     from ti_spinorbit.system import integrals as I
 
     M, a = sys_.total_mass, float(sys_.a)

@@ -11,7 +11,7 @@ axis:
   |R| = 2548 m.
 
 For each N the order-N force on the secondary and torque on it
-(ti_spinorbit.model.multipole.mutual_force_torque: Cartesian multipole–multipole expansion of
+(ti_spinorbit.multipole.mutual_force_torque: Cartesian multipole–multipole expansion of
 Hou, Scheeres & Xin 2017, CeMDA 127:369, at any order) are compared with the exact ones: the
 exterior potential of the homogeneous primary in closed confocal form (MacMillan 1930;
 Chandrasekhar 1969), its elliptic-type integral by Gauss–Legendre quadrature, integrated over
@@ -33,7 +33,7 @@ import _common
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 import ellipsoid_exact as ex  # noqa: E402  (the exact reference lives with the tests)
 
-from ti_spinorbit.model import multipole as mp  # noqa: E402
+from ti_spinorbit import multipole as mp  # noqa: E402
 
 NAME = "order_convergence"
 DENSITY = 2400.0

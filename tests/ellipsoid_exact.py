@@ -19,7 +19,7 @@ Route (independent of any inertia-integral expansion):
   cos θ, trapezoid in longitude) in the ellipsoidal coordinates of its unit ball: spectrally
   convergent while it lies outside the first body.
 
-Conventions (those of ti_spinorbit.model.multipole): A frame; R from A's centre to B's; C takes
+Conventions (those of ti_spinorbit.multipole): A frame; R from A's centre to B's; C takes
 B-frame vectors to the A frame; force on B; torques about each centre, δU = −τ·ε.
 """
 

@@ -1,6 +1,6 @@
 """The table-driven order-N mutual potential of the kernels (kernels/multipole_gravity.py with
 the tables of ti_spinorbit/engine/multipole_tables.py) against the independent host reference
-(ti_spinorbit/model/multipole.py), against the hand-written order-4 kernels, inside the planar
+(ti_spinorbit/multipole.py), against the hand-written order-4 kernels, inside the planar
 and 3-D equations of motion, and in runs (conservation, checkpoints, refusals)."""
 
 import numpy as np
@@ -12,7 +12,7 @@ from ti_spinorbit.engine import accuracy, evaluation, multipole_tables as MT
 from ti_spinorbit.engine.checkpoint import CheckpointError
 from ti_spinorbit.engine.ensemble import Ensemble
 from ti_spinorbit.engine.members import Members
-from ti_spinorbit.model import multipole as M
+from ti_spinorbit import multipole as M
 from ti_spinorbit.model import planar as PL
 from ti_spinorbit.system import integrals as I
 
@@ -97,7 +97,7 @@ CASES = [(2, None), (3, None), (4, None), (5, None), (6, None), (7, None), (8, N
 @pytest.mark.parametrize("bodies", ["ellipsoids", "clouds"])
 @pytest.mark.parametrize("order,degrees", CASES)
 def test_kernel_equals_the_host_reference(rng, bodies, order, degrees):
-    """U, the gradient and both torques equal model/multipole.py to 1e-13 relative, at
+    """U, the gradient and both torques equal ti_spinorbit/multipole.py to 1e-13 relative, at
     orders 2..12 with and without degree caps, tilted and near contact; and the reference at
     the order below differs by far more, so the comparison sees the top order's terms."""
     if bodies == "ellipsoids":
@@ -387,7 +387,7 @@ def test_a_body_that_stops_below_the_degree_is_refused():
 
 
 def test_mutual_potential_at_order_n_equals_the_reference():
-    """tso.mutual_potential(order=N) in SI against model/multipole.py with the bodies' own
+    """tso.mutual_potential(order=N) in SI against ti_spinorbit/multipole.py with the bodies' own
     integrals (bodies that hold them)."""
     system = _ellipsoid_system()
     if not _holds(system, 10):

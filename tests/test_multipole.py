@@ -1,4 +1,4 @@
-"""Any-order mutual potential (ti_spinorbit.model.multipole) against independent routes.
+"""Any-order mutual potential (ti_spinorbit.multipole) against independent routes.
 
 (a) point masses; (b) point clouds: convergence to the exact pairwise sum; (c) point clouds:
 the truncated Cartesian series equals the pairwise Legendre series truncated at the same order
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from numpy.polynomial import legendre
 
-from ti_spinorbit.model import multipole as mp
+from ti_spinorbit import multipole as mp
 
 sys.path.insert(0, os.path.dirname(__file__))
 import ellipsoid_exact as ex  # noqa: E402

@@ -4,7 +4,7 @@ integration of the same equations.
 The package integrates the full two-body problem in the primary's frame, in scaled units,
 with the table-driven order-N kernels (docs/physics.md §3.8, §4). The oracle here is written
 separately: SI units, inertial frame, scipy's DOP853, the mutual force and both torques from
-the NumPy multipole expansion (ti_spinorbit.model.multipole) at the same order, and Euler's
+the NumPy multipole expansion (ti_spinorbit.multipole) at the same order, and Euler's
 equations in angular-momentum form,
 
     d²R/dt² = F / m_red,   dL_b/dt = τ_b,   ω_b = S_b I_b⁻¹ S_bᵀ L_b,   dS_b/dt = [ω_b]× S_b,
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import ti_spinorbit as tso
-from ti_spinorbit.model import multipole as mp
+from ti_spinorbit import multipole as mp
 from ti_spinorbit.system.initial import ROW_SLICES
 
 ORDER = 6

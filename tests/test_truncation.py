@@ -8,7 +8,7 @@ secondary (tests/ellipsoid_exact.py); over its configuration set they must fall 
 with order, faster at a larger separation; a sphere feels no torque; bad inputs are refused.
 
 The per-member estimates (engine.evaluation.truncation_estimates, through the kernels) must
-equal the same differences computed by the NumPy expansion (model.multipole) at the member's
+equal the same differences computed by the NumPy expansion (ti_spinorbit.multipole) at the member's
 closest recorded approach; the radar shape of Didymos is "truncated" at order 4 and not at 8;
 the verdict is saved, loaded and reported by the command line.
 """
@@ -29,7 +29,7 @@ import ti_spinorbit as tso
 from ti_spinorbit import cli
 from ti_spinorbit.engine import accuracy, evaluation
 from ti_spinorbit.layout import spatial as _S
-from ti_spinorbit.model import multipole as mp
+from ti_spinorbit import multipole as mp
 
 G = 6.67430e-11
 DENSITY = 2400.0

@@ -175,16 +175,12 @@ def astropy_unit(text):
 
 
 def _mean_motion(system):
-    """n (rad/s) of ``system``: one BinarySystem, a catalogue name, or a list of systems
-    that share one n; None when there is none (or they differ)."""
-    if system is None:
+    """n (rad/s) of ``system``: one BinarySystem, or a list of systems that share one n;
+    None when there is none (or they differ, or ``system`` is a catalogue name: the entry
+    points resolve names first, so that this module, below the systems, never imports
+    them)."""
+    if system is None or isinstance(system, str):
         return None
-    if isinstance(system, str):
-        try:
-            from .system import catalog
-            system = catalog.as_system(system)
-        except (ValueError, TypeError, KeyError):
-            return None
     if isinstance(system, (list, tuple)):
         rates = {_mean_motion(s) for s in system}
         return rates.pop() if len(rates) == 1 else None

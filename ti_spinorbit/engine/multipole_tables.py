@@ -6,7 +6,7 @@ both torques of two rigid bodies at any truncation order N by walking these tabl
 time: every member walks the same entries in the same order, so no thread diverges, and no
 term is unrolled at compile time, so one compiled kernel serves every order above 4
 (``layout.multipole.KERNEL_ORDER``). What the tables encode (docs/physics.md §3.8 derives
-it; ``ti_spinorbit.model.multipole`` is the independent host reference):
+it; ``ti_spinorbit.multipole`` is the independent host reference):
 
 Normalised quantities. With D_γ(R) = ∂^γ(1/|R|) (γ a multi-index, |γ| its degree),
 t̂_A^α = (−1)^{|α|} T_A^α / α! and t̂_B'^β = T'_B^β / β! (T'_B: the secondary's integrals
@@ -14,7 +14,7 @@ carried into the primary's frame), the truncated potential is
 
     U_N = −G Σ_{|α|+|β| ≤ N} t̂_A^α t̂_B'^β D_{α+β}(R),
 
-the Cartesian multipole–multipole expansion of ``model/multipole.py`` with its coefficient
+the Cartesian multipole–multipole expansion of ``ti_spinorbit/multipole.py`` with its coefficient
 (−1)^{|α|} (α+β)!/(α!β!) a_{α+β} absorbed: every pair costs one product, no coefficient.
 
 Three kinds of terms, so that the secondary is rotated only as far as the mixed terms need:
@@ -46,7 +46,7 @@ D_γ from the two-term recurrence (n = |γ| ≥ 1, D_0 = 1/r)
 
     n r² D_γ = −(2n − 1) Σ_i γ_i R_i D_{γ−e_i} − (n − 1) Σ_i γ_i (γ_i − 1) D_{γ−2e_i},
 
-the recurrence of ``model/multipole.py`` with a_γ = D_γ / γ!, for the 2d + 1 entries of each
+the recurrence of ``ti_spinorbit/multipole.py`` with a_γ = D_γ / γ!, for the 2d + 1 entries of each
 degree d whose z exponent is at most 1 (five terms: the z second-order one vanishes; an
 index with a negative component gets weight 0 and index 0, so every entry has five); the
 other entries, (d − 1) d / 2 of them, follow from ∇²(1/r) = 0,
@@ -73,7 +73,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..layout import multipole as _H
-from ..model.multipole import multi_indices
+from ..multipole import multi_indices
 
 MAX_ORDER = _H.MAX_ORDER
 

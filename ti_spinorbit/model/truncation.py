@@ -30,7 +30,7 @@ Decisions:
   closest approach of the unperturbed orbit. The series converges only while the bodies'
   bounding spheres are apart, so a separation at or below the sum of the bounding radii is
   refused.
-* **Formulation.** The host-side order-N expansion of :mod:`ti_spinorbit.model.multipole`
+* **Formulation.** The host-side order-N expansion of :mod:`ti_spinorbit.multipole`
   (NumPy only), with the bodies' integrals from ``Body.integral``; it agrees with the kernels'
   order-4 terms to round-off (tests/test_multipole.py), so the table describes the kernels'
   truncation.
@@ -42,7 +42,7 @@ import numpy as np
 
 from .._validate import require_count, require_positive_scalar, show
 from ..system.systems import G
-from . import multipole
+from .. import multipole
 
 #: Default orders of the table (the paper's is 4).
 DEFAULT_ORDERS = (2, 4, 6, 8, 12)

@@ -34,6 +34,7 @@ from ..model.attitude import (CLASSES, CLASS_UNIT as ATTITUDE_CLASS, classify,
 from ..model.models import check_indicator_space
 from ..model.observables import derive
 from ..model.perturbations import UNIT as PERTURBATIONS
+from ..system import catalog
 from ..system.initial import ROW_SLICES, ROW_UNIT as STATE_ROW, physical_rows
 from ..system.systems import BinarySystem, NEAR_CIRCULAR_E, NearCircularWarning
 from ..units import to_plain
@@ -60,6 +61,12 @@ def plain_starts(system, theta_p, thetadot_p, orbits):
     ``units.n``, or an angular rate divided by the system's n; a length of time in
     ``units.orbit`` or a time divided by the period 2π/n, where ``system`` is one system),
     a plain value unchanged after the degree hint. None stays None."""
+    if isinstance(system, str) or (isinstance(system, (list, tuple)) and
+                                   any(isinstance(s, str) for s in system)):
+        try:                # a catalogue name: its n (a bad one is refused later, by name)
+            system = catalog.as_system(system, allow_list=True)
+        except (TypeError, ValueError):
+            system = None
     return (to_plain("theta_p", theta_p, "deg"),
             to_plain("thetadot_p", thetadot_p, "n", system=system),
             to_plain("orbits", orbits, "orbit", system=system))

@@ -218,7 +218,7 @@ class BinarySystem(_display.Readable):
         the line of centres (docs/physics.md §7.5). The figures' extra attraction makes it
         shorter than the Keplerian :attr:`orbital_period` (0.8 % for the catalogue's Didymos),
         and it is what an observed period measures (to first order in e)."""
-        from ..model.multipole import multi_indices, mutual_force_torque   # NumPy only
+        from ..multipole import multi_indices, mutual_force_torque   # NumPy only
 
         order = require_count("order", order, 2, min(self.primary.order, self.secondary.order))
         TA, TB = ({tuple(int(i) for i in k): body.integral(*(int(i) for i in k))
