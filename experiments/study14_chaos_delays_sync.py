@@ -33,7 +33,9 @@ synchronous rotation is measured directly, for 1991 VH, 2003 YT1 and 2004 DC:
   0.1 n. (At the tide's own strength factor the paper's f_Y = 5e-4 would equal the tide at
   |θ̇ − n| = 6.6 n (1991 VH), 156 n (2003 YT1), 256 n (2004 DC) for Δt = 600 s: YORP would
   win outright and break the synchronous islands of the last two; the ratio printed as
-  "YORP/tide at equal strength".)
+  "YORP/tide at equal strength".) YORP takes its mean-distance form (``distance="mean"``):
+  a constant offset of the tidal equilibrium is the experiment, and the strength S speeds up
+  the spin dynamics but not the heliocentric orbit, which would modulate YORP on it.
 
 Capture into synchronous rotation (the definition used for every member): let φ(t) be the
 angle α between the secondary's long axis and the line to the primary, unwrapped modulo the
@@ -301,7 +303,8 @@ def main():
             perts = [tso.Tides(body="secondary", time_lag=TIME_LAG, strength=factor * S)]
             if yorp:
                 perts.append(tso.YORP(body="secondary", coefficient=YORP_COEFFICIENT,
-                                      strength=yorp_strength(nominal, factor * S)))
+                                      strength=yorp_strength(nominal, factor * S),
+                                      distance="mean"))
             run = int(round(orbits / factor))           # every run lasts 40 of its own τ
             res = run_ensemble(system, tp, td, perts, run)
             results[label] = res
