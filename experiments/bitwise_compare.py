@@ -358,12 +358,16 @@ def perturbations(yorp_convention=None):
     import ti_spinorbit as tso
 
     yorp = dict(body="secondary", coefficient=5e-4, strength=1e3)
+    byorp = dict(coefficient=1e-3, strength=1e3)
     if yorp_convention is not None and accepts(tso.YORP, "convention"):
         yorp["convention"] = yorp_convention
+    # the mean-distance form, which trees before the heliocentric distance had
+    if accepts(tso.YORP, "distance"):
+        yorp["distance"] = byorp["distance"] = "mean"
     return [tso.Tides(body="secondary", strength=1e3),
             tso.Tides(body="primary", k2=1e-3, time_lag=60.0, strength=1e2),
             tso.YORP(**yorp),
-            tso.BYORP(coefficient=1e-3, strength=1e3)]
+            tso.BYORP(**byorp)]
 
 
 def explicit_states(system, planar):
