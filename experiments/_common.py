@@ -34,6 +34,7 @@ PAPER = {
     "study13": "§3",              # energy and angular-momentum drift per year (text)
     "study14": "§8",              # does chaos delay synchronisation? tides in the equations
     "study15": "§2",              # beyond the paper: its order-4 model against order and shape
+    "study16": "§8",              # beyond the paper: Earth flybys of 1991 VH (its non-synchronous secondary)
 }
 
 
