@@ -209,7 +209,7 @@ def test_cli_overlap_prints_the_verdict(tmp_path):
     p = run_cli("overlap", "--system", "1991 VH", "--elongations", "1.04", "1.04", "0.01",
                 "--orbits", "100", "--max-orbits", "200", "--out", "o.png", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
-    assert "not converged by 200 orbits" in p.stdout and "(upper bound" in p.stdout
+    assert "not converged by 200 orbits" in p.stdout and "is an upper bound" in p.stdout
     assert "     100     .m" in p.stdout and "     200     .m" in p.stdout
     meta = io.read_metadata(tmp_path / "o.npz")
     assert meta["converged"] is False and meta["convergence"].startswith("not converged by 200")

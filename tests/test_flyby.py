@@ -314,3 +314,20 @@ def test_quantities_are_taken_and_converted():
     assert given.inclination_deg == pytest.approx(plain.inclination_deg, rel=1e-14)
     with pytest.raises(ValueError, match="q_km must be in"):
         tso.Flyby(q_km=1e4 * u.s)
+
+
+def test_a_split_binary_is_classified_with_its_last_moments():
+    """Earth at 2 radii splits 1991 VH after its last sample: the escaping member's attitude
+    class agrees with its reported largest spin-axis angle, which holds the end state (it
+    tumbles), instead of what the samples before the encounter alone would say."""
+    from ti_spinorbit.model import attitude
+
+    vh = tso.catalog.system("1991 VH")
+    flyby = tso.Flyby(q_km=2.0 * R_EARTH_KM, v_inf_km_s=8.0, inclination_deg=60.0,
+                      node_deg=20.0, periapsis_deg=30.0,
+                      t_closest_h=12.0 * vh.orbital_period / 3600.0)
+    ts = tso.time_series(vh, 0.0, [1.0], orbits=30, rtol=1e-10, perturbations=[flyby],
+                         integrator=tso.Integrator(model="3d"))
+    assert ts.status_names[0] in ("escape", "collision")
+    assert ts.max_npa_angle[0] > attitude.NPA_ANGLE
+    assert attitude.CLASSES[ts.attitude_class[0]] == "tumbling"

@@ -28,7 +28,7 @@ from ..engine.options import Integrator, Run
 from ..engine.results import (COORDINATES, FLOAT as _F, INTEGER as _I, METHOD, ORBITS, RELATIVE,
                               Result, SPIN, STATUS, unit)
 from ..layout import RECORD_WIDTH, spatial as _S
-from ..model import coordinates as _coords
+from ..model import attitude as _attitude, coordinates as _coords
 from ..model.attitude import (CLASSES, CLASS_UNIT as ATTITUDE_CLASS, classify,
                               euler_angles_of_rows, npa_angle, pole_tilt)
 from ..model.models import check_indicator_space
@@ -757,7 +757,8 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
         status=status, systems=members, initial_theta_p=tp, initial_thetadot_p=td,
         energy_drift=energy_drift, angmom_drift=angmom_drift, max_drift=limit, rtol=ens.rtol,
         orbits=orbits, coordinates=coordinates, seconds=out.seconds, method=ens.method,
-        initial_states=rows, max_tilt=tilt, max_npa_angle=npa, attitude_class=_attitude_classes(members, out.samples),
+        initial_states=rows, max_tilt=tilt, max_npa_angle=npa,
+        attitude_class=_attitude_classes(members, out.samples, tilt, npa),
         states=_sample_rows(members, out.samples, cols["t"].shape[1]) if states else None,
         perturbations=perturbations, stop_status=np.asarray(out.status, dtype=np.int32).copy(),
         work=None if exchange is None else exchange[..., 0] * e_unit,
@@ -782,13 +783,21 @@ def _stack_padded(arrays, width, columns):
     return x
 
 
-def _attitude_classes(members, samples):
-    """Attitude class code per member (``attitude.CLASSES``; −1 with fewer than 2 samples)."""
+def _attitude_classes(members, samples, max_tilt, max_npa):
+    """Attitude class code per member (``attitude.CLASSES``; −1 with fewer than 2 samples),
+    from its samples, made to agree with the reported ``max_tilt`` and ``max_npa_angle``,
+    which also hold the start and the end state: a member whose spin leaves its short axis
+    (or whose pole tilts) only after its last sample, as an escaping one may, is tumbling
+    (or librating in 3-D), not what its samples alone would say."""
 
     out = np.full(len(members), -1, dtype=np.int8)
     for k, (m, rec) in enumerate(zip(members, samples)):
         if np.count_nonzero(np.all(np.isfinite(rec[:, 1:]), axis=1)) >= 2:
             out[k] = classify([rec[:, 1:]], m)[0]
+    known = out >= 0
+    out[known & (np.asarray(max_npa) > _attitude.NPA_ANGLE)] = _attitude.TUMBLING
+    out[(out == _attitude.PLANAR_LIBRATION) & (np.asarray(max_tilt) > _attitude.TILT_ANGLE)] = \
+        _attitude.LIBRATION_3D
     return out
 
 
