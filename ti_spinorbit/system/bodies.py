@@ -133,7 +133,7 @@ class Body(_display.Readable):
     Parameters
     ----------
     mass : float or Quantity
-        Mass in kg, in [1e-9, 1e35] (``MIN_MASS``, ``MAX_MASS`` of ``ti_spinorbit._validate``);
+        Mass in kg, in [1e-9, 1e35];
         a Quantity is converted (:mod:`ti_spinorbit.units`).
     integrals : dict
         ``{(l, m, n): T^{lmn}}`` for 2 <= l + m + n <= ``order``, SI units (kg m^{l+m+n}).
@@ -164,6 +164,19 @@ class Body(_display.Readable):
     :func:`~ti_spinorbit.system.shapes.Composite`) leave the map on the body: ``offset``
     (m, the centre of mass in the input frame) and ``rotation`` (input frame -> body frame),
     so that ``x_body = rotation @ (x_input - offset)``.
+
+    See Also
+    --------
+    Sphere, Ellipsoid, Polyhedron, Composite : bodies with their integrals computed
+
+    Examples
+    --------
+    A body given by its mass and second-order inertia integrals T^{lmn} (kg m^(l+m+n)):
+
+    >>> body = tso.Body(1e12, {(2, 0, 0): 1e17, (0, 2, 0): 0.9e17, (0, 0, 2): 0.8e17},
+    ...                 bounding_radius=600.0)
+    >>> body.integral(2, 0, 0), body.integral(1, 1, 0)     # a key not stored is zero
+    (1e+17, 0.0)
     """
 
     mass: float
@@ -234,7 +247,7 @@ class Body(_display.Readable):
 
     # ---- derived quantities -------------------------------------------------------------
     def integral(self, l: int, m: int, n: int) -> float:
-        """T^{lmn} in SI units (kg m^{l+m+n}) for any l + m + n <= :attr:`order`: the mass
+        """T^{lmn} in SI units (kg m^{l+m+n}) for any l + m + n <= ``order``: the mass
         for (0, 0, 0), 0 for the first moments (the origin is the centre of mass) and for
         every entry not stored. Beyond the body's order: ValueError (one line, naming the
         body, the degree asked and the order), never a silent zero."""
@@ -364,7 +377,18 @@ def Ellipsoid(a, b, c, density=None, *, mass=None, name="ellipsoid", order=MAX_O
     ``MAX_LENGTH``) and the body may not be a needle: (b² + c²)/(a² + b²) >= 1e-6 (its
     smallest principal moment over its largest). x is the long axis and z the short one (the
     spin axis of a principal-axis rotator). Every integral up to ``order`` (4..16, default
-    ``MAX_ORDER`` = 16) is the closed form of the module docstring, the odd ones exactly 0."""
+    ``MAX_ORDER`` = 16) is the closed form of the module docstring, the odd ones exactly 0.
+
+    Examples
+    --------
+    Semi-axes a >= b >= c in metres (not diameters):
+
+    >>> moon = tso.Ellipsoid(294, 196, 190, density=2618)
+    >>> f"{moon.mass:.4g} kg"
+    '1.201e+11 kg'
+    >>> f"{moon.integral(2, 0, 0) / moon.mass:.1f} m²"     # a²/5
+    '17287.2 m²'
+    """
     a, b, c = (to_plain(label, value, "m") for label, value in (("a", a), ("b", b), ("c", c)))
     for label, value in (("a", a), ("b", b), ("c", c)):
         require_positive_scalar(label, value, MIN_LENGTH, MAX_LENGTH, "m")
@@ -399,7 +423,16 @@ def Sphere(radius, density=None, *, mass=None, name="sphere", order=MAX_ORDER) -
 
     Its exterior field is exactly that of a point mass; the integrals are kept anyway so the
     same kernels serve every body. ``radius`` in [1e-3, 1e10] m; density and mass bounds, and
-    ``order``, as for :func:`Ellipsoid`."""
+    ``order``, as for :func:`Ellipsoid`.
+
+    Examples
+    --------
+    >>> primary = tso.Sphere(600, density=1581)          # radius in m, density in kg/m³
+    >>> f"{primary.mass:.4g} kg"
+    '1.43e+12 kg'
+    >>> primary.integral(2, 0, 0) == primary.integral(0, 0, 2)
+    True
+    """
     radius = to_plain("radius", radius, "m")
     require_positive_scalar("radius", radius, MIN_LENGTH, MAX_LENGTH, "m")
     return Ellipsoid(radius, radius, radius, density, mass=mass, name=name, order=order)
