@@ -185,6 +185,18 @@ def Polyhedron(vertices, faces, *, density=None, mass=None, name="polyhedron",
         the centre of mass; its integrals are those of
         :func:`~ti_spinorbit.system.integrals.polyhedron_integrals` (signed tetrahedra:
         exact for any closed mesh, star-shaped or not; docs/physics.md §2.7).
+
+    Examples
+    --------
+    A tetrahedron with 100 m edges along the axes, its facets wound outwards:
+
+    >>> vertices = 100.0 * np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    >>> faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+    >>> rock = tso.Polyhedron(vertices, faces, density=2000)
+    >>> round(rock.volume)                                 # m³, 100³/6
+    166667
+    >>> rock.offset                                        # its centre of mass, m
+    array([25., 25., 25.])
     """
     _check_name(name)
     order = check_order(order)
@@ -265,6 +277,17 @@ def read_shape(path, *, unit="km", density=None, mass=None, format=None, facets=
     ValueError
         One line: the file and line of unreadable content, the file and what is wrong with
         its mesh, or a bad parameter.
+
+    Examples
+    --------
+    A shape-model file (here a tetrahedron written as OBJ, in km):
+
+    >>> with open("tetra.obj", "w") as f:
+    ...     _ = f.write("v 0 0 0\\nv 0.1 0 0\\nv 0 0.1 0\\nv 0 0 0.1\\n"
+    ...                 "f 1 3 2\\nf 1 2 4\\nf 1 4 3\\nf 2 3 4\\n")
+    >>> rock = tso.read_shape("tetra.obj", unit="km", density=2000)
+    >>> round(rock.volume)                                 # m³
+    166667
     """
     if isinstance(path, (tuple, list)):
         if len(path) != 2 or facets is not None:
@@ -325,6 +348,13 @@ class Part:
     weight : float
         Multiplies the part's mass and every integral (default 1; -1 removes the part's
         shape: a void, or a core lighter than its mantle given by its density deficit).
+
+    Examples
+    --------
+    >>> core = tso.Part(tso.Sphere(150, density=1500), offset=(50, 0, 0))   # m
+    >>> core.weight
+    1.0
+    >>> void = tso.Part(tso.Sphere(50, density=2000), weight=-1.0)         # a hole
     """
 
     body: Body
@@ -390,6 +420,16 @@ def Composite(parts, *, name="composite", order=None) -> Body:
     Returns
     -------
     Body
+
+    Examples
+    --------
+    A mantle with a denser core off its centre (the core's excess density, 1500 kg/m³ above the
+    mantle's):
+
+    >>> cored = tso.Composite([tso.Ellipsoid(400, 390, 380, density=2000),
+    ...                        tso.Part(tso.Sphere(150, density=1500), offset=(50, 0, 0))])
+    >>> f"{cored.mass:.4g} kg"
+    '5.178e+11 kg'
     """
     _check_name(name)
     if isinstance(parts, (Part, Body, str, bytes)) or not hasattr(parts, "__iter__"):
