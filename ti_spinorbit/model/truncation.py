@@ -85,6 +85,14 @@ class TruncationTable:
         largest reference torque on that body (0 for a body that feels none).
     system : str
         The system's name.
+
+    Examples
+    --------
+    >>> table = tso.truncation(tso.catalog.system("1991 VH"), orders=(2, 4))
+    >>> print(table)                                       # doctest: +ELLIPSIS
+    truncation error of the mutual potential, 1991 VH at 3135 m (against order 8):
+        N   force      torque (secondary)   torque (primary)
+        2   ...
     """
 
     orders: np.ndarray
@@ -148,6 +156,14 @@ def truncation(system, orders=DEFAULT_ORDERS, separation=None, *, reference=None
     Returns
     -------
     TruncationTable
+
+    Examples
+    --------
+    >>> table = tso.truncation(tso.catalog.system("1991 VH"), orders=(2, 4))
+    >>> table.orders
+    array([2, 4])
+    >>> bool(table.force[1] < 1e-5)             # order 4 is well inside the force limit
+    True
     """
     if isinstance(orders, (str, bytes)) or not hasattr(orders, "__iter__"):
         raise TypeError(f"orders must be a sequence of whole numbers (got {show(orders)})")
