@@ -59,7 +59,18 @@ NEAR_CIRCULAR_E = 1e-3
 class NearCircularWarning(ImplausibleInputWarning):
     """A surface of section at e < 1e-3 (``NEAR_CIRCULAR_E``): the pericentre, where the
     section samples, is ill-defined on a (nearly) circular orbit, and the section's points
-    scatter with the osculating elements rather than the spin."""
+    scatter with the osculating elements rather than the spin.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> circular = tso.catalog.system("1991 VH", eccentricity=0.0)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     sos = tso.surface_of_section(circular, 0.0, [0.45], orbits=2)
+    >>> any(issubclass(w.category, tso.NearCircularWarning) for w in caught)
+    True
+    """
 
 
 @dataclass(frozen=True, repr=False)
@@ -124,6 +135,35 @@ class BinarySystem(_display.Readable):
     ImplausibleInputWarning
         A body with a semi-axis (or bounding radius) below 1 m or a semimajor axis below 10 m
         (``SMALL_BODY_M``, ``SMALL_ORBIT_M``): kilometres typed as metres?
+
+    See Also
+    --------
+    ti_spinorbit.catalog.system : the systems of Naidu & Margot 2015, Table 1
+
+    References
+    ----------
+    * Naidu, S. P. & Margot, J.-L. 2015, Near-Earth asteroid satellite spins under
+      spin-orbit coupling, AJ 149:80.
+
+    Examples
+    --------
+    A system in SI units (radius and semi-axes in metres, densities in kg/m³):
+
+    >>> system = tso.BinarySystem(tso.Sphere(600, density=1581),
+    ...                           tso.Ellipsoid(294, 196, 190, density=2618),
+    ...                           a=3300, e=0.05, name="mine")
+    >>> round(system.mass_ratio, 1), round(system.omega0, 3)
+    (11.9, 1.074)
+    >>> round(system.orbital_period / 3600, 1)             # hours
+    32.5
+
+    The same bodies matched to an observed orbital period (both densities scaled by one
+    factor):
+
+    >>> matched = tso.BinarySystem(system.primary, system.secondary, a=3300, e=0.05,
+    ...                            orbital_period=30 * 3600)
+    >>> round(matched.density_scale, 3)
+    1.175
     """
 
     primary: Body
