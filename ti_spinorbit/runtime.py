@@ -131,6 +131,11 @@ def init(arch=None, *, offline_cache=True, debug=False, cpu_max_num_threads=None
 
     Returns the arch name in use. Calling again with the same arch is a no-op; calling with
     a different arch re-initialises Taichi, which invalidates existing ensembles.
+
+    Examples
+    --------
+    >>> tso.init()               # the CPU, the default; a no-op when already started there
+    'cpu'
     """
     name = arch if arch is not None else (os.environ.get(ARCH_ENV) or "cpu")
     if not isinstance(name, str) or name.lower() not in _KNOWN_ARCHS:
