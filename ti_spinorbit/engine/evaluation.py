@@ -68,6 +68,19 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4, degre
     (V, F, torque_primary, torque_secondary)
         V in J; F = −∂V/∂R the force on the secondary, N; torques about each body's centre of
         mass, N m (δV = −torque·δθ for an infinitesimal rotation of that body alone).
+
+    Examples
+    --------
+    The energy, force and torques of 1991 VH's bodies 3 km apart, the secondary's axes along
+    the primary's (``S`` the identity):
+
+    >>> vh = tso.catalog.system("1991 VH")
+    >>> V, F, torque_p, torque_s = tso.mutual_potential(
+    ...     vh.primary, vh.secondary, R=[3000.0, 500.0, 0.0], S=np.eye(3))
+    >>> f"{V:.4g} J"
+    '-3.771e+09 J'
+    >>> F.shape, torque_s.shape                            # N and N m, primary frame
+    ((3,), (3,))
     """
     from ..kernels import advance as K      # Taichi: imported on first use
 
