@@ -84,6 +84,19 @@ class Integrator:
     controller : Controller
         Step-size policy (``ti_spinorbit.kernels.controller.Controller``: safety, factor
         limits, event tolerances); another one than the default compiles its own kernels.
+
+    See Also
+    --------
+    Run : how to run (progress, checkpoints, Dask)
+
+    Examples
+    --------
+    >>> how = tso.Integrator(method="dop853", rtol=1e-12)
+    >>> how.method, how.rtol, how.order
+    ('dop853', 1e-12, 4)
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5, integrator=how)
+    >>> sos.method
+    'dop853'
     """
 
     method: str = "cash-karp"
@@ -194,6 +207,16 @@ class Run:
     worker_arch, worker_threads : optional
         ``arch`` and ``cpu_max_num_threads`` of :func:`ti_spinorbit.init` in each worker; by
         default a worker initialises lazily (``TI_SPINORBIT_ARCH`` or the CPU).
+
+    See Also
+    --------
+    Integrator : how to integrate (method, tolerances, model, order)
+
+    Examples
+    --------
+    >>> quiet = tso.Run(progress=False)                   # no progress bar
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5, run=quiet)
+    >>> resumable = tso.Run(checkpoint="vh.ckpt", resume=True)   # for long runs
     """
 
     progress: Union[None, bool, Callable[[float], None]] = None
