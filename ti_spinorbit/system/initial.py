@@ -165,6 +165,20 @@ class InitialState:
     as matrices, so a quaternion and its matrix give equal states); comparing with anything
     else is ``NotImplemented`` (so ``state == 3`` is False). States are immutable (frozen,
     read-only arrays) and hashable, consistently with ``==``.
+
+    Examples
+    --------
+    The paper's start (θ_p = 0°, θ̇_p = 0.43 n) with the secondary rolled by 5°, then kicked
+    by 2.7 mm/s against its motion:
+
+    >>> vh = tso.catalog.system("1991 VH")
+    >>> start = vh.tilted_start(0.0, 0.43, roll=5.0)
+    >>> start                                              # doctest: +ELLIPSIS
+    InitialState(|R| = 3135 m, ..., secondary z axis 5° from the orbit normal)
+    >>> kicked = start.kicked([0.0, -2.7e-3, 0.0])         # Δv in m/s, orbit frame
+    >>> ts = tso.time_series(vh, orbits=2, initial_states=[start], samples_per_orbit=16)
+    >>> ts.attitude_class_names
+    ['3-D libration']
     """
 
     R: np.ndarray
@@ -199,7 +213,7 @@ class InitialState:
     def check(self, system, name="initial state"):
         """Raise ValueError (one line) if the bodies touch, the orbit is not bound, or a spin
         is beyond the bounds every other path holds (|ω₁| <= ``MAX_PRIMARY_SPIN`` n and
-        |ω₂| <= ``MAX_SPIN`` n, ``ti_spinorbit._validate``: the steps per orbit grow with
+        |ω₂| <= ``MAX_SPIN`` n: the steps per orbit grow with
         the spin, so a faster one makes a run of unbounded length).
 
         Contact: |R| <= the sum of the bodies' bounding radii (the kernels' collision test).
