@@ -136,25 +136,73 @@ def _state_rows_and_tilt(members, records_list, y0, y_end):
 class SectionResult(Result, _display.Readable, kind="section"):
     """Pericentre surface of section for N members (arrays padded with NaN to (N, max count)).
 
-    Attributes (SI unless stated): ``theta_p`` deg in [0, 180); ``thetadot_p`` units of n;
-    ``t`` s; ``r`` pericentre distance m; ``a``, ``e`` osculating elements (m, -); ``count``
-    crossings per member; ``energy_drift``, ``angmom_drift`` relative drifts of the total
-    energy and angular-momentum vector from the start to the end of the run; ``max_drift``
-    the limit they were held against (``ti_spinorbit.engine.accuracy``); ``status`` codes with
-    ``status_names`` ("done", "inaccurate" when a drift exceeds ``max_drift``, "non-finite",
-    "collision", ...) and ``status_counts``; ``accepted``, ``rejected``, ``rhs_calls``;
-    with ``indicators=True``: ``megno`` (MEGNO ⟨Y⟩ at the end: → 2 quasi-periodic, ≫ 2
-    chaotic) and ``lyapunov`` (finite-time maximal Lyapunov exponent, 1/orbit), else NaN;
-    ``coordinates`` "inertial" (``thetadot_p`` and ``initial_thetadot_p`` are the inertial
-    spin rate) or "apsidal" (spin rate minus the apsidal rate ϖ̇, the paper's; ``apsidal_rate``
-    then holds ϖ̇/n at every crossing, NaN where e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``);
-    θ_p is the same in both (docs/physics.md §6.7); ``stop_status`` the integrator's own
-    status codes before the accuracy verdict: why each member stopped ("done" when it ran to
-    the end), kept for an "inaccurate" member that collided or escaped (None in files written
-    before it existed); ``truncation_force`` / ``truncation_torque`` the relative size of the
-    mutual potential's next two orders at each member's closest approach, in the force and in
-    the secondary's torque (over |F| ρ_B): "truncated" above ``accuracy.TRUNCATION_LIMITS``,
-    NaN where not estimated (docs/physics.md §3.9; None in files written before it existed)."""
+    Attributes
+    ----------
+    theta_p : ndarray, shape (N, max count)
+        θ_p at every pericentre crossing, deg in [0, 180); NaN-padded, as every per-crossing
+        array. The same in both ``coordinates`` (docs/physics.md §6.7).
+    thetadot_p : ndarray, shape (N, max count)
+        θ̇_p/n at every crossing, units of the mean motion n: the inertial spin rate, or with
+        ``coordinates="apsidal"`` the spin rate minus the apsidal rate ϖ̇ (the paper's).
+    t : ndarray, shape (N, max count)
+        Time of every crossing, s.
+    r : ndarray, shape (N, max count)
+        Pericentre distance, m.
+    a, e : ndarray, shape (N, max count)
+        Osculating semimajor axis (m) and eccentricity at every crossing.
+    count : ndarray of int, shape (N,)
+        Crossings recorded per member.
+    initial_theta_p, initial_thetadot_p : ndarray, shape (N,)
+        Each member's start, deg and units of n.
+    energy_drift, angmom_drift : ndarray, shape (N,)
+        Relative drift of the total energy and of the total angular-momentum vector from the
+        start to the end of the run.
+    max_drift : float
+        The drift limit they were held against (docs/statuses.md).
+    status : ndarray of int, shape (N,)
+        Status codes (:class:`~ti_spinorbit.Status`), with ``status_names`` ("done",
+        "inaccurate" when a drift exceeds ``max_drift``, "non-finite", "collision", ...) and
+        ``status_counts``.
+    stop_status : ndarray of int, shape (N,)
+        The integrator's own codes before the accuracy verdict: why each member stopped
+        ("done" when it ran to the end), kept for an "inaccurate" member that collided or
+        escaped (None in files written before it existed).
+    accepted, rejected, rhs_calls : ndarray of int, shape (N,)
+        Accepted and rejected steps and right-hand-side calls per member.
+    megno, lyapunov : ndarray, shape (N,)
+        With ``indicators=True``: MEGNO ⟨Y⟩ at the end (→ 2 quasi-periodic, ≫ 2 chaotic) and the
+        finite-time maximal Lyapunov exponent (1/orbit); else NaN.
+    indicator_space : str
+        The shadow direction of the indicators, "planar" or "full" (docs/physics.md §10.4).
+    coordinates : str
+        "inertial" or "apsidal", the spin coordinate of ``thetadot_p`` and
+        ``initial_thetadot_p``.
+    apsidal_rate : ndarray, shape (N, max count) or None
+        With ``coordinates="apsidal"``: ϖ̇/n at every crossing (NaN where e is below the
+        apsidal coordinates' minimum eccentricity).
+    systems : list of BinarySystem
+        Each member's system.
+    initial_states, max_tilt, max_npa_angle : ndarray
+        The members' SI start rows (docs/physics.md §6.8), and the largest tilt of the
+        secondary's pole and non-principal-axis angle reached, deg.
+    truncation_force, truncation_torque : ndarray, shape (N,)
+        The relative size of the mutual potential's next two orders at each member's closest
+        approach, in the force and in the secondary's torque (over |F| ρ_B): "truncated" above
+        the truncation limits, NaN where not estimated (docs/physics.md §3.9).
+    rtol, atol, method, order, degrees, orbits, seconds, perturbations
+        The integration's tolerances, Runge-Kutta pair, truncation order and degree caps, run
+        length (orbital periods), wall time (s) and perturbations.
+
+    Examples
+    --------
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45, 1.70], orbits=10)
+    >>> sos.theta_p.shape                                  # (members, crossings), NaN-padded
+    (2, 10)
+    >>> bool(np.isnan(sos.theta_p[1, -1]))                 # the second member crossed 9 times
+    True
+    >>> sos.status_counts
+    {'done': 2}
+    """
 
     # what a loaded file's arrays must look like (Result.SHAPES; n members, w crossings)
     SHAPES = {
@@ -234,7 +282,7 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
         ``DegreesExpectedWarning``), or an angle Quantity (``np.pi / 2 * u.rad``).
     thetadot_p : float, array or Quantity
         Initial spin rate of the secondary, units of the mean motion n, in [-100, 100]
-        (``_validate.MAX_SPIN``, the bound of the command line's --thetadot); a Quantity
+        (the bound of the command line's --thetadot too); a Quantity
         dimensionless, in ``ti_spinorbit.units.n``, or an angular rate (rad/s), divided by
         the system's n (one system, or systems of one n).
     orbits : float or Quantity
@@ -291,6 +339,33 @@ def surface_of_section(system: SystemLike, theta_p=None, thetadot_p=None, orbits
     Returns
     -------
     SectionResult
+
+    See Also
+    --------
+    time_series : dense samples of the same integrations
+    chaos_map : MEGNO over a grid of starts
+    classify_section : resonant, chaotic or quasi-periodic
+    ti_spinorbit.output.plotting.plot_section : the options of ``.plot()``
+
+    References
+    ----------
+    * Naidu, S. P. & Margot, J.-L. 2015, Near-Earth asteroid satellite spins under
+      spin-orbit coupling, AJ 149:80.
+    * Wisdom, J., Peale, S. J. & Mignard, F. 1984, The chaotic rotation of Hyperion,
+      Icarus 58:137.
+
+    Examples
+    --------
+    Two starts of 1991 VH at pericentre (θ_p = 0°; θ̇_p in units of n), 10 orbits each:
+
+    >>> sos = tso.surface_of_section("1991 VH", theta_p=0.0, thetadot_p=[0.45, 1.70], orbits=10)
+    >>> sos.count                                          # section points per member
+    array([10,  9])
+    >>> sos.status_names
+    ['done', 'done']
+    >>> sos.units()["thetadot_p"]
+    'mean motion n'
+    >>> ax = sos.plot()                                    # the paper's conventions
     """
     theta_p, thetadot_p, orbits = plain_starts(system, theta_p, thetadot_p, orbits)
     integrator = _options.integrator(integrator, rtol, method)
@@ -459,7 +534,7 @@ def _state_property(name, shape, doc):
 class Conservation(_display.Readable):
     """Conservation check of one member of a time series
     (:meth:`ti_spinorbit.TimeSeriesResult.conservation`):
-    prints as a few lines, draws with :meth:`plot`, and unpacks as the ``(numbers, series)``
+    prints as a few lines, draws with :meth:`Conservation.plot`, and unpacks as the ``(numbers, series)``
     pair it replaces (``numbers, (t, de, dl, parts) = ts.conservation(0)``).
 
     ``energy_drift``, ``angmom_drift`` the largest relative drift of the total energy
@@ -521,23 +596,61 @@ class Conservation(_display.Readable):
 class TimeSeriesResult(Result, _display.Readable, kind="time_series"):
     """Densely sampled trajectories (padded with NaN to (N, max samples)).
 
-    ``t`` s; ``alpha`` deg, long axis from the line of centres in (−180, 180]; ``theta`` deg,
-    long axis from the initial pericentre direction (inertial, orbit plane); ``thetadot``
-    spin rate about the orbit normal, units of n; ``r`` m; ``energy`` total, J, and its split
-    ``energy_orbit`` (|P|²/2m + V), ``energy_primary``, ``energy_secondary`` (spins), J;
-    ``angmom_orbit``, ``angmom_primary``, ``angmom_secondary`` inertial angular momenta,
-    (N, samples, 3), kg m² s⁻¹; ``energy_drift``, ``angmom_drift`` the largest relative drift
-    of the total energy and angular-momentum vector over every sample and the end of the run,
-    held against ``max_drift`` for the ``status`` verdict (``ti_spinorbit.engine.accuracy``);
-    ``rtol``, ``orbits`` the run's tolerance and length (orbital periods); ``coordinates``
-    "inertial" (as above) or "apsidal": then ``theta`` is the long axis from the osculating
-    line of apsides (α + f) and ``thetadot`` its rate, spin rate − ϖ̇ (NaN where the osculating
-    e < ``coordinates.APSIDAL_MIN_ECCENTRICITY``); docs/physics.md §6.7; ``stop_status`` the
-    integrator's status codes before the accuracy verdict (why each member stopped);
-    ``order`` the truncation order of the mutual potential, and ``truncation_force`` /
-    ``truncation_torque`` the size of its next orders at each member's closest sampled
-    approach ("truncated" above ``accuracy.TRUNCATION_LIMITS``; NaN where not estimated;
-    docs/physics.md §3.9)."""
+    Attributes
+    ----------
+    t : ndarray, shape (N, max samples)
+        Sample times, s; NaN-padded, as every per-sample array.
+    alpha : ndarray, shape (N, max samples)
+        The secondary's long axis from the line of centres, deg in (−180, 180].
+    theta : ndarray, shape (N, max samples)
+        The long axis from the initial pericentre direction (inertial, orbit plane), deg; with
+        ``coordinates="apsidal"`` from the osculating line of apsides (α + f).
+    thetadot : ndarray, shape (N, max samples)
+        Spin rate about the orbit normal, units of n; apsidal: spin rate − ϖ̇ (NaN where the
+        osculating e is too small), docs/physics.md §6.7.
+    r : ndarray, shape (N, max samples)
+        Separation, m.
+    energy, energy_orbit, energy_primary, energy_secondary : ndarray, shape (N, max samples)
+        The total energy and its split: the orbit (|P|²/2m + V) and the two spins, J.
+    angmom_orbit, angmom_primary, angmom_secondary : ndarray, shape (N, max samples, 3)
+        Inertial angular momenta, kg m² s⁻¹.
+    work, external_angmom : ndarray
+        The work the perturbations did (J) and the angular momentum they brought in
+        (kg m² s⁻¹), per sample.
+    states : ndarray or None
+        With ``states=True``: the SI state rows at every sample (docs/physics.md §6.8).
+    attitude_class, max_tilt, max_npa_angle : ndarray, shape (N,)
+        The secondary's attitude class code (with ``attitude_class_names``), the largest pole
+        tilt and non-principal-axis angle reached, deg.
+    initial_theta_p, initial_thetadot_p : ndarray, shape (N,)
+        Each member's start, deg and units of n.
+    energy_drift, angmom_drift : ndarray, shape (N,)
+        The largest relative drift of the total energy and angular-momentum vector over every
+        sample and the end of the run, held against ``max_drift`` for the ``status`` verdict.
+    status, stop_status : ndarray of int, shape (N,)
+        Status codes (:class:`~ti_spinorbit.Status`, with ``status_names``) and the
+        integrator's codes before the accuracy verdict (why each member stopped).
+    truncation_force, truncation_torque : ndarray, shape (N,)
+        The size of the mutual potential's next orders at each member's closest sampled
+        approach ("truncated" above the truncation limits; NaN where not estimated;
+        docs/physics.md §3.9).
+    coordinates : str
+        "inertial" or "apsidal".
+    systems, initial_states : list, ndarray
+        Each member's system and SI start row.
+    rtol, method, order, degrees, orbits, seconds, max_drift, perturbations
+        The run's tolerance, Runge-Kutta pair, truncation order and degree caps, length
+        (orbital periods), wall time (s), drift limit and perturbations.
+
+    Examples
+    --------
+    >>> ts = tso.time_series("1991 VH", 0.0, [0.45], orbits=2, samples_per_orbit=16)
+    >>> ts.thetadot.shape, ts.status_names
+    ((1, 32), ['done'])
+    >>> check = ts.conservation(0)                         # drifts of one member
+    >>> bool(check.energy_drift < 1e-9)
+    True
+    """
 
     # what a loaded file's arrays must look like (Result.SHAPES; n members, s samples)
     SHAPES = {
@@ -705,7 +818,22 @@ def time_series(system: SystemLike, theta_p=None, thetadot_p=None, orbits=None,
     every sample; the drifts are those of E − W and L − L_ext.
 
     ``theta_p``, ``thetadot_p`` and ``orbits`` are floats (arrays) or Quantities, as for
-    surface_of_section."""
+    surface_of_section.
+
+    See Also
+    --------
+    surface_of_section : the same integrations recorded at pericentre
+    ti_spinorbit.output.plotting.plot_time_series : the options of ``.plot()``
+
+    Examples
+    --------
+    >>> ts = tso.time_series("1991 VH", 0.0, [0.45, 1.70], orbits=2, samples_per_orbit=16)
+    >>> ts.t.shape                                         # (members, samples), s
+    (2, 32)
+    >>> ts.units()["thetadot"], ts.units()["alpha"]
+    ('mean motion n', 'deg')
+    >>> ax = ts.plot()                                     # θ̇/n against time in orbits
+    """
     theta_p, thetadot_p, orbits = plain_starts(system, theta_p, thetadot_p, orbits)
     integrator = _options.integrator(integrator, rtol, method)
     run = _options.run(run)
