@@ -12,6 +12,14 @@ polyhedron is built once per process (it does not depend on the secondary's opti
 
 Names are matched ignoring case and everything but letters and digits: "Didymos (radar
 shape)", "didymos_radar_shape" and "DidymosRadarShape" are the same entry.
+
+Examples
+--------
+>>> tso.catalog.names()[:4]
+['test', '1991 VH', '2003 YT1', '2004 DC']
+>>> vh = tso.catalog.system("1991 VH")
+>>> round(vh.omega0, 3)
+1.074
 """
 
 import json
@@ -65,8 +73,7 @@ def _resolve(name):
 
 def system(name, elongation=None, secondary_density=None, eccentricity=None) -> BinarySystem:
     """A catalogued system as a BinarySystem, optionally with the elongation a/b (in [1, 10],
-    and small enough that b >= c), secondary density ρ_s (kg m^-3, in [1, 1e5]: ``MIN_DENSITY``,
-    ``MAX_DENSITY`` of ``ti_spinorbit._validate``) or eccentricity (0 <= e < 1, and small
+    and small enough that b >= c), secondary density ρ_s (kg m^-3, in [1, 1e5]) or eccentricity (0 <= e < 1, and small
     enough that the bodies clear each other at pericentre) changed.
 
     The energy-test case ("test") has fixed shapes; only its eccentricity may change."""
