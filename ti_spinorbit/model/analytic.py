@@ -29,6 +29,13 @@ quadrature); frequencies and spin rates are in units of n, angles in radians, en
   SI units.
 
 Reference paper: Naidu & Margot 2015, AJ 149:80.
+
+Examples
+--------
+>>> round(tso.analytic.omega0(1.5), 3)                 # a/b = 1.5
+1.074
+>>> round(tso.analytic.omega0_overlap(0.05), 4)        # ω0^RO = 1/(2 + √(14 e))
+0.3525
 """
 
 import math
