@@ -531,6 +531,18 @@ def classify_section(result, megno=None, island_shift=True, include_inaccurate=F
     Returns
     -------
     SectionClassification
+
+    See Also
+    --------
+    surface_of_section : the sections it classifies
+    chaos_map : chaos by MEGNO alone, over a grid
+
+    Examples
+    --------
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45, 1.70], orbits=10, indicators=True)
+    >>> labels = tso.classify_section(sos).classification
+    >>> len(labels)
+    2
     """
     failed = ~usable(result.status, include_inaccurate)
     systems = result.systems if island_shift else None
