@@ -143,6 +143,12 @@ def libration_amplitude(system: SystemLike, thetadot_p, orbits, samples_per_orbi
         Amplitude in degrees, one per member (a float for a single member); NaN where α
         circulates, the integration stopped early (collision, escape, ...) or the member
         failed the accuracy check (unless ``include_inaccurate``).
+
+    Examples
+    --------
+    >>> amplitude = tso.libration_amplitude("1991 VH", [0.45], orbits=5)
+    >>> amplitude.shape                                    # deg, one per start
+    (1,)
     """
     _, thetadot_p, orbits = plain_starts(system, None, thetadot_p, orbits)
     integrator = _options.integrator(integrator, rtol, method)
@@ -167,18 +173,37 @@ def _psi_A_deg(omega0, e):
 class RelaxedLibration(Result, _display.Readable, kind="relaxed_libration"):
     """Centre of the synchronous island and the relaxed-mode libration amplitude.
 
-    ``centre_thetadot_p`` initial θ̇_p/n (θ_p(0) = 0) of the island centre; ``amplitude`` deg,
-    max |α| of that trajectory; ``extent`` deg, its section's horizontal half extent (the
-    excited mode left over); ``psi_A`` and ``psi_A_effective`` deg, the decoupled estimates
-    2e/(ω0² − 1) with ω0 and with ω0,eff² = ω0² m1/(m1+m2); ``iterations`` zoom launches;
-    ``candidates`` and ``extents`` the θ̇_p/n tried and their extents (deg), one array per
-    launch, the coarse bracket first (extent NaN where the start does not librate);
-    ``converged`` whether the final window is narrower than ``xtol`` and the extent at the
-    centre is below ``max_extent`` and the final trajectory passed the accuracy check;
-    ``status`` that trajectory's status ("done", "inaccurate", ...), ``energy_drift`` and
-    ``angmom_drift`` its relative drifts and ``max_drift`` their limit
-    (``ti_spinorbit.engine.accuracy``); ``seconds`` wall time; ``coordinates`` the spin coordinate of
-    ``centre_thetadot_p`` and ``candidates`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
+    Attributes
+    ----------
+    centre_thetadot_p : float
+        Initial θ̇_p/n (θ_p(0) = 0) of the island centre.
+    amplitude : float
+        Max |α| of that trajectory, deg: the relaxed-mode libration amplitude.
+    extent : float
+        Its section's horizontal half extent, deg (the excited mode left over).
+    psi_A, psi_A_effective : float
+        The decoupled estimates 2e/(ω0² − 1), deg, with ω0 and with ω0,eff² = ω0² m1/(m1+m2)
+        (``omega0``, ``omega0_effective``).
+    converged : bool
+        Whether the final window is narrower than ``xtol``, the extent at the centre is below
+        ``max_extent``, the final trajectory passed the accuracy check and the checks at
+        longer runs and at rtol/10 agree (``search_converged``, ``converged_in_orbits``,
+        ``converged_in_tolerance``, ``convergence_checked``; ``message`` says which).
+    iterations, candidates, extents
+        Zoom launches, and the θ̇_p/n tried with their extents (deg), one array per launch, the
+        coarse bracket first (extent NaN where the start does not librate).
+    lengths, centres_by_length, amplitudes_by_length
+        The evidence against run length; ``rtol_check``, ``centre_rtol_check`` and
+        ``amplitude_rtol_check`` at rtol/10, held to ``centre_tol`` and ``amplitude_tol``.
+    status, energy_drift, angmom_drift, max_drift
+        The final trajectory's status, its relative drifts and their limit.
+    coordinates : str
+        The spin coordinate of ``centre_thetadot_p`` and ``candidates`` ("inertial" or
+        "apsidal", docs/physics.md §6.7).
+    system, orbits, rtol, method, samples_per_orbit, xtol, seconds, series, perturbations
+        The system, run length (orbital periods), tolerance, Runge-Kutta pair, sampling, the
+        search's tolerance, wall time (s), the centre's time series and the perturbations.
+    """
 
     # what a loaded file's arrays must look like (Result.SHAPES; k lengths)
     SHAPES = {k: (("k",), _F) for k in ("lengths", "centres_by_length", "amplitudes_by_length")}
@@ -316,7 +341,7 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
         one per launch: :class:`ti_spinorbit.engine.checkpoint.Launches`).
     candidates : array or Quantity, optional
         Coarse bracket of initial θ̇_p/n (θ_p = 0), at least 5 values, ascending, each in
-        [-100, 100] (``_validate.MAX_SPIN``); default 45 values over 0.2-1.3.
+        [-100, 100]; default 45 values over 0.2-1.3.
     zoom_candidates : int
         Candidates per zoom launch (odd, so the window's centre is one of them).
     xtol : float
@@ -379,6 +404,26 @@ def relaxed_libration(system: BinarySystem, orbits=100, *, rtol=None, method=Non
         Bad input.
     RuntimeError
         No coarse candidate librates, or the trajectory at the centre found does not.
+
+    See Also
+    --------
+    libration_amplitude : the amplitude of given starts
+    ti_spinorbit.analytic.psi_A : the forced amplitude of the decoupled problem
+
+    References
+    ----------
+    * Naidu, S. P. & Margot, J.-L. 2015, AJ 149:80, §7 and Fig. 3.
+
+    Examples
+    --------
+    The centre of Didymos' synchronous island and the libration there (a short, unchecked
+    search: ``converge=False``):
+
+    >>> lib = tso.relaxed_libration("Didymos", orbits=5, converge=False)
+    >>> round(float(lib.amplitude), 1)                     # deg
+    15.8
+    >>> lib.status_names
+    ['done']
     """
     system = catalog.as_system(system)
     candidates, orbits, max_orbits = (to_plain(name, value, unit, system=system) for name, value, unit
