@@ -106,13 +106,31 @@ class OverlapDecision(_display.ReadableLine):
 class OverlapScan(Result, _display.Readable, kind="overlap_scan"):
     """Result of :func:`overlap_threshold`.
 
-    ``first_overlap``: first elongation a/b where the 1:1 and 3:2 resonances overlap (None if
-    none in the scan); ``elongation_ro``: the analytic a/b at ω0^RO(e); ``omega0_ro``: ω0^RO;
-    ``elongations``, ``overlaps``: the scan; ``decisions``: per-elongation evidence;
-    ``max_drift`` the accuracy limit every trajectory was held against and ``n_inaccurate``
-    the trajectories above it (``ti_spinorbit.engine.accuracy``), left out of the decisions unless
-    ``include_inaccurate``; ``coordinates`` the spin coordinate of the starts, centres and
-    ranges ("inertial" or "apsidal", docs/physics.md §6.7)."""
+    Attributes
+    ----------
+    first_overlap : float or None
+        The first elongation a/b where the 1:1 and 3:2 resonances overlap (None if none in the
+        scan).
+    elongation_ro, omega0_ro : float
+        The analytic a/b at ω0^RO(e) and ω0^RO = 1/(2 + √(14e)) itself.
+    elongations, overlaps : ndarray
+        The scan and its verdict per elongation.
+    decisions : list of OverlapDecision
+        The evidence per elongation.
+    converged, converged_orbits, message : bool, float, str
+        Whether the decisions stopped changing as the run length doubled, at which length, and
+        the verdict in words; ``lengths``, ``overlaps_by_length``,
+        ``megno_overlaps_by_length`` and ``megno_first_overlap`` the evidence against length.
+    max_drift, n_inaccurate : float, int
+        The accuracy limit every trajectory was held against and the trajectories above it,
+        left out of the decisions unless ``include_inaccurate``.
+    coordinates : str
+        The spin coordinate of the starts, centres and ranges ("inertial" or "apsidal",
+        docs/physics.md §6.7).
+    name, eccentricity, orbits, max_orbits, member_orbits, rtol, method, seconds, sections, perturbations
+        The system, its e, the run lengths (orbital periods), tolerance, Runge-Kutta pair,
+        wall time (s), the sections of the last length, and the perturbations.
+    """
 
     # what a loaded file's arrays must look like (Result.SHAPES; m elongations, k lengths)
     SHAPES = {
@@ -281,6 +299,28 @@ def overlap_threshold(system: Union[str, SystemFactory], elongations=None,
     Each decision also carries the MEGNO criterion (:func:`megno_connects`,
     ``OverlapDecision.megno_overlap``; ``megno_first_overlap`` its threshold): a chaotic
     layer spanning both islands shows in ⟨Y⟩ before a single trajectory has crossed it.
+
+    See Also
+    --------
+    ti_spinorbit.analytic.omega0_overlap : the analytic threshold ω0^RO = 1/(2 + √(14e))
+
+    References
+    ----------
+    * Naidu, S. P. & Margot, J.-L. 2015, AJ 149:80, §6.
+    * Chirikov, B. V. 1979, A universal instability of many-dimensional oscillator
+      systems, Physics Reports 52:263.
+
+    Examples
+    --------
+    Two elongations of 1991 VH, a few starts and 20 orbits each (the paper's scan takes 1000 to
+    4000 orbits):
+
+    >>> scan = tso.overlap_threshold("1991 VH", elongations=[1.02, 1.06], orbits=20,
+    ...                              max_orbits=20, centre_starts=4, separatrix_starts=4)
+    >>> scan.elongations
+    array([1.02, 1.06])
+    >>> round(scan.elongation_ro, 3)                       # the analytic threshold
+    1.042
     """
     # every scalar before any system is built or integrated
     check_coordinates(coordinates)
