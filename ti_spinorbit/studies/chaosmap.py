@@ -120,14 +120,43 @@ class ChaosMap(Result, _display.Readable, kind="chaos_map"):
     """Chaos indicators over a θ_p × θ̇_p/n grid of starts (2-D arrays of shape
     (len(theta_p), len(thetadot_p)), i.e. ``[i, j]`` is the start (theta_p[i], thetadot_p[j])).
 
-    ``theta_p`` initial θ_p, deg; ``thetadot_p`` initial θ̇_p/n; ``megno`` MEGNO ⟨Y⟩;
-    ``lyapunov`` finite-time maximal Lyapunov exponent, 1/orbit; ``classification`` labels
-    ("resonant", "quasi-periodic", "chaotic", "undetermined"); ``mean_thetadot`` mean θ̇_p/n over
-    the section points; ``status`` integrator status codes (``SectionResult.status_names``); ``chaotic_fraction``
-    share of finished members labelled chaotic; ``section`` the underlying SectionResult (flat
-    members in the same C order); ``seconds`` wall time of the launch; ``coordinates`` the
-    spin coordinate of ``thetadot_p`` and ``mean_thetadot`` ("inertial" or "apsidal",
-    docs/physics.md §6.7)."""
+    Attributes
+    ----------
+    theta_p, thetadot_p : ndarray
+        The grid's axes: initial θ_p (deg) and θ̇_p/n.
+    megno : ndarray
+        MEGNO ⟨Y⟩ per start (→ 2 regular, ≫ 2 chaotic).
+    lyapunov : ndarray
+        Finite-time maximal Lyapunov exponent, 1/orbit.
+    classification : ndarray of str
+        "resonant", "quasi-periodic", "chaotic" or "undetermined".
+    mean_thetadot : ndarray
+        Mean θ̇_p/n over the section points.
+    chaotic_fraction : float
+        Share of the finished starts labelled chaotic (``megno > megno_chaotic``), NaN when
+        none can be counted.
+    megno_chaotic : float
+        The MEGNO threshold of "chaotic".
+    fraction_lengths, fraction_by_length : ndarray
+        The chaotic fraction at orbits/4, orbits/2 and orbits, with ``fraction_monotone`` and
+        ``fraction_message`` saying whether it has settled.
+    status : ndarray of int
+        Status codes (:class:`~ti_spinorbit.Status`).
+    energy_drift, angmom_drift : ndarray
+        Relative drifts per start; ``max_drift`` their limit, ``n_inaccurate`` the starts above
+        it (left out of ``chaotic_fraction`` unless ``include_inaccurate``).
+    section : SectionResult
+        The underlying section, members in the same C order.
+    coordinates : str
+        The spin coordinate of ``thetadot_p`` and ``mean_thetadot`` ("inertial" or "apsidal",
+        docs/physics.md §6.7).
+    indicator_space, tilt, max_tilt, attitude_class
+        The indicators' shadow direction, the starts' tilt (deg) and, for tilted starts, the
+        largest pole tilt and attitude class per start.
+    orbits, rtol, method, seconds, perturbations
+        Run length (orbital periods), tolerance, Runge-Kutta pair, wall time (s) and
+        perturbations.
+    """
 
     # what a loaded file's arrays must look like (Result.SHAPES; k lengths)
     SHAPES = {
@@ -220,7 +249,7 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
         Initial θ_p values, deg (x axis of the map); an angle Quantity is converted, a plain
         axis that looks like radians gets the degree hint (:mod:`ti_spinorbit.units`).
     thetadot_p : 1-D array or Quantity
-        Initial θ̇_p/n values, units of n (y axis), in [-100, 100] (``_validate.MAX_SPIN``);
+        Initial θ̇_p/n values, units of n (y axis), in [-100, 100];
         a Quantity dimensionless, in ``ti_spinorbit.units.n``, or an angular rate (rad/s).
     orbits : float or Quantity
         Integration time in orbital periods, > 0 (a Quantity in ``units.orbit``, or a
@@ -269,6 +298,28 @@ def chaos_map(system: BinarySystem, theta_p, thetadot_p, orbits, *, rtol=None, m
     Returns
     -------
     ChaosMap
+
+    See Also
+    --------
+    parameter_map : the chaotic fraction over (a/b, e)
+    ti_spinorbit.output.plotting.plot_chaos_map : the options of ``.plot()``
+
+    References
+    ----------
+    * Cincotta, P. M. & Simó, C. 2000, Simple tools to study global dynamics in
+      non-axisymmetric galactic potentials, A&AS 147:205 (MEGNO).
+
+    Examples
+    --------
+    A 3 × 3 grid of starts of 1991 VH, 10 orbits each (the gallery's map is 64 × 64 × 500):
+
+    >>> cmap = tso.chaos_map("1991 VH", np.linspace(0, 180, 3), np.linspace(0.4, 2.6, 3),
+    ...                      orbits=10)
+    >>> cmap.megno.shape                                   # (theta_p, thetadot_p)
+    (3, 3)
+    >>> 0.0 <= cmap.chaotic_fraction <= 1.0
+    True
+    >>> ax = cmap.plot()
     """
     check_coordinates(coordinates)
     system = catalog.as_system(system)
@@ -399,15 +450,32 @@ def _inaccurate_code():
 class ParameterMap(Result, _display.Readable, kind="parameter_map"):
     """Chaotic fraction over elongation a/b × eccentricity e.
 
-    ``elongations`` (a/b), ``eccentricities`` the axes; ``chaotic_fraction`` shape
-    (len(elongations), len(eccentricities)); ``megno``, ``classification``, ``status`` per start,
-    shape (len(elongations), len(eccentricities), starts); ``theta_p`` (deg) and
-    ``thetadot_p`` (units of n) the starts used at every grid point; ``omega0`` ω0(a/b) of the
-    ellipsoid; ``seconds`` wall time of the one launch; ``energy_drift``, ``angmom_drift``
-    per start and ``max_drift`` the accuracy limit (``ti_spinorbit.engine.accuracy``);
-    ``inaccurate`` the count of "inaccurate" starts per (a/b, e), excluded from
-    ``chaotic_fraction`` unless ``include_inaccurate``; ``coordinates`` the spin coordinate
-    of ``thetadot_p`` ("inertial" or "apsidal", docs/physics.md §6.7)."""
+    Attributes
+    ----------
+    elongations, eccentricities : ndarray
+        The axes: a/b and e.
+    chaotic_fraction : ndarray, shape (len(elongations), len(eccentricities))
+        The share of chaotic starts at each grid point.
+    megno, classification, status : ndarray, shape (len(elongations), len(eccentricities), starts)
+        Per start.
+    theta_p, thetadot_p : ndarray
+        The starts used at every grid point, deg and units of n.
+    omega0 : ndarray
+        ω0(a/b) of the ellipsoid, units of n.
+    energy_drift, angmom_drift : ndarray
+        Relative drifts per start; ``max_drift`` their limit.
+    inaccurate : ndarray of int
+        The "inaccurate" starts per (a/b, e), left out of ``chaotic_fraction`` unless
+        ``include_inaccurate``.
+    fraction_lengths, fraction_by_length
+        The chaotic fraction at shorter run lengths, with ``fraction_monotone`` and
+        ``fraction_message``.
+    coordinates : str
+        The spin coordinate of ``thetadot_p`` ("inertial" or "apsidal", docs/physics.md §6.7).
+    name, orbits, rtol, method, seconds, indicator_space, perturbations
+        The system family's name, run length (orbital periods), tolerance, Runge-Kutta pair,
+        wall time of the one launch (s), indicators' shadow direction and perturbations.
+    """
 
     # what a loaded file's arrays must look like (Result.SHAPES; k lengths)
     SHAPES = {
@@ -506,6 +574,17 @@ def parameter_map(system: Union[str, Callable[[float, float], BinarySystem]],
     Returns
     -------
     ParameterMap
+
+    See Also
+    --------
+    chaos_map : one system, a grid of starts
+
+    Examples
+    --------
+    >>> pmap = tso.parameter_map("1991 VH", [1.3, 1.5], [0.05], orbits=10,
+    ...                          thetadot_p=[1.0, 1.5])
+    >>> pmap.chaotic_fraction.shape                        # (elongations, eccentricities)
+    (2, 1)
     """
     check_coordinates(coordinates)
     theta_p, thetadot_p, orbits = plain_starts(None, theta_p, thetadot_p, orbits)
