@@ -73,8 +73,9 @@ def _resolve(name):
 
 def system(name, elongation=None, secondary_density=None, eccentricity=None) -> BinarySystem:
     """A catalogued system as a BinarySystem, optionally with the elongation a/b (in [1, 10],
-    and small enough that b >= c), secondary density ρ_s (kg m^-3, in [1, 1e5]) or eccentricity (0 <= e < 1, and small
-    enough that the bodies clear each other at pericentre) changed.
+    and small enough that b >= c), secondary density ρ_s (kg m^-3, in [1, 1e5]) or
+    eccentricity (0 <= e < 1, and small enough that the bodies clear each other at
+    pericentre) changed.
 
     The energy-test case ("test") has fixed shapes; only its eccentricity may change."""
     key = _resolve(name)
