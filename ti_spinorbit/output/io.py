@@ -311,6 +311,18 @@ def save(result, path, extra=None, include_sections=True, overwrite=False):
     ``created_utc``, ``rtol``/``atol``/``order``/``orbits`` where the result has them,
     ``fields`` (every scalar field), ``units`` (every array and scalar), ``systems``,
     ``status_codes`` and ``status_counts``; see the module docstring for the layout.
+
+    See Also
+    --------
+    load, read_metadata, to_xarray
+
+    Examples
+    --------
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5)
+    >>> path = tso.save(sos, "vh_sos.npz")
+    >>> with np.load("vh_sos.npz") as f:                   # NumPy alone reads it
+    ...     f["theta_p"].shape
+    (1, 5)
     """
     kind = kind_of(result)
     _check_save_args(path, extra)
@@ -415,7 +427,15 @@ def _open(path):
 
 
 def read_metadata(path):
-    """The JSON metadata of a saved result, as a dict (ArchiveError for a malformed file)."""
+    """The JSON metadata of a saved result, as a dict (ArchiveError for a malformed file).
+
+    Examples
+    --------
+    >>> _ = tso.save(tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5), "vh_meta.npz")
+    >>> meta = tso.read_metadata("vh_meta.npz")
+    >>> meta["kind"], meta["units"]["theta_p"]
+    ('section', 'deg')
+    """
     zf, _, meta = _open(path)
     zf.close()
     return meta
@@ -439,6 +459,14 @@ def load(path):
         damaged, malformed or edited file of any sort (every one-bit flip included; arrays
         whose shapes, dtypes or status / attitude codes are not what the package writes);
         one line naming the file and the fault.
+
+    Examples
+    --------
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5)
+    >>> _ = tso.save(sos, "vh_load.npz")
+    >>> again = tso.load("vh_load.npz")
+    >>> type(again).__name__, bool(np.array_equal(again.theta_p, sos.theta_p))
+    ('SectionResult', True)
     """
     p = os.fspath(path)
     zf, entries, meta = _open(p)
