@@ -20,7 +20,17 @@ class ArchiveError(ValueError):
     archive: not an ``.npz``, damaged (truncated, flipped bytes, renamed or missing entries,
     bad ``.npy`` headers), malformed metadata (wrong types, absurd nesting), an unknown kind
     or an unreadable ``format_version``. The message is one line naming the file and what is
-    wrong. A subclass of ValueError, so ``except ValueError`` still catches it."""
+    wrong. A subclass of ValueError, so ``except ValueError`` still catches it.
+
+    Examples
+    --------
+    >>> _ = open("not_a_result.npz", "wb").write(b"junk")
+    >>> try:
+    ...     tso.load("not_a_result.npz")
+    ... except tso.ArchiveError as error:
+    ...     print("refused")
+    refused
+    """
 
 
 #: Largest ratio of uncompressed to compressed size that deflate can reach (≈ 1032:1), with
