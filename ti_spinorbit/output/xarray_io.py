@@ -310,6 +310,12 @@ def to_xarray(result_or_path):
     ------
     ImportError
         xarray is not installed (``pip install "ti-spinorbit[xarray]"``).
+
+    Examples
+    --------
+    >>> ds = tso.to_xarray(tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5))
+    >>> ds["theta_p"].attrs["units"]
+    'deg'
     """
     xr = _xarray()
     metadata = None
