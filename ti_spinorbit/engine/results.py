@@ -40,7 +40,19 @@ class Status(enum.IntEnum):
     integrator cannot carry never stalls the ensemble (a code after ``INACCURATE`` because
     archives already hold codes 0-6). ``TRUNCATED``: a member that ran to the end within the
     drift limit, whose mutual potential's truncation error at its closest approach exceeds
-    the truncation limit (:mod:`ti_spinorbit.engine.accuracy`)."""
+    the truncation limit (:mod:`ti_spinorbit.engine.accuracy`).
+
+    See Also
+    --------
+    Result : every result's ``status``, ``status_names`` and ``status_counts``
+
+    Examples
+    --------
+    >>> tso.Status.DONE.label, int(tso.Status.DONE)
+    ('done', 1)
+    >>> tso.Status.from_label("non-finite")
+    <Status.NONFINITE: 5>
+    """
 
     RUNNING = layout.RUNNING
     DONE = layout.DONE
@@ -147,7 +159,20 @@ class Result:
     array that has them (``n`` members, ``w`` crossings, ``s`` samples, ``k`` lengths, ...) or
     fixed sizes; dtype kinds are :data:`FLOAT`, :data:`INTEGER`, :data:`BOOL`, :data:`TEXT`.
     A field not listed is not checked; a listed one that does not fit makes
-    :func:`ti_spinorbit.output.io.load` refuse the file, naming the field."""
+    :func:`ti_spinorbit.output.io.load` refuse the file, naming the field.
+
+    See Also
+    --------
+    save, load, to_xarray, Status
+
+    Examples
+    --------
+    >>> sos = tso.surface_of_section("1991 VH", 0.0, [0.45], orbits=5)
+    >>> isinstance(sos, tso.Result)
+    True
+    >>> sos.units()["t"], sos.orbits
+    ('s', 5.0)
+    """
 
     #: the archive kind (:data:`KINDS`); "" for the protocol itself
     kind = ""
