@@ -64,6 +64,12 @@ def warmup(models=MODELS, indicators=(False, True), sampling=(False, True), meth
         One per variant: ``variant``, ``how`` ("compiled", "loaded" from the disk cache, or
         "ready" already in this process), ``kernel_seconds`` (the compile or load of the
         kernels this variant uses first: integrator, and diagnostics when not used before) and ``seconds`` (the whole first run).
+
+    Examples
+    --------
+    Compile (or load from the cache) the planar kernel without indicators or sampling:
+
+    >>> _ = tso.warmup(models=("planar",), indicators=(False,), sampling=(False,), verbose=False)
     """
 
     models = _choices("models", models, MODELS)
