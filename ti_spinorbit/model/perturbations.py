@@ -280,6 +280,28 @@ class Tides:
         The body's radius, m; default its volume-equivalent radius.
     strength : float
         Factor on the force and torque (default 1): 1e5 makes 1e5 years of tides act in one.
+
+    See Also
+    --------
+    YORP, BYORP, SolarTide
+    ti_spinorbit.analytic.tidal_despin_rate : the decoupled despin rate
+
+    References
+    ----------
+    * Mignard, F. 1979, The evolution of the lunar orbit revisited. I, Moon and Planets
+      20:301.
+    * Hut, P. 1981, Tidal evolution in close binary systems, A&A 99:126.
+
+    Examples
+    --------
+    A tide on the secondary, 600 s time lag, made a million times stronger so that it acts in
+    a few orbits:
+
+    >>> tide = tso.Tides(body="secondary", k2=1e-5, time_lag=600.0, strength=1e6)
+    >>> ts = tso.time_series("1991 VH", 0.0, [1.70], orbits=2, samples_per_orbit=16,
+    ...                      perturbations=[tide])
+    >>> ts.work.shape                                      # J done by the tide, per sample
+    (1, 32)
     """
 
     body: str = "secondary"
@@ -378,6 +400,16 @@ class YORP:
         heliocentric orbit, T (a⊙² sqrt(1 − e⊙²)) / d(t)², whose orbit average is T;
         ``"mean"``: T at all times (the paper's form). A saved YORP without it is read back
         as ``"mean"``, the torque it was run with.
+
+    See Also
+    --------
+    Tides, BYORP
+
+    Examples
+    --------
+    >>> yorp = tso.YORP(coefficient=5e-4)                  # f_Y, on the secondary
+    >>> yorp.body, yorp.convention
+    ('secondary', 'paper')
     """
 
     body: str = "secondary"
@@ -448,6 +480,16 @@ class BYORP:
     distance : {"orbit", "mean"}
         As for :class:`YORP`: the force at the Sun's distance of the moment (default), or
         its mean-distance value at all times.
+
+    See Also
+    --------
+    Tides, YORP
+
+    Examples
+    --------
+    >>> byorp = tso.BYORP(coefficient=1e-3)
+    >>> byorp.strength
+    1.0
     """
 
     coefficient: float = 1e-3
@@ -518,6 +560,19 @@ class SolarTide:
     strength : float
         Factor on the Sun's mass in the force and torques (default 1); the Sun's motion
         keeps the real mass.
+
+    See Also
+    --------
+    HeliocentricOrbit : the orbit it takes by default
+    Flyby : a planet passing by
+
+    Examples
+    --------
+    The Sun's tide on 1991 VH, on the system's own heliocentric orbit:
+
+    >>> sun = tso.SolarTide()
+    >>> sun.inclination_deg is None                        # from the system's orbit
+    True
     """
 
     heliocentric_a_au: Optional[float] = None
@@ -690,6 +745,18 @@ class Flyby:
     strength : float
         Factor on the planet's mass in the force and torques (default 1); its motion keeps
         the real mass.
+
+    See Also
+    --------
+    SolarTide
+
+    Examples
+    --------
+    Earth passing at 200 000 km and 4 km/s:
+
+    >>> earth = tso.Flyby("Earth", v_inf_km_s=4.0, q_km=2e5)
+    >>> earth.planet, earth.q_km
+    ('Earth', 200000.0)
     """
 
     planet: Optional[str] = None
@@ -908,8 +975,8 @@ def _check_strength(k, p, system):
 def perturbation_rows(systems, perturbations):
     """(N, NPERT) scaled blocks of the members' ``systems`` (one per member), or None
     without perturbations. A perturbation too strong to be one for a member's system
-    (:func:`change_per_orbit` against :data:`SPIN_CHANGE_LIMIT`, :data:`ORBIT_CHANGE_LIMIT`,
-    :data:`TIDE_FORCE_LIMIT`) is refused here, before any work (ValueError naming it and the
+    (:func:`change_per_orbit` against :data:`SPIN_CHANGE_LIMIT`, ``ORBIT_CHANGE_LIMIT``,
+    ``TIDE_FORCE_LIMIT``) is refused here, before any work (ValueError naming it and the
     largest strength allowed)."""
     items = check_perturbations(perturbations)
     if not items:
