@@ -136,6 +136,12 @@ class HeliocentricOrbit:
     binary_periapsis_deg : float
         ``frame="ecliptic"`` only: the angle in the mutual orbit plane from its ascending
         node on the ecliptic to the initial line of centres, degrees (default 0).
+
+    Examples
+    --------
+    >>> orbit = tso.HeliocentricOrbit(1.0, 0.1)            # a in AU, e
+    >>> orbit.frame
+    'binary'
     """
 
     a_au: float
