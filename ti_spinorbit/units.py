@@ -69,7 +69,20 @@ class ImplausibleInputWarning(UserWarning):
     """An input that is allowed but probably not meant: bodies or an orbit far smaller than
     any asteroid (kilometres typed as metres?), an angle in degrees that looks like radians
     (:class:`DegreesExpectedWarning`), or a surface of section at e ≈ 0 where the
-    pericentre is ill-defined."""
+    pericentre is ill-defined.
+
+    Examples
+    --------
+    Bodies and an orbit given in kilometres where metres are expected run, with a warning:
+
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     tiny = tso.BinarySystem(tso.Sphere(0.6, density=1581),
+    ...                             tso.Ellipsoid(0.294, 0.196, 0.19, density=2618), a=3.3, e=0.05)
+    >>> any(issubclass(w.category, tso.ImplausibleInputWarning) for w in caught)
+    True
+    """
 
 
 class DegreesExpectedWarning(ImplausibleInputWarning):
