@@ -24,7 +24,7 @@ from conftest import lumpy_body, run_options
 
 pytest.importorskip("distributed")
 
-# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+# the slow part of the suite: deselect with -m "not slow" (README, its first lines)
 pytestmark = pytest.mark.slow
 
 THETA_P = np.array([0.0, 45.0, 90.0])

@@ -22,7 +22,7 @@ TOOLS = ["sphinx", "numpydoc", "pydata_sphinx_theme", "sphinx_gallery", "myst_pa
 MISSING = [name for name in TOOLS if importlib.util.find_spec(name) is None]
 GENERATED = ("_build", "auto_examples", "generated", "sg_execution_times.rst")
 
-# the slow part of the suite (deselect with -m "not slow", README "Tests"); skipped without
+# the slow part of the suite (deselect with -m "not slow", README, its first lines); skipped without
 # the documentation tools
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(
     bool(MISSING), reason=f"documentation tools not installed ({', '.join(MISSING)}): "

@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import pytest
 
-# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+# the slow part of the suite: deselect with -m "not slow" (README, its first lines)
 pytestmark = pytest.mark.slow
 
 EXPERIMENTS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "experiments")

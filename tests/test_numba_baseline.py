@@ -23,7 +23,7 @@ import bench_throughput as bt  # noqa: E402
 
 sys.path.remove(EXPERIMENTS)
 
-# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+# the slow part of the suite: deselect with -m "not slow" (README, its first lines)
 pytestmark = pytest.mark.slow
 
 

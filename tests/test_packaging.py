@@ -11,7 +11,7 @@ import pytest
 
 import ti_spinorbit as tso
 
-# the slow part of the suite: deselect with -m "not slow" (README, "Tests")
+# the slow part of the suite: deselect with -m "not slow" (README, its first lines)
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]

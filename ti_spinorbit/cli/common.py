@@ -25,7 +25,7 @@ from ..output.io import read_metadata, save
 from ..system import catalog
 from ..system.systems import read_system_file
 
-#: Exit statuses (README "Statuses, exit codes and accuracy").
+#: Exit statuses (docs/statuses.md, "Statuses, exit codes and accuracy").
 EXIT_OK, EXIT_CHECK_FAILED, EXIT_ERROR, EXIT_INACCURATE, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 #: Figures and data files.
 FIGURE_EXTENSIONS = (".png", ".pdf", ".svg")
