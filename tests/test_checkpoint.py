@@ -124,7 +124,7 @@ def test_mismatched_and_damaged_checkpoints_are_refused(tmp_path):
 
 
 # ---- a finished run's checkpoint is removed (Run(keep_checkpoint=True) keeps it) -----------
-class _Interrupt:
+class Interrupt:
     """A progress callback that raises KeyboardInterrupt at its ``at``-th call (after that
     window's checkpoint is written)."""
 
@@ -187,7 +187,7 @@ def test_an_interrupted_run_keeps_its_checkpoint_and_the_resume_removes_it(tmp_p
     ckpt = tmp_path / "stopped.ckpt"
     with pytest.raises(KeyboardInterrupt):
         tso.surface_of_section(vh, 0.0, STARTS, **run_options(
-            **{**ARGS, "progress": _Interrupt(3)}, checkpoint=ckpt))
+            **{**ARGS, "progress": Interrupt(3)}, checkpoint=ckpt))
     assert checkpoint.holds_checkpoint(ckpt)   # kept for the resume
     assert len(list(ckpt.glob("records-*.npz"))) == 3
     resumed = tso.surface_of_section(vh, 0.0, STARTS, **run_options(**ARGS, checkpoint=ckpt,

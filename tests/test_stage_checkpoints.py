@@ -25,21 +25,10 @@ import ti_spinorbit as tso
 from ti_spinorbit.engine import checkpoint as C
 
 from conftest import run_cli, run_options
+from test_checkpoint import Interrupt
 
 THETA, RATES = [0.0, 90.0], [0.8, 1.2, 1.6]
 MAP = dict(orbits=8, rtol=1e-8)
-
-
-class Interrupt:
-    """A progress callback that raises KeyboardInterrupt at its ``at``-th call."""
-
-    def __init__(self, at):
-        self.at, self.calls = at, 0
-
-    def __call__(self, fraction):
-        self.calls += 1
-        if self.calls == self.at:
-            raise KeyboardInterrupt
 
 
 @pytest.fixture
