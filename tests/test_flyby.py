@@ -17,7 +17,7 @@ from ti_spinorbit.model import perturbations as PT
 from ti_spinorbit.system.bodies import Ellipsoid, Sphere
 from ti_spinorbit.system.systems import G
 
-from test_solar_tide import _kernel_rhs, assert_third_body_terms
+from test_solar_tide import _kernel_rhs, assert_resumed_equals_whole, assert_third_body_terms
 
 GM_EARTH, R_EARTH_KM = PLANETS["Earth"]
 
@@ -269,21 +269,8 @@ def test_resumed_run_with_a_flyby_equals_an_uninterrupted_one(tmp_path):
     """A flyby during a run killed after two windows and resumed from its checkpoint equals
     the uninterrupted run bit for bit (the clock, hence the planet, restored: its closest
     approach, at 300 h = 9.2 orbits, comes after the resume at 8)."""
-    from test_checkpoint import killed_run
-    from test_perturbation_plumbing import assert_same
-
-    vh = tso.catalog.system("1991 VH")
-    ckpt = tmp_path / "ts.ckpt"
-    kw = dict(orbits=12, rtol=1e-10, samples_per_orbit=8)
-    flyby = "tso.Flyby(q_km=1.5e5, v_inf_km_s=3.0, inclination_deg=0.0, t_closest_h=300.0)"
-    killed_run(tmp_path, ckpt, kill_after=2, kind="series", starts=[0.83], args=kw,
-               extra=f"perturbations=[{flyby}],")
-    kw["perturbations"] = [eval(flyby)]
-    resumed = tso.time_series(vh, 0.0, [0.83], **kw,
-                              run=tso.Run(checkpoint=ckpt, resume=True, window_orbits=4))
-    whole = tso.time_series(vh, 0.0, [0.83], **kw, run=tso.Run(window_orbits=4))
-    assert_same(resumed, whole)
-    assert np.all(whole.work[:, -1] != 0)
+    assert_resumed_equals_whole(
+        tmp_path, "tso.Flyby(q_km=1.5e5, v_inf_km_s=3.0, inclination_deg=0.0, t_closest_h=300.0)")
 
 
 def test_quantities_are_taken_and_converted():

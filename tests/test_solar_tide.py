@@ -383,6 +383,13 @@ def test_kernel_kepler_solution_matches_a_bracketing_root_finder(e):
 def test_resumed_run_under_the_sun_equals_an_uninterrupted_one(tmp_path):
     """The Sun depends on time: a run killed after two windows and resumed from its
     checkpoint (the clock restored from it) equals the uninterrupted run bit for bit."""
+    assert_resumed_equals_whole(tmp_path, "tso.SolarTide(inclination_deg=20.0, strength=300.0)")
+
+
+def assert_resumed_equals_whole(tmp_path, perturbation):
+    """A 1991 VH time series under ``perturbation`` (its source text), killed after two
+    4-orbit windows and resumed from its checkpoint, equals the uninterrupted run bit for bit,
+    and the perturbation did work."""
     from test_checkpoint import killed_run
     from test_perturbation_plumbing import assert_same
 
@@ -390,8 +397,8 @@ def test_resumed_run_under_the_sun_equals_an_uninterrupted_one(tmp_path):
     ckpt = tmp_path / "ts.ckpt"
     kw = dict(orbits=12, rtol=1e-10, samples_per_orbit=8)
     killed_run(tmp_path, ckpt, kill_after=2, kind="series", starts=[0.83], args=kw,
-               extra="perturbations=[tso.SolarTide(inclination_deg=20.0, strength=300.0)],")
-    kw["perturbations"] = [tso.SolarTide(inclination_deg=20.0, strength=300.0)]
+               extra=f"perturbations=[{perturbation}],")
+    kw["perturbations"] = [eval(perturbation)]
     resumed = tso.time_series(vh, 0.0, [0.83], **kw,
                               run=tso.Run(checkpoint=ckpt, resume=True, window_orbits=4))
     whole = tso.time_series(vh, 0.0, [0.83], **kw, run=tso.Run(window_orbits=4))
