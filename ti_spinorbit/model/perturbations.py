@@ -110,7 +110,8 @@ DISTANCES = ("orbit", "mean")
 DISTANCE = "orbit"
 DISTANCE_LEGACY = "mean"
 #: Unit text of a result's ``perturbations`` field (saved as their descriptions).
-UNIT = "objects: Tides / YORP / BYORP / SolarTide / Flyby with SI parameters (ti_spinorbit.model.perturbations)"
+UNIT = ("objects: Tides / YORP / BYORP / SolarTide / Flyby with SI parameters "
+        "(ti_spinorbit.model.perturbations)")
 
 
 def solar_radiation_constant():
@@ -669,8 +670,8 @@ class SolarTide:
         P, Q = self.directions(system)
         out = np.zeros(NPERT)
         out[Q_SUN] = self.strength * GM_SUN / (L ** 3 / T ** 2)
-        _sun_orbit_columns(out, system, a, e, math.radians(self.heliocentric(system).mean_anomaly_deg),
-                           L, T)
+        M0 = math.radians(self.heliocentric(system).mean_anomaly_deg)
+        _sun_orbit_columns(out, system, a, e, M0, L, T)
         # the kernels put a third body at +(x P + y Q) of its conic: the Sun is at minus the
         # barycentre's heliocentric position
         out[Q_SUN_P:Q_SUN_P + 3] = -P
@@ -803,9 +804,10 @@ class Flyby:
                              f"(got lengths {sorted(sizes)})")
         if self.planet is not None:
             radius = PLANETS[self.planet][1]
-            if min(np.atleast_1d(self.q_km)) < radius:
+            closest = min(np.atleast_1d(self.q_km))
+            if closest < radius:
                 raise ValueError(f"q_km must be at least {self.planet}'s radius {radius:g} km "
-                                 f"(got {min(np.atleast_1d(self.q_km)):g} km: the binary would hit it)")
+                                 f"(got {closest:g} km: the binary would hit it)")
         require_positive_scalar("strength", self.strength, *STRENGTH_RANGE)
 
     @property
