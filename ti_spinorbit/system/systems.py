@@ -566,9 +566,9 @@ def _body_from(b, label, mismatches, directory=None):
     refuse_unknown_keys(b, BODY_KEYS, repr(label))
     if "shape" in b:
         return _shape_body_from(b, label, mismatches, directory)
-    if "density" in b and "semi_axes_m" in b and "integrals" not in b:
-        return _ellipsoid_of_density(b, label, mismatches)
-    stray = [k for k in SHAPE_KEYS if k in b]
+    # an ellipsoid may be given by its density instead of its mass (_plain_body_from)
+    by_density = "semi_axes_m" in b and "integrals" not in b
+    stray = [k for k in SHAPE_KEYS if k in b and not (k == "density" and by_density)]
     if stray:
         raise ValueError(f"{label} {stray[0]!r} belongs to a body given by a shape file: add "
                          "\"shape\": \"polyhedron\" and \"file\" (or \"packaged\"), or delete it")
@@ -685,42 +685,17 @@ def _shape_body_from(b, label, mismatches, directory):
     return body
 
 
-def _ellipsoid_of_density(b, label, mismatches):
-    """A uniform ellipsoid given by semi_axes_m and density (kg/m^3); a mass_kg beside them is
-    derived, and checked."""
-    stray = [k for k in SHAPE_KEYS if k in b and k != "density"]
-    if stray:
-        raise ValueError(f"{label} {stray[0]!r} belongs to a body given by a shape file: add "
-                         "\"shape\": \"polyhedron\" and \"file\" (or \"packaged\"), or delete it")
-    axes = b["semi_axes_m"]
-    if not isinstance(axes, (list, tuple)) or len(axes) != 3:
-        raise TypeError(f"{label} semi_axes_m must be a list [a, b, c] of three lengths in m "
-                        f"(got {show(axes)})")
-    order = check_order(b["order"], f"{label} order") if "order" in b else MAX_ORDER
-    try:
-        body = Ellipsoid(*axes, require_real(f"{label} density", b["density"]),
-                         name=b.get("name", "body"), order=order)
-    except (TypeError, ValueError) as exc:
-        raise type(exc)(f"{label}: {exc}") from None
-    for key, derived in (("mass_kg", body.mass), ("bounding_radius_m", body.bounding_radius)):
-        if key in b:
-            given = require_real(f"{label} {key}", b[key])
-            if not math.isclose(given, derived, rel_tol=DERIVED_RTOL):
-                mismatches.append(f"{label} {key} is {given:.12g} in the description, but its "
-                                  f"semi_axes_m and density give {derived:.12g}")
-    return body
-
-
 def _plain_body_from(b, label, mismatches):
-    """An ellipsoid (semi_axes_m) or a general body (integrals)."""
+    """An ellipsoid (semi_axes_m, with mass_kg or density) or a general body (integrals)."""
     axes, integrals = b.get("semi_axes_m"), b.get("integrals")
-    needed = ("mass_kg",) if axes is not None and integrals is None else \
+    by_density = "density" in b          # an ellipsoid's: its mass_kg is then derived
+    needed = () if by_density else ("mass_kg",) if axes is not None and integrals is None else \
         ("mass_kg", "bounding_radius_m")
     for key in needed:
         if key not in b:
             raise ValueError(f"{label} description lacks {key!r} (has {', '.join(map(repr, b))})")
     name = b.get("name", "body")
-    mass = require_real(f"{label} mass_kg", b["mass_kg"])
+    mass = None if by_density else require_real(f"{label} mass_kg", b["mass_kg"])
     order = b.get("order")
     if order is not None:
         order = check_order(order, f"{label} order")
@@ -729,8 +704,9 @@ def _plain_body_from(b, label, mismatches):
         if not isinstance(axes, (list, tuple)) or len(axes) != 3:
             raise TypeError(f"{label} semi_axes_m must be a list [a, b, c] of three lengths in m "
                             f"(got {show(axes)})")
+        density = require_real(f"{label} density", b["density"]) if by_density else None
         try:
-            ellipsoid = Ellipsoid(*axes, mass=mass, name=name,
+            ellipsoid = Ellipsoid(*axes, density, mass=mass, name=name,
                                   order=MAX_ORDER if order is None else order)
         except (TypeError, ValueError) as exc:
             raise type(exc)(f"{label}: {exc}") from None
@@ -740,6 +716,11 @@ def _plain_body_from(b, label, mismatches):
                 f"{label} {name!r} is a general Body: its description needs 'integrals' "
                 "({'l,m,n': T^lmn}, as written by ti_spinorbit.output.io.save) or 'semi_axes_m'; "
                 "describe() alone does not hold its inertia integrals")
+        if by_density and "mass_kg" in b:
+            given = require_real(f"{label} mass_kg", b["mass_kg"])
+            if not math.isclose(given, ellipsoid.mass, rel_tol=DERIVED_RTOL):
+                mismatches.append(f"{label} mass_kg is {given:.12g} in the description, but its "
+                                  f"semi_axes_m and density give {ellipsoid.mass:.12g}")
         if "bounding_radius_m" in b:
             given = require_real(f"{label} bounding_radius_m", b["bounding_radius_m"])
             derived = ellipsoid.bounding_radius
@@ -925,7 +906,7 @@ def _init_with_period(self, primary, secondary, a, e, primary_spin_period=None, 
         # both masses × k: the force × k², the reduced mass × k, so the period × k^(-1/2),
         # as the Keplerian one: the same factor rule
         kepler = _dataclass_probe(primary, secondary, a_m, e).circular_period()
-    ratio = kepler / period
+    ratio = kepler / period         # the matched period (Keplerian or circular) over P
     factor = ratio * ratio                    # a product overflows to inf, ** 2 would raise
     volume = _volume(primary) + _volume(secondary)
     if volume > 0.0:
