@@ -196,13 +196,35 @@ def _check_distance(distance):
                          "mean-distance form")
 
 
-def _sun_orbit_columns(out, system, a, e, M0, L, T):
-    """The Sun slot's orbit columns of ``out`` (a, e in m and -, M0 rad): a/L, e, the
-    heliocentric mean motion × T, M0 (the Sun's tide and YORP/BYORP read the same ones)."""
-    out[Q_SUN_A] = a / L
-    out[Q_SUN_E] = e
-    out[Q_SUN_N] = math.sqrt((GM_SUN + G * system.total_mass) / a ** 3) * T
-    out[Q_SUN_M0] = M0
+def _conic_columns(out, c, a, e, n, M0, L, T):
+    """The conic of the third-body slot at column ``c`` of ``out``: a/L (a in m), e, n T (n in
+    rad/s), M0 (rad). The Sun slot's are read by the Sun's tide and by YORP/BYORP alike."""
+    out[c + T_A] = a / L
+    out[c + T_E] = e
+    out[c + T_N] = n * T
+    out[c + T_M0] = M0
+
+
+def _sun_mean_motion(system, a):
+    """The heliocentric mean motion sqrt(G (M_⊙ + m1 + m2) / a³), rad s⁻¹, a in m."""
+    return math.sqrt((GM_SUN + G * system.total_mass) / a ** 3)
+
+
+def _third_body_block(system, c, gm, a, e, n, M0, P, Q):
+    """A block holding one third body in its slot at column ``c``: μ = ``gm`` (m³ s⁻²,
+    strength included), its conic (a in m, e, n in rad/s, M0 rad, the body at x P + y Q),
+    ν = m2 / (m1 + m2) and each body's J_xx − J_yy = B − A, scaled."""
+    M, L, T = _scales(system)
+    out = np.zeros(NPERT)
+    out[c + T_MU] = gm / (L ** 3 / T ** 2)
+    _conic_columns(out, c, a, e, n, M0, L, T)
+    out[c + T_P:c + T_P + 3] = P
+    out[c + T_Q:c + T_Q + 3] = Q
+    out[c + T_NU] = system.secondary.mass / system.total_mass
+    for col, body in ((c + T_J1, system.primary), (c + T_J2, system.secondary)):
+        A, B, _ = body.moments         # J_xx − J_yy = I_yy − I_xx (principal frame)
+        out[col] = (B - A) / (M * L ** 2)
+    return out
 
 
 def _radiation_orbit(p, system):
@@ -215,7 +237,7 @@ def _radiation_orbit(p, system):
         orbit = getattr(system, "heliocentric_orbit", None)
         M0 = math.radians(orbit.mean_anomaly_deg) if (
             p.heliocentric_a_au is None and orbit is not None) else 0.0
-        _sun_orbit_columns(out, system, a, e, M0, L, T)
+        _conic_columns(out, Q_SUN, a, e, _sun_mean_motion(system, a), M0, L, T)
         out[Q_RAD] = (a / L) ** 2 * math.sqrt(1.0 - e * e)
     return out
 
@@ -648,7 +670,7 @@ class SolarTide:
     def mean_motion(self, system):
         """The heliocentric mean motion sqrt(G (M_⊙ + m1 + m2) / a³), rad s⁻¹."""
         a, _ = self.orbit(system)
-        return math.sqrt((GM_SUN + G * system.total_mass) / a ** 3)
+        return _sun_mean_motion(system, a)
 
     def sun_position(self, system, t):
         """The Sun's position relative to the barycentre at time t (s), m, inertial frame
@@ -665,22 +687,13 @@ class SolarTide:
         return self.strength * GM_SUN * r ** 3 / (G * system.total_mass * (a * (1.0 - e)) ** 3)
 
     def block(self, system):
-        M, L, T = _scales(system)
         a, e = self.orbit(system)
         P, Q = self.directions(system)
-        out = np.zeros(NPERT)
-        out[Q_SUN] = self.strength * GM_SUN / (L ** 3 / T ** 2)
         M0 = math.radians(self.heliocentric(system).mean_anomaly_deg)
-        _sun_orbit_columns(out, system, a, e, M0, L, T)
         # the kernels put a third body at +(x P + y Q) of its conic: the Sun is at minus the
         # barycentre's heliocentric position
-        out[Q_SUN_P:Q_SUN_P + 3] = -P
-        out[Q_SUN_Q:Q_SUN_Q + 3] = -Q
-        out[Q_SUN_NU] = system.secondary.mass / system.total_mass
-        for col, body in ((Q_SUN_J1, system.primary), (Q_SUN_J2, system.secondary)):
-            A, B, _ = body.moments         # J_xx − J_yy = I_yy − I_xx (principal frame)
-            out[col] = (B - A) / (M * L ** 2)
-        return out
+        return _third_body_block(system, Q_SUN, self.strength * GM_SUN, a, e,
+                                 _sun_mean_motion(system, a), M0, -P, -Q)
 
     def in_plane(self, system=None):
         """Whether the Sun stays in the start's orbit plane (its orbit's P and Q without a z
@@ -860,23 +873,9 @@ class Flyby:
         return self.strength * self.gm * r ** 3 / (G * system.total_mass * q ** 3)
 
     def block(self, system, k=0):
-        M, L, T = _scales(system)
-        a, e, n, M0 = self.hyperbola(system, k)
-        P, Q = self.directions(k)
-        out = np.zeros(NPERT)
-        c = Q_FLYBY
-        out[c + T_MU] = self.strength * self.gm / (L ** 3 / T ** 2)
-        out[c + T_A] = a / L
-        out[c + T_E] = e
-        out[c + T_N] = n * T
-        out[c + T_M0] = M0
-        out[c + T_P:c + T_P + 3] = P          # the planet at +(x P + y Q) of its hyperbola
-        out[c + T_Q:c + T_Q + 3] = Q
-        out[c + T_NU] = system.secondary.mass / system.total_mass
-        for col, body in ((c + T_J1, system.primary), (c + T_J2, system.secondary)):
-            A, B, _ = body.moments
-            out[col] = (B - A) / (M * L ** 2)
-        return out
+        # the planet at +(x P + y Q) of its hyperbola
+        return _third_body_block(system, Q_FLYBY, self.strength * self.gm,
+                                 *self.hyperbola(system, k), *self.directions(k))
 
     @property
     def slot(self):
