@@ -166,6 +166,26 @@ def _kepler_state(a, e, M, mu):
     return r, v
 
 
+def rebound_relative_orbit(rebound, system, gm, r3, v3, R0, V0, t):
+    """The relative position secondary − primary at times ``t`` (s) from REBOUND (IAS15, SI),
+    the binary's two bodies started at R0, V0 (m, m/s) about their barycentre at the origin
+    and a point mass ``gm`` (m³ s⁻²) at r3, v3 relative to it."""
+    m1, m2 = system.primary.mass, system.secondary.mass
+    nu = m2 / (m1 + m2)
+    sim = rebound.Simulation()
+    sim.G = G
+    sim.add(m=gm / G, **dict(zip(("x", "y", "z"), r3)), **dict(zip(("vx", "vy", "vz"), v3)))
+    for m, f in ((m1, -nu), (m2, 1.0 - nu)):
+        sim.add(m=m, **dict(zip(("x", "y", "z"), f * R0)),
+                **dict(zip(("vx", "vy", "vz"), f * V0)))
+    sim.integrator = "ias15"
+    out = np.empty((len(t), 3))
+    for k, tk in enumerate(t):
+        sim.integrate(tk, exact_finish_time=1)
+        out[k] = np.array(sim.particles[2].xyz) - np.array(sim.particles[1].xyz)
+    return out
+
+
 def test_wide_binary_relative_orbit_agrees_with_rebound():
     """A wide binary (100 km, e = 0.2) at 1 AU with the Sun 25° out of its plane, over three
     mutual orbits (26 days): the relative orbit equals REBOUND's (IAS15; the Sun and two
@@ -195,24 +215,10 @@ def test_wide_binary_relative_orbit_agrees_with_rebound():
         [[1, 0, 0], [0, math.cos(i), -math.sin(i)], [0, math.sin(i), math.cos(i)]]) @ Rz(
         math.radians(peri))
     r_h, v_h = rot @ r_h, rot @ v_h
-    m1, m2 = system.primary.mass, system.secondary.mass
-    nu = m2 / (m1 + m2)
     # REBOUND in the inertial frame moving with the barycentre's initial velocity, origin at
     # it: the binary's coordinates stay small (at 1 AU their round-off alone is 1e-9 of the
     # separation after three orbits)
-    sim = rebound.Simulation()
-    sim.G = G
-    sim.add(m=GM_SUN / G, **dict(zip(("x", "y", "z"), -r_h)),
-            **dict(zip(("vx", "vy", "vz"), -v_h)))
-    for m, f in ((m1, -nu), (m2, 1.0 - nu)):
-        sim.add(m=m, **dict(zip(("x", "y", "z"), f * R[0])),
-                **dict(zip(("vx", "vy", "vz"), f * V[0])))
-    sim.integrator = "ias15"
-    theirs = np.empty_like(R)
-    for k, tk in enumerate(t):
-        sim.integrate(tk, exact_finish_time=1)
-        p1, p2 = sim.particles[1], sim.particles[2]
-        theirs[k] = np.array(p2.xyz) - np.array(p1.xyz)
+    theirs = rebound_relative_orbit(rebound, system, GM_SUN, -r_h, -v_h, R[0], V[0], t)
     err = np.linalg.norm(R - theirs, axis=1) / sep
     moved = np.linalg.norm(R - bare.states[0][:, 0:3], axis=1) / sep
     assert err.max() < 1e-9, err.max()
