@@ -70,6 +70,18 @@ def vh():
 
 
 @pytest.fixture(scope="module")
+def section(vh):
+    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], orbits=3, rtol=1e-9)
+
+
+@pytest.fixture(scope="module")
+def many(vh):
+    """A section of 12 members (above plotting.MAX_LEGEND): a colourbar of the start, not a
+    legend."""
+    return tso.surface_of_section(vh, 0.0, np.linspace(0.8, 1.9, 12), orbits=2, rtol=1e-9)
+
+
+@pytest.fixture(scope="module")
 def time_series(vh):
     return tso.time_series(vh, 0.0, [0.83, 1.63], orbits=2, samples_per_orbit=8, rtol=1e-9)
 

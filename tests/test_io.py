@@ -26,12 +26,7 @@ from ti_spinorbit.studies.section import SectionResult, TimeSeriesResult
 from conftest import lumpy_body
 
 
-# ---- results of every kind, as cheap as real calls get --------------------------------------
-@pytest.fixture(scope="module")
-def section(vh):
-    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], orbits=3, rtol=1e-9)
-
-
+# ---- results of every kind (the fixtures are conftest.py's) ------------------------------------
 KINDS = {"section": SectionResult, "time_series": TimeSeriesResult, "chaos_map": ChaosMap,
          "parameter_map": ParameterMap, "overlap_scan": OverlapScan,
          "relaxed_libration": RelaxedLibration}

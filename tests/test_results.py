@@ -32,17 +32,6 @@ KINDS = {"section": SectionResult, "time_series": TimeSeriesResult, "chaos_map":
 ROOT = Path(__file__).resolve().parent.parent
 
 
-@pytest.fixture(scope="module")
-def section(vh):
-    return tso.surface_of_section(vh, 0.0, [0.83, 1.63], orbits=3, rtol=1e-9)
-
-
-@pytest.fixture(scope="module")
-def many(vh):
-    """A section of 12 members (above plotting.MAX_LEGEND): colourbar of the start."""
-    return tso.surface_of_section(vh, 0.0, np.linspace(0.8, 1.9, 12), orbits=2, rtol=1e-9)
-
-
 @pytest.fixture(autouse=True)
 def _close_figures():
     yield
