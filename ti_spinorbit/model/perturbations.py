@@ -799,13 +799,12 @@ class Flyby:
             raise ValueError(f"Flyby planet must be one of {', '.join(PLANETS)} (got "
                              f"{show(self.planet)}), or give mass_kg=")
         if self.mass_kg is not None:
-            require_positive_scalar("mass_kg", self.mass_kg, 1e3, 1e31, "kg")
+            object.__setattr__(self, "mass_kg", require_positive_scalar(
+                "mass_kg", self.mass_kg, 1e3, 1e31, "kg"))
         ranges = {"v_inf_km_s": (0.01, 100.0, "km/s"), "q_km": (1.0, 1e9, "km"),
                   "inclination_deg": (*INCLINATION_RANGE, "deg"),
                   "node_deg": (*ANGLE_RANGE, "deg"), "periapsis_deg": (*ANGLE_RANGE, "deg"),
                   "t_closest_h": (-1e6, 1e6, "h")}
-        if self.mass_kg is not None:
-            object.__setattr__(self, "mass_kg", _to_plain("mass_kg", self.mass_kg, "kg"))
         sizes = set()
         for name in self.FIELDS:
             values = _per_member(name, getattr(self, name), *ranges[name])
