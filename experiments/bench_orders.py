@@ -8,7 +8,7 @@ throughput benchmark's (``bench_throughput.starts``: θ_p, θ̇_p/n on an R2 seq
 order-N integral rows come from the ellipsoids' closed form (``system.integrals``), so the
 script runs whatever order the bodies store. Integration through ``Ensemble`` (Cash-Karp,
 rtol = atol = 1e-12, escape distance 1000 a); orders up to 4 run the hand-written kernels,
-higher ones the table-driven ones (docs/physics.md §3.8). Each point integrates about
+higher ones the table-driven harmonic ones (docs/physics.md §3.8a). Each point integrates about
 ``--seconds`` of wall time (a pilot run sizes it; at least 0.05 orbit), after a 1-member
 launch that compiles or loads the variant. Sections:
 
@@ -19,16 +19,19 @@ rates
     included); the targets of the order-N work (3-D: order 6 >= 1/4 and order 8 >= 1/12 of
     the order-4 rate) are printed with MET/MISS.
 split
-    one core, the order-N potential alone (``multipole_gravity.mutual_n`` in a loop on 256
-    states, a dependent chain as in bench_throughput's RHS loop), and with each part of it
-    switched off in turn through its table header (the secondary-frame derivatives, the
-    rotation of the secondary's integrals, the mixed pairs): where its time goes.
+    one core, the Cartesian form's potential alone (``multipole_gravity.mutual_n``, the
+    kernels' independent check, no longer what they integrate with; in a loop on 256 states,
+    a dependent chain as in bench_throughput's RHS loop), and with each part of it switched
+    off in turn through its table header (the secondary-frame derivatives, the rotation of
+    the secondary's integrals, the mixed pairs): where that form's time goes. The harmonic
+    form against it: ``bench_harmonics.py``.
 compile
     cold compile of each order's variant in a fresh process with an empty kernel cache (the
     integrator and the diagnostics kernels, as ``tso.warmup`` counts them), per model.
 memory
-    bytes per member of the order-N block: the integral row and the scratch row
-    (``multipole_tables.Tables``), beside the ~100 numbers every member carries anyway.
+    bytes per member of the order-N block: the coefficient row and the scratch row
+    (``harmonic_tables.HarmonicTables``; the Cartesian form's beside them), beside the ~100
+    numbers every member carries anyway.
 
     python experiments/bench_orders.py                        # everything, ~10 min on 2 cores
     python experiments/bench_orders.py --sections rates --models 3d --orders 4 6 8
@@ -248,20 +251,26 @@ def compile_times(models, orders):
 
 
 def memory(orders):
-    from ti_spinorbit.engine import multipole_tables as MT
+    """Bytes per member of the kernels' order-N block (the harmonic form: coefficient row
+    and scratch) and of the shared tables, beside the Cartesian form's for reference."""
+    from ti_spinorbit.engine import harmonic_tables as HT, multipole_tables as MT
     rows = []
     for order in orders:
         if order <= 4:
             continue
         for caps in [None] + ([CAPS[order]] if order in CAPS else []):
             degrees = MT.check_degrees(order, caps)
+            h = HT.tables(order, *degrees)
             t = MT.tables(order, *degrees, False)
-            rows.append({"order": order, "degrees": degrees, "row_bytes": 8 * t.width,
-                         "scratch_bytes": 8 * t.scratch, "pairs": t.pairs,
-                         "table_bytes": t.ints.nbytes + t.floats.nbytes})
-            print(f"  order {order:2d} degrees {str(degrees):8s}: {8 * t.width} B row + "
-                  f"{8 * t.scratch} B scratch per member; tables {t.ints.nbytes + t.floats.nbytes}"
-                  f" B shared, {t.pairs} mixed pairs", flush=True)
+            rows.append({"order": order, "degrees": degrees, "row_bytes": 8 * h.width,
+                         "scratch_bytes": 8 * h.scratch,
+                         "table_bytes": h.ints.nbytes + h.floats.nbytes,
+                         "cartesian_row_bytes": 8 * t.width,
+                         "cartesian_scratch_bytes": 8 * t.scratch, "cartesian_pairs": t.pairs})
+            print(f"  order {order:2d} degrees {str(degrees):8s}: {8 * h.width} B row + "
+                  f"{8 * h.scratch} B scratch per member; tables "
+                  f"{h.ints.nbytes + h.floats.nbytes} B shared (Cartesian form: {8 * t.width}"
+                  f" + {8 * t.scratch} B, {t.pairs} mixed pairs)", flush=True)
     return rows
 
 

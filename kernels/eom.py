@@ -25,7 +25,7 @@ import taichi as ti
 from ti_spinorbit.layout import multipole as _MP, spatial as _L
 
 from . import perturb
-from .multipole_gravity import mutual_n
+from .harmonic_gravity import mutual_h
 from .mutual_gravity import mat_t_vec, mat_vec, mutual, vec3, mat3
 
 # The state offsets and the member parameter row (two body rows, then derived constants,
@@ -74,11 +74,11 @@ def gravity(p: ti.template(), i, k, G, R, S, order: ti.template(), odd: ti.templ
             mpr: ti.template(), mps: ti.template(), mpi: ti.template(), mpf: ti.template()):
     """U, ∂U/∂R, μ1, μ2 of member i (frame A): the hand-written formulas of
     ``mutual_gravity.py`` for order <= 4 (the code as it always was), the table-driven ones
-    of ``multipole_gravity.py`` above (``order`` is then ``layout.multipole.KERNEL_ORDER``
-    and the tables ``mpi``, ``mpf`` hold the true order; member i's integral row is
+    of ``harmonic_gravity.py`` above (``order`` is then ``layout.multipole.KERNEL_ORDER``
+    and the tables ``mpi``, ``mpf`` hold the true order; member i's coefficient row is
     ``mpr[i]``, the scratch row ``mps[k]``)."""
     if ti.static(order > _MP.HAND_WRITTEN_MAX):
-        return mutual_n(mpr, i, mps, k, mpi, mpf, G, R, S)
+        return mutual_h(mpr, i, mps, k, mpi, mpf, G, R, S)
     else:
         return mutual(p, i, BODY_A, BODY_B, G, R, S, order, odd)
 

@@ -52,7 +52,7 @@ import taichi as ti
 from ti_spinorbit.layout import multipole as _MP, planar as _L
 
 from . import perturb
-from .multipole_gravity import mutual_n
+from .harmonic_gravity import mutual_h
 
 # The state offsets and the member parameter row (scaled units) are ti_spinorbit.layout's,
 # shared with the host (ti_spinorbit.model.planar fills the row).
@@ -112,7 +112,7 @@ def potential(pv, y, order: ti.template(), odd: ti.template(), mpr: ti.template(
 @ti.func
 def potential_n(y, mpr: ti.template(), i, mps: ti.template(), mpi: ti.template(),
                 mpf: ti.template()):
-    """(V, V_r, V_A, V_B) of the order-N potential (``multipole_gravity.mutual_n``) in the
+    """(V, V_r, V_A, V_B) of the order-N potential (``harmonic_gravity.mutual_h``) in the
     plane: R = r (cos ψ_A, sin ψ_A, 0) in the primary's frame (the stored cosine and sine
     normalised) and S the z-rotation by
     θ_B − θ_A = ψ_A − ψ_B. V_r = −∂U/∂R · R/r, and V_k = −τ_k,z (the torques about z;
@@ -131,7 +131,7 @@ def potential_n(y, mpr: ti.template(), i, mps: ti.template(), mpi: ti.template()
     s = sA * cB - cA * sB                      # sin(ψ_A − ψ_B)
     R = ti.Vector([r * cA, r * sA, 0.0], ti.f64)
     S = ti.Matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], ti.f64)
-    U, dUdR, mu1, mu2 = mutual_n(mpr, i, mps, i, mpi, mpf, 1.0, R, S)
+    U, dUdR, mu1, mu2 = mutual_h(mpr, i, mps, i, mpi, mpf, 1.0, R, S)
     return -U, -(dUdR[0] * cA + dUdR[1] * sA), -mu1[2], -mu2[2]
 
 

@@ -3,6 +3,7 @@ default), small systems used across the suite, and 1991 VH with one cheap result
 kind (module scope, like the per-file fixtures they replace)."""
 
 import dataclasses
+import math
 import os
 import subprocess
 import sys
@@ -52,6 +53,32 @@ def random_rotation(rng):
     if np.linalg.det(q) < 0:
         q[:, 0] *= -1
     return q
+
+
+def axis_rotation(axis, angle):
+    """The rotation by ``angle`` (rad) about coordinate axis 0, 1 or 2."""
+    c, s = math.cos(angle), math.sin(angle)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    Q = np.eye(3)
+    Q[i, i] = Q[j, j] = c
+    Q[j, i], Q[i, j] = s, -s
+    return Q
+
+
+def degenerate_geometries(rng, scale=1.0):
+    """(R, C) pairs (R in units of ``scale``) where the line-of-centres angles of the
+    order-N potential degenerate: R along ±z (no azimuth), the secondary's z axis along the
+    line of centres (β = 0) or against it (β = π), the planar model's geometry (R in the
+    plane, C a z-rotation or the identity), and generic ones."""
+    out = [((0.0, 0.0, 1.7), np.eye(3)), ((0.0, 0.0, -1.7), random_rotation(rng)),
+           ((1.3, 0.8, 0.0), axis_rotation(2, 0.7)), ((1.3, 0.8, 0.0), np.eye(3)),
+           ((0.0, 1.6, 0.0), axis_rotation(0, math.pi)), ((0.9, 1.2, -0.4), random_rotation(rng))]
+    for R, flip in (((1.1, -0.6, 0.9), 1.0), ((-0.5, 0.7, 1.3), -1.0)):   # β = 0 and β = π
+        z = flip * np.asarray(R) / np.linalg.norm(R)
+        x = np.cross(z, [0.0, 1.0, 0.0])
+        x /= np.linalg.norm(x)
+        out.append((R, np.column_stack([x, np.cross(z, x), z])))
+    return [(scale * np.asarray(R, dtype=float), C) for R, C in out]
 
 
 def lumpy_body(rng, n=40, scale=1.0, mass=1.0):

@@ -104,6 +104,35 @@ class multipole:
      NHEAD) = range(32)
 
 
+class harmonic:
+    """The order-N potential in harmonics (``ti_spinorbit.engine.harmonic_tables``,
+    ``kernels/harmonic_gravity.py``): the positions of the header at the start of its integer
+    table. Sizes, table sections and per-member scratch offsets are read from it at run time,
+    so one compiled kernel serves every order and degree cap.
+
+    Within a degree l the 2l + 1 coefficients are stored by class: m = 0, 2, 4, ... (cos,
+    even), m = 1, 3, ... (cos, odd), m = −2, −4, ... (sin, even), m = −1, −3, ... (sin, odd);
+    every J_l then maps each class to one class as a dense block, and a z-rotation pairs
+    equal positions of two classes (``harmonic_tables``)."""
+
+    (K_N,                  # truncation order
+     K_DA, K_DB,           # degree caps of the primary and the secondary
+     K_KA, K_KB,           # top degrees of each body in the mixed terms (min(d, N − 2))
+     K_TOP,                # max(dA, dB): the multiple angles and per-degree buffers
+     K_ROW_B,              # first column of the secondary in a coefficient row: (dA + 1)²
+     K_MASK_A, K_MASK_B,   # bit l set: the body's degree l is not zero for some member
+     K_NPAIR,              # the (l1, l2) interaction blocks
+     K_I_DEG,              # per degree: J and Jᵀ value offsets, then the input class of
+                           # each output class for J and for Jᵀ (DEG_WIDTH integers)
+     K_I_GC,               # generators about x and y: 4 columns per global row
+     K_I_PAIR,             # (l1, l2, offset of its 2 min(l1, l2) + 1 couplings) per block
+     K_F_G,                # generator values (4 per global row)
+     K_S_A, K_S_B, K_S_GA, K_S_GB, K_S_T1, K_S_T2, K_S_TRIG, K_S_W,   # scratch offsets
+     K_SCRATCH,            # scratch columns per member
+     KHEAD) = range(24)
+    DEG_WIDTH = 10
+
+
 class perturbation:
     """Columns of the perturbation block, relative to its start (a model's NPAR)."""
 

@@ -127,10 +127,10 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4, degre
 
 
 def _mutual_potential_n(primary, secondary, Rf, Sf, order, degrees, batch):
-    """:func:`mutual_potential` above order 4: the table-driven kernel in units of the
+    """:func:`mutual_potential` above order 4: the kernels' order-N potential in units of the
     contact distance L = ρ_A + ρ_B and the total mass M (G = 1), so that no power of a length
     in metres comes near the float range, then back to SI."""
-    from ..kernels import multipole_gravity as K     # Taichi: imported on first use
+    from ..kernels import harmonic_gravity as K      # Taichi: imported on first use
 
     dA, dB = _mp.check_degrees(order, degrees)
     _check_degree(primary, "primary", dA, order)

@@ -354,15 +354,39 @@ class Multipole:
         """The rows ``index`` (one per state, e.g. the member of each record)."""
         return Multipole(self.tables, self.rows[np.asarray(index)])
 
+    @property
+    def harmonic(self):
+        """(coefficient rows, harmonic tables) of the kernels (``harmonic_tables``): the rows
+        in real solid harmonics, and tables that skip each body's degrees that are zero in
+        every row (an ellipsoid's odd degrees). Built on first use and kept."""
+        cached = self.__dict__.get("_harmonic")
+        if cached is None:
+            from . import harmonic_tables as _ht
+            dA, dB = self.degrees
+            rows = _ht.coefficient_rows(self.rows, dA, dB)
+            tab = _ht.tables(self.order, dA, dB, _ht.degree_mask(rows, dA),
+                             _ht.degree_mask(rows, dB, first=(dA + 1) ** 2))
+            cached = (rows, tab)
+            object.__setattr__(self, "_harmonic", cached)
+        return cached
+
     def arguments(self, slots):
-        """(rows, scratch, ints, floats) for a launch with ``slots`` scratch rows (one per
+        """(rows, scratch, ints, floats) of the kernels' order-N potential
+        (``kernels/harmonic_gravity.py``) for a launch with ``slots`` scratch rows (one per
         thread's slot: the member in the integrator, the state in the diagnostics)."""
+        rows, tab = self.harmonic
+        return rows, np.zeros((max(int(slots), 1), tab.scratch)), tab.ints, tab.floats
+
+    def cartesian_arguments(self, slots):
+        """The same four arrays for the Cartesian kernel (``kernels/multipole_gravity.py``,
+        the kernels' independent check): integral rows and these tables."""
         return (self.rows, np.zeros((max(int(slots), 1), self.tables.scratch)),
                 self.tables.ints, self.tables.floats)
 
     def bytes(self, slots):
-        """Bytes of the rows and of ``slots`` scratch rows."""
-        return 8 * (self.rows.size + max(int(slots), 1) * self.tables.scratch)
+        """Bytes of the kernels' rows and of ``slots`` scratch rows."""
+        rows, tab = self.harmonic
+        return 8 * (rows.size + max(int(slots), 1) * tab.scratch)
 
 
 def no_arguments():
