@@ -14,17 +14,19 @@ transverse force from R × ∂U/∂R = τ_A + τ_B (angular momentum conserved b
 everything is turned back into the primary's frame.
 
 Why this form and not the Cartesian one (``multipole_gravity.py``, kept as the kernels'
-independent check): the same numbers at 1e-13 for a fraction of the work at every order
+independent check): the same numbers to 1e-13 for a fraction of the work at every order
 above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
 
-* each z-rotation is fused into the pass before it or after it (the copy from the member's
-  row, or the output of a J product), so a body's degree costs three passes;
+* the host turns each body's rotation into a program of flat lists (``harmonic_tables``):
+  z-rotation pairs and dense J-block rows, so the kernel runs a few flat loops with no
+  per-degree logic and each helper has one call site (compile time grows with inlined
+  copies);
 * degrees above the mixed terms' (l > min(d, N − 2)) enter only through m = 0 (the other
-  body's monopole) and the generators' neighbours m = ±1, so their last pass computes those
-  three rows only;
+  body's monopole) and the generators' neighbours m = ±1, so their last product computes
+  those three rows only; a body's degrees that are zero in every member are left out;
 * r^−(L+1) is tabulated once per evaluation; the angles come from matrix entries, never from
   trigonometric calls (multiple angles by the addition recurrence);
-* the secondary's z-torque is the primary's with the opposite sign: along the line of
+* the primary's z-torque is the secondary's with the opposite sign: along the line of
   centres (R × ∂U/∂R)_z = 0.
 
 Per-member data, passed as arguments of the kernels beside the parameter rows (the same four
@@ -41,137 +43,41 @@ from ti_spinorbit.layout import harmonic as _K
 
 from .mutual_gravity import vec3
 
-
-@ti.func
-def _sizes(l):
-    """Class sizes of degree l: cos even, cos odd, sin even, sin odd (``layout.harmonic``)."""
-    return l // 2 + 1, (l + 1) // 2, l // 2, (l + 1) // 2
+_BITS = 9                       # harmonic_tables.BITS: a packed entry is a | b << 9 | c << 18
+_MASK = (1 << _BITS) - 1
 
 
 @ti.func
-def _size(l, a):
-    n = l // 2 + 1
-    if a == 1 or a == 3:
-        n = (l + 1) // 2
-    elif a == 2:
-        n = l // 2
-    return n
+def _pairs(scr: ti.template(), k, tab_i: ti.template(), n, o, v, trig, top):
+    """X(ψ) in place on the pairs (p, q, m) of a list (packed: ``harmonic_tables.pack``):
+    v[p], v[q] ← rotated by mψ."""
+    for e in range(n):
+        w = tab_i[o + e]
+        p = v + (w & _MASK)
+        q = v + ((w >> _BITS) & _MASK)
+        m = w >> (2 * _BITS)
+        c = scr[k, trig + m]
+        s = scr[k, trig + top + 1 + m]
+        a = scr[k, p]
+        b = scr[k, q]
+        scr[k, p] = c * a - s * b
+        scr[k, q] = s * a + c * b
 
 
 @ti.func
-def _offset(l, a):
-    """Position of class a's first coefficient within degree l."""
-    n0, n1, n2, _ = _sizes(l)
-    o = 0
-    if a >= 1:
-        o += n0
-    if a >= 2:
-        o += n1
-    if a >= 3:
-        o += n2
-    return o
-
-
-@ti.func
-def _angles(scr: ti.template(), k, o, top, c, s):
-    """cos mψ at scr[k, o + m] and sin mψ at scr[k, o + top + 1 + m], m = 1..top."""
-    cm, sm = 1.0, 0.0
-    for m in range(1, top + 1):
-        cm, sm = cm * c - sm * s, sm * c + cm * s
-        scr[k, o + m] = cm
-        scr[k, o + top + 1 + m] = sm
-
-
-@ti.func
-def _load(rows: ti.template(), j, src, scr: ti.template(), k, dst, l, trig, top):
-    """scr[dst..] ← X(ψ) of the member's degree-l coefficients (row columns src..), class
-    order: m = 2i pairs cos-even position i with sin-even i − 1, m = 2i + 1 cos-odd i with
-    sin-odd i."""
-    n0, n1, n2, n3 = _sizes(l)
-    scr[k, dst] = rows[j, src]
-    for i in range(1, n0):
-        c = scr[k, trig + 2 * i]
-        s = scr[k, trig + top + 1 + 2 * i]
-        p = rows[j, src + i]
-        q = rows[j, src + n0 + n1 + i - 1]
-        scr[k, dst + i] = c * p - s * q
-        scr[k, dst + n0 + n1 + i - 1] = s * p + c * q
-    for i in range(n1):
-        c = scr[k, trig + 2 * i + 1]
-        s = scr[k, trig + top + 2 + 2 * i]
-        p = rows[j, src + n0 + i]
-        q = rows[j, src + n0 + n1 + n2 + i]
-        scr[k, dst + n0 + i] = c * p - s * q
-        scr[k, dst + n0 + n1 + n2 + i] = s * p + c * q
-
-
-@ti.func
-def _zrot(scr: ti.template(), k, v, l, mtop, trig, top):
-    """X(ψ) in place on the degree-l vector at v, orders |m| <= mtop."""
-    n0, n1, n2, n3 = _sizes(l)
-    for i in range(1, ti.min(n0, mtop // 2 + 1)):
-        c = scr[k, trig + 2 * i]
-        s = scr[k, trig + top + 1 + 2 * i]
-        p = scr[k, v + i]
-        q = scr[k, v + n0 + n1 + i - 1]
-        scr[k, v + i] = c * p - s * q
-        scr[k, v + n0 + n1 + i - 1] = s * p + c * q
-    for i in range(ti.min(n1, (mtop + 1) // 2)):
-        c = scr[k, trig + 2 * i + 1]
-        s = scr[k, trig + top + 2 + 2 * i]
-        p = scr[k, v + n0 + i]
-        q = scr[k, v + n0 + n1 + n2 + i]
-        scr[k, v + n0 + i] = c * p - s * q
-        scr[k, v + n0 + n1 + n2 + i] = s * p + c * q
-
-
-@ti.func
-def _product(scr: ti.template(), k, src, dst, l, full, tab_i: ti.template(),
-             tab_f: ti.template(), which):
-    """scr[dst..] ← M scr[src..] for degree l, M = J (which 0) or Jᵀ (1): per output class a
-    dense block from one input class (the degree's table entry); with ``full`` False only
-    the rows m = 0, ±1 (first rows of the cos-even, cos-odd and sin-odd classes)."""
-    d = tab_i[_K.K_I_DEG] + _K.DEG_WIDTH * l
-    f = tab_i[d + which]
-    for a in range(4):
-        b = tab_i[d + 2 + 4 * which + a]
-        na = _size(l, a)
-        nb = _size(l, b)
-        rows_ = na
-        if not full:
-            rows_ = 0 if a == 2 else ti.min(na, 1)
-        ia = dst + _offset(l, a)
-        ib = src + _offset(l, b)
-        for i in range(rows_):
-            s = 0.0
-            fr = f + i * nb
-            for c in range(nb):
-                s += tab_f[fr + c] * scr[k, ib + c]
-            scr[k, ia + i] = s
-        f += na * nb
-
-
-@ti.func
-def _torque_xy(scr: ti.template(), k, base, gbase, deg, kmix, mask, tab_i: ti.template(),
-               tab_f: ti.template()):
-    """(τ_x, τ_y) of one body in the line-of-centres frame: −Σ ∂U/∂C_lm (G_k C)_lm over the
-    rows where ∂U/∂C can be non-zero (all m up to degree kmix, m = 0 above)."""
-    oc = tab_i[_K.K_I_GC]
-    of = tab_i[_K.K_F_G]
-    tx, ty = 0.0, 0.0
-    for l in range(2, deg + 1):
-        if (mask >> l) & 1:
-            nrow = 2 * l + 1 if l <= kmix else 1
-            b = base + l * l
-            for i in range(nrow):
-                g = l * l + i
-                acc = scr[k, gbase + g]
-                t = oc + 4 * g
-                f = of + 4 * g
-                tx += acc * (tab_f[f] * scr[k, b + tab_i[t]] + tab_f[f + 1] * scr[k, b + tab_i[t + 1]])
-                ty += acc * (tab_f[f + 2] * scr[k, b + tab_i[t + 2]]
-                             + tab_f[f + 3] * scr[k, b + tab_i[t + 3]])
-    return -tx, -ty
+def _rows(scr: ti.template(), k, tab_i: ti.template(), tab_f: ti.template(), n, o, dst, src):
+    """Dense block rows in chunks ((destination, source, accumulate) packed, weights): four
+    products each, the weights past a row's end zero (``harmonic_tables.CHUNK``)."""
+    for e in range(n):
+        w = tab_i[o + 2 * e]
+        s0 = src + ((w >> _BITS) & _MASK)
+        f = tab_i[o + 2 * e + 1]
+        acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
+               + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
+        d = dst + (w & _MASK)
+        if w >> (2 * _BITS):
+            acc += scr[k, d]
+        scr[k, d] = acc
 
 
 @ti.func
@@ -180,23 +86,15 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     """Mutual potential U, gradient dU/dR, torque on A (mu1) and on B (mu2), frame A, at the
     order and degree caps the tables were built for; member j's coefficient row
     (``rows[j]``), slot k's scratch (``scr[k]``)."""
-    N = tab_i[_K.K_N]
-    dA = tab_i[_K.K_DA]
-    dB = tab_i[_K.K_DB]
-    KA = tab_i[_K.K_KA]
-    KB = tab_i[_K.K_KB]
     top = tab_i[_K.K_TOP]
-    rowB = tab_i[_K.K_ROW_B]
-    mA = tab_i[_K.K_MASK_A]
-    mB = tab_i[_K.K_MASK_B]
-    sA = tab_i[_K.K_S_A]
-    sB = tab_i[_K.K_S_B]
-    sGA = tab_i[_K.K_S_GA]
-    sGB = tab_i[_K.K_S_GB]
     t1 = tab_i[_K.K_S_T1]
     t2 = tab_i[_K.K_S_T2]
     trig = tab_i[_K.K_S_TRIG]
     sw = tab_i[_K.K_S_W]
+    sA = tab_i[_K.K_S_A]
+    sB = tab_i[_K.K_S_B]
+    sGA = tab_i[_K.K_S_GA]
+    sGB = tab_i[_K.K_S_GB]
     # the line-of-centres frame L = Rz(−α) Ry(−θ) Rz(−φ) and the secondary's Ry(β) Rz(γ)
     x, y, z = R[0], R[1], R[2]
     rho = ti.sqrt(x * x + y * y)
@@ -214,86 +112,117 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     cb, sb = Q[2, 2], ca * Q[0, 2] + sa * Q[1, 2]
     cg, sg = ca * Q[1, 1] - sa * Q[0, 1], ca * Q[1, 0] - sa * Q[0, 0]
     L = ti.Matrix([[ca, sa, 0.0], [-sa, ca, 0.0], [0.0, 0.0, 1.0]], ti.f64) @ P
+    # the multiple angles of the five angles (slots 0..4: −φ, −θ, −α for the primary, γ, β for
+    # the secondary): cos mψ at trig + slot·2(top+1) + m, sin mψ top + 1 further; m = 1 put
+    # first, the rest in one loop (one call site for all five)
     n2 = 2 * (top + 1)
-    _angles(scr, k, trig, top, cf, -sf)
-    _angles(scr, k, trig + n2, top, ct, -st)
-    _angles(scr, k, trig + 2 * n2, top, ca, -sa)
-    _angles(scr, k, trig + 3 * n2, top, cg, sg)
-    _angles(scr, k, trig + 4 * n2, top, cb, sb)
-    # both bodies into the frame L, degree by degree (degree 0 is the mass; 1 is zero):
-    # one loop over the bodies and the two J products, so each helper has one call site
-    # (every call of a ti.func is inlined; compile time grows with the copies)
-    scr[k, sA] = rows[j, 0]
-    scr[k, sB] = rows[j, rowB]
+    cs = ti.Vector([cf, -sf, ct, -st, ca, -sa, cg, sg, cb, sb], ti.f64)
+    for a in ti.static(range(5)):
+        scr[k, trig + a * n2 + 1] = cs[2 * a]
+        scr[k, trig + a * n2 + top + 2] = cs[2 * a + 1]
+    for a in range(5):
+        o = trig + a * n2
+        c1 = scr[k, o + 1]
+        s1 = scr[k, o + top + 2]
+        scr[k, o] = 1.0
+        scr[k, o + top + 1] = 0.0
+        cm, sm = c1, s1
+        for m in range(2, top + 1):
+            cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
+            scr[k, o + m] = cm
+            scr[k, o + top + 1 + m] = sm
+    # both bodies into the frame L by their programs: the member's coefficients copied, then
+    # three passes (X; J then X; Jᵀ then X), one loop over the bodies and one over the passes
+    # so that each helper has one call site (every ti.func call is inlined; compile time
+    # grows with the copies)
     for body in range(2):
-        src0, dst0, deg, kmix, mask, z0, z1, z2 = 0, sA, dA, KA, mA, 0, 1, 2
-        if body == 1:
-            src0, dst0, deg, kmix, mask, z0, z1, z2 = rowB, sB, dB, KB, mB, 3, 4, -1
-        for l in range(2, deg + 1):
-            if (mask >> l) & 1:
-                _load(rows, j, src0 + l * l, scr, k, t1, l, trig + z0 * n2, top)
-                for which in range(2):                    # J, then Jᵀ
-                    full = which == 0 or l <= kmix
-                    src, dst, zs = t1, t2, z1
-                    if which == 1:
-                        src, dst, zs = t2, dst0 + l * l, z2
-                    _product(scr, k, src, dst, l, full, tab_i, tab_f, which)
-                    if zs >= 0:
-                        _zrot(scr, k, dst, l, l if full else 1, trig + zs * n2, top)
+        pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
+        src = tab_i[pg + _K.P_SRC]
+        dst = tab_i[pg + _K.P_DST]
+        scr[k, dst] = rows[j, src]                       # degree 0: the mass
+        o = tab_i[pg + _K.P_LOAD]
+        for e in range(tab_i[pg + _K.P_NLOAD]):
+            w = tab_i[o + e]
+            p = w & _MASK
+            q = (w >> _BITS) & _MASK
+            scr[k, t1 + p] = rows[j, src + p]
+            scr[k, t1 + q] = rows[j, src + q]
+        for step in range(3):
+            fields = ti.Vector([_K.P_NLOAD, _K.P_LOAD, _K.P_Z0, 0, 0])
+            vec, src_ = t1, t1
+            if step == 1:
+                fields = ti.Vector([_K.P_NX1, _K.P_X1, _K.P_Z1, _K.P_NJ, _K.P_J])
+                vec, src_ = t2, t1
+            elif step == 2:
+                fields = ti.Vector([_K.P_NX2, _K.P_X2, _K.P_Z2, _K.P_NJT, _K.P_JT])
+                vec, src_ = dst, t2
+            if step > 0:                                 # the J (or Jᵀ) rows into vec
+                _rows(scr, k, tab_i, tab_f, tab_i[pg + fields[3]], tab_i[pg + fields[4]], vec,
+                      src_)
+            _pairs(scr, k, tab_i, tab_i[pg + fields[0]], tab_i[pg + fields[1]], vec,
+                   trig + n2 * tab_i[pg + fields[2]], top)
+        acc0 = tab_i[pg + _K.P_ACC]
+        scr[k, acc0] = 0.0
+        o = tab_i[pg + _K.P_ROW]
+        for e in range(tab_i[pg + _K.P_NROW]):
+            scr[k, acc0 + tab_i[o + e]] = 0.0
     # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C
     inv_r = 1.0 / r
-    w = -G * inv_r
-    for q in range(N + 1):
-        scr[k, sw + q] = w                       # −G r^−(q+1)
-        w *= inv_r
-    for q in range((dA + 1) * (dA + 1)):
-        scr[k, sGA + q] = 0.0
-    for q in range((dB + 1) * (dB + 1)):
-        scr[k, sGB + q] = 0.0
-    op = tab_i[_K.K_I_PAIR]
+    wr = -G * inv_r
+    for q in range(tab_i[_K.K_NPOW]):
+        scr[k, sw + q] = wr                              # −G r^−(q+1)
+        wr *= inv_r
+    ot = tab_i[_K.K_I_TERM]
+    ok = tab_i[_K.K_F_TERM]
     U = 0.0
     dUdr = 0.0
-    for pi in range(tab_i[_K.K_NPAIR]):
-        l1 = tab_i[op + 3 * pi]
-        l2 = tab_i[op + 3 * pi + 1]
-        fo = tab_i[op + 3 * pi + 2]
-        mn = ti.min(l1, l2)
-        wl = scr[k, sw + l1 + l2]
-        e = 0.0
-        for a in range(4):
-            ia = l1 * l1 + _offset(l1, a)
-            ib = l2 * l2 + _offset(l2, a)
-            for i in range(_size(mn, a)):
-                kv = wl * tab_f[fo + i]
-                ca_ = scr[k, sA + ia + i]
-                cb_ = scr[k, sB + ib + i]
-                e += ca_ * kv * cb_
-                scr[k, sGA + ia + i] += kv * cb_
-                scr[k, sGB + ib + i] += kv * ca_
-            fo += _size(mn, a)
-        U += e
-        dUdr -= (l1 + l2 + 1) * e * inv_r
-    # torques in the frame L: x, y from the generators, z analytically (G_z C: m ↔ −m, × m)
-    ax, ay, bx, by = 0.0, 0.0, 0.0, 0.0
+    for e in range(tab_i[_K.K_NTERM]):
+        w = tab_i[ot + e]
+        ia = w & _MASK
+        ib = (w >> _BITS) & _MASK
+        Lt = w >> (2 * _BITS)
+        kv = scr[k, sw + Lt] * tab_f[ok + e]
+        a = scr[k, sA + ia]
+        b = scr[k, sB + ib]
+        u = a * kv * b
+        U += u
+        dUdr -= (Lt + 1) * u
+        scr[k, sGA + ia] += kv * b
+        scr[k, sGB + ib] += kv * a
+    dUdr *= inv_r
+    # torques in the frame L: x, y from the generators (4 entries per row), z of the
+    # secondary analytically ((G_z C)_±m = ∓m C_∓m), the primary's z opposite (along the
+    # line of centres (R × ∂U/∂R)_z = 0)
+    oc = tab_i[_K.K_I_GC]
+    of = tab_i[_K.K_F_G]
+    tau = ti.Matrix([[0.0, 0.0], [0.0, 0.0]], ti.f64)
     for body in range(2):
-        if body == 0:
-            ax, ay = _torque_xy(scr, k, sA, sGA, dA, KA, mA, tab_i, tab_f)
-        else:
-            bx, by = _torque_xy(scr, k, sB, sGB, dB, KB, mB, tab_i, tab_f)
+        pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
+        base = tab_i[pg + _K.P_DST]
+        acc0 = tab_i[pg + _K.P_ACC]
+        o = tab_i[pg + _K.P_ROW]
+        tx, ty = 0.0, 0.0
+        for e in range(tab_i[pg + _K.P_NROW]):
+            g = tab_i[o + e]
+            av = scr[k, acc0 + g]
+            wx = tab_i[oc + 2 * g]
+            wy = tab_i[oc + 2 * g + 1]
+            f = of + 4 * g
+            tx += av * (tab_f[f] * scr[k, base + (wx & _MASK)]
+                        + tab_f[f + 1] * scr[k, base + ((wx >> _BITS) & _MASK)])
+            ty += av * (tab_f[f + 2] * scr[k, base + (wy & _MASK)]
+                        + tab_f[f + 3] * scr[k, base + ((wy >> _BITS) & _MASK)])
+        tau[body, 0] = -tx
+        tau[body, 1] = -ty
     bz = 0.0
-    for l in range(2, KB + 1):
-        if (mB >> l) & 1:
-            n0, n1, n2_, _ = _sizes(l)
-            g = sGB + l * l
-            c = sB + l * l
-            for i in range(1, n0):             # m = 2i: cos-even i, sin-even i − 1
-                bz += 2 * i * (scr[k, g + i] * scr[k, c + n0 + n1 + i - 1]
-                               - scr[k, g + n0 + n1 + i - 1] * scr[k, c + i])
-            for i in range(n1):                # m = 2i + 1: cos-odd i, sin-odd i
-                bz += (2 * i + 1) * (scr[k, g + n0 + i] * scr[k, c + n0 + n1 + n2_ + i]
-                                     - scr[k, g + n0 + n1 + n2_ + i] * scr[k, c + n0 + i])
-    tauA = vec3(ax, ay, -bz)
-    tauB = vec3(bx, by, bz)
+    ob = tab_i[_K.K_I_BZ]
+    for e in range(tab_i[_K.K_NBZ]):
+        w = tab_i[ob + e]
+        gp = w & _MASK
+        gm = (w >> _BITS) & _MASK
+        bz += (w >> (2 * _BITS)) * (scr[k, sGB + gp] * scr[k, sB + gm] - scr[k, sGB + gm] * scr[k, sB + gp])
+    tauA = vec3(tau[0, 0], tau[0, 1], -bz)
+    tauB = vec3(tau[1, 0], tau[1, 1], bz)
     s = tauA + tauB
     dU = vec3(s[1] * inv_r, -s[0] * inv_r, dUdr)
     LT = L.transpose()

@@ -135,24 +135,27 @@ def test_host_harmonic_form_equals_the_cartesian_reference(rng, order, degrees):
 
 
 def test_tables_hold_the_matrices_and_rows_do_not_depend_on_their_neighbours(rng):
-    """The class blocks of the tables rebuild J_l and J_lᵀ exactly; an ellipsoid's odd
-    degrees are masked out and a cloud's are not; a member's coefficient row is bit for bit
-    the same alone and among other rows."""
-    tab = HT.tables(8, 8, 8)
-    K = __import__("ti_spinorbit.layout", fromlist=["harmonic"]).harmonic
-    for l in range(9):
-        sizes = [len(c) for c in HT.classes(l)]
-        off = np.concatenate([[0], np.cumsum(sizes)])
-        d = tab.ints[K.K_I_DEG] + K.DEG_WIDTH * l
-        for which, target in ((0, H.j_matrix(l)), (1, H.j_matrix(l).T)):
-            f = tab.ints[d + which]
+    """The primary's program (its J and Jᵀ rows: dense class blocks in chunks of
+    ``CHUNK`` columns) rebuilds J_l and J_lᵀ exactly, every row of a degree present, every
+    chunk inside its degree; an ellipsoid's odd degrees are masked out and a cloud's are
+    not; a member's coefficient row is bit for bit the same alone and among other rows."""
+    from ti_spinorbit.layout import harmonic as K
+    tab = HT.tables(12, 8, 8)                      # degrees <= 8 all in the mixed terms
+    pg, W = K.K_PROG_A, HT.CHUNK
+    for which, (nkey, okey) in enumerate(((K.P_NJ, K.P_J), (K.P_NJT, K.P_JT))):
+        n, o = tab.ints[pg + nkey], tab.ints[pg + okey]
+        packed = tab.ints[o:o + 2 * n].reshape(n, 2)         # (dst | src << 9 | add << 18, f)
+        mask = (1 << HT.BITS) - 1
+        entries = np.column_stack([packed[:, 0] & mask, (packed[:, 0] >> HT.BITS) & mask,
+                                   packed[:, 1], packed[:, 0] >> 2 * HT.BITS])
+        assert len(set(entries[:, 0])) == sum(2 * l + 1 for l in range(2, 9))
+        for l in range(2, 9):
             J = np.zeros((2 * l + 1, 2 * l + 1))
-            for a in range(4):
-                b = tab.ints[d + 2 + 4 * which + a]
-                n = sizes[a] * sizes[b]
-                J[off[a]:off[a + 1], off[b]:off[b + 1]] = tab.floats[f:f + n].reshape(
-                    sizes[a], sizes[b])
-                f += n
+            mine = entries[(entries[:, 0] >= l * l) & (entries[:, 0] < (l + 1) ** 2)]
+            assert np.all(mine[:, 1] >= l * l) and np.all(mine[:, 1] + W <= (l + 1) ** 2)
+            for dst, src, f, _ in mine:
+                J[dst - l * l, src - l * l:src - l * l + W] += tab.floats[f:f + W]
+            target = H.j_matrix(l) if which == 0 else H.j_matrix(l).T
             perm = HT.permutation(l)
             np.testing.assert_array_equal(J, target[np.ix_(perm, perm)])
     ell = MT.body_integrals(_Ell(), 6)

@@ -107,30 +107,31 @@ class multipole:
 class harmonic:
     """The order-N potential in harmonics (``ti_spinorbit.engine.harmonic_tables``,
     ``kernels/harmonic_gravity.py``): the positions of the header at the start of its integer
-    table. Sizes, table sections and per-member scratch offsets are read from it at run time,
-    so one compiled kernel serves every order and degree cap.
+    table. Every size, list and per-member scratch offset is read from it at run time, so one
+    compiled kernel serves every order, degree cap and degree mask.
 
     Within a degree l the 2l + 1 coefficients are stored by class: m = 0, 2, 4, ... (cos,
     even), m = 1, 3, ... (cos, odd), m = −2, −4, ... (sin, even), m = −1, −3, ... (sin, odd);
-    every J_l then maps each class to one class as a dense block, and a z-rotation pairs
-    equal positions of two classes (``harmonic_tables``)."""
+    every J_l then maps each class to one class as a dense block. The host turns the whole
+    evaluation into flat lists (a program per body), so the kernel is a few flat loops."""
 
-    (K_N,                  # truncation order
-     K_DA, K_DB,           # degree caps of the primary and the secondary
-     K_KA, K_KB,           # top degrees of each body in the mixed terms (min(d, N − 2))
-     K_TOP,                # max(dA, dB): the multiple angles and per-degree buffers
-     K_ROW_B,              # first column of the secondary in a coefficient row: (dA + 1)²
-     K_MASK_A, K_MASK_B,   # bit l set: the body's degree l is not zero for some member
-     K_NPAIR,              # the (l1, l2) interaction blocks
-     K_I_DEG,              # per degree: J and Jᵀ value offsets, then the input class of
-                           # each output class for J and for Jᵀ (DEG_WIDTH integers)
-     K_I_GC,               # generators about x and y: 4 columns per global row
-     K_I_PAIR,             # (l1, l2, offset of its 2 min(l1, l2) + 1 couplings) per block
-     K_F_G,                # generator values (4 per global row)
+    (K_ROW_B,              # first column of the secondary in a coefficient row: (dA + 1)²
+     K_NPOW,               # powers −G r^−(L+1) tabulated, L = 0..N
+     K_TOP,                # max(dA, dB, 1): the multiple angles' top order
+     K_NTERM, K_I_TERM, K_F_TERM,   # the interaction terms: (ia, ib, L) and K
+     K_NBZ, K_I_BZ,        # the secondary's z-torque pairs: (g+, g−, m)
+     K_I_GC, K_F_G,        # generators about x and y: 4 columns, 4 values per global row
      K_S_A, K_S_B, K_S_GA, K_S_GB, K_S_T1, K_S_T2, K_S_TRIG, K_S_W,   # scratch offsets
      K_SCRATCH,            # scratch columns per member
-     KHEAD) = range(24)
-    DEG_WIDTH = 10
+     K_PROG_A) = range(20)  # the primary's program; the secondary's PROGRAM_WIDTH after
+    # fields of a body's program: count and integer offset of each list (load pairs
+    # (p, q, m); J rows (dst, src, columns, value offset); pairs (p, q, m) on the J output;
+    # Jᵀ rows; pairs on the final coefficients; the rows its torque reads, zeroed first),
+    # then its row offset, its scratch regions (coefficients, ∂U/∂C) and angle slots (−1: none)
+    (P_NLOAD, P_LOAD, P_NJ, P_J, P_NX1, P_X1, P_NJT, P_JT, P_NX2, P_X2, P_NROW, P_ROW,
+     P_SRC, P_DST, P_ACC, P_Z0, P_Z1, P_Z2, PROGRAM_WIDTH) = range(19)
+    K_PROG_B = K_PROG_A + PROGRAM_WIDTH
+    KHEAD = K_PROG_B + PROGRAM_WIDTH
 
 
 class perturbation:

@@ -13,15 +13,20 @@ What the kernels need from the host:
   secondary's of 0..dB, scaled) turned into harmonic coefficients, degree l at columns
   l² .. l² + 2l of each body in class order (``layout.harmonic``: cos even, cos odd, sin
   even, sin odd), the secondary after (dA + 1)² columns;
-* **integer table**: the header of ``ti_spinorbit.layout.harmonic``, then per degree the
-  offsets of J_l and J_lᵀ in the float table and, for each output class, the one input class
-  its dense block reads (about a quarter of each degree's (2l+1)² entries is non-zero, all
-  inside these blocks: checked when the tables are built), the generators about x and y as
-  exactly two (column, value) pairs per row (padded with a zero), and the interaction blocks
-  (l1, l2, offset of the couplings) with l1 ≤ dA, l2 ≤ dB, l1 + l2 ≤ N, neither 1 (first
-  moments vanish about the centres of mass) nor a degree the masks leave out;
-* **float table**: the dense blocks of J and Jᵀ (row-major, output classes in order), the
-  generators' values and the couplings K_{l1 l2}[m, m] for |m| ≤ min(l1, l2), in class order.
+* **integer table**: the header of ``ti_spinorbit.layout.harmonic`` and, per body, a
+  program of flat lists that the kernel walks in order: the pairs (p, q, m) that load the
+  member's coefficients turned by the first z-rotation, the rows of J (destination, source,
+  columns, value offset: each output class of J_l reads one input class as a dense block,
+  about a quarter of the degree's (2l+1)² entries, all others zero, checked when the tables
+  are built), the pairs of the next z-rotation, the rows of Jᵀ, the pairs of the last
+  z-rotation (the primary's), and the rows of ∂U/∂C the torque reads; then the interaction
+  terms (ia, ib, l1 + l2) for l1 ≤ dA, l2 ≤ dB, l1 + l2 ≤ N, neither 1 (first moments vanish
+  about the centres of mass) nor a masked degree, |m| ≤ min(l1, l2); the secondary's
+  z-torque pairs; the generators about x and y, two (column, value) pairs per global row.
+  Degrees above the mixed terms' (l > min(d, N − 2)) meet only the other body's monopole:
+  their Jᵀ rows and last pairs are those of m = 0, ±1 only;
+* **float table**: the dense blocks of J and Jᵀ, the generators' values and the couplings
+  K_{l1 l2}[m, m] of the terms.
 
 Every member walks the same tables in the same order, so threads never diverge; one compiled
 kernel serves every order and degree cap (``layout.multipole.KERNEL_ORDER``).
@@ -98,75 +103,187 @@ class HarmonicTables:
 ALL_DEGREES = (1 << (MAX_ORDER + 1)) - 1
 
 
+#: Columns per chunk of a J row: a row of a dense class block (at most 7 columns, at degree
+#: 12) is one or two chunks of fixed width, a loop-free 4-term product in the kernel
+#: (measured faster than a loop over the row's columns, whose length is 1 to 7).
+CHUNK = 4
+
+
+#: Bits of a position in a packed table entry: positions within a body's region are below
+#: (MAX_ORDER + 1)² = 289 < 2⁹. Entries of three small fields are one int32 (a | b << 9 |
+#: c << 18), one load in the kernel instead of three.
+BITS = 9
+
+
+def pack(a, b, c=0):
+    """One int32 holding a, b (< 2⁹) and c (< 2¹³)."""
+    if not (0 <= a < 1 << BITS and 0 <= b < 1 << BITS and 0 <= c < 1 << 13):
+        raise AssertionError(f"table entry ({a}, {b}, {c}) does not pack")
+    return a | (b << BITS) | (c << 2 * BITS)
+
+
+def position(l, m):
+    """Position of order m within degree l in class storage order."""
+    n0, n1, n2 = l // 2 + 1, (l + 1) // 2, l // 2
+    if m >= 0:
+        return m // 2 if m % 2 == 0 else n0 + (m - 1) // 2
+    return n0 + n1 + (-m // 2 - 1) if m % 2 == 0 else n0 + n1 + n2 + (-m - 1) // 2
+
+
 @lru_cache(maxsize=32)
 def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES) -> HarmonicTables:
     """The harmonic tables of the order-``order`` potential with degree caps
     (``degree_a``, ``degree_b``), built once per process (module docstring). ``mask_a``,
     ``mask_b``: bit l clear when that body's degree-l coefficients are zero for every member
     (:func:`degree_mask`; e.g. the odd degrees of ellipsoids), so its rotation and its terms
-    are skipped."""
+    are left out."""
     N, dA, dB = int(order), int(degree_a), int(degree_b)
     if not 0 <= N <= MAX_ORDER or not 0 <= dA <= N or not 0 <= dB <= N:
         raise ValueError(f"tables need 0 <= degrees <= order <= {MAX_ORDER} (got order {N}, "
                          f"degrees ({dA}, {dB}))")
     top = max(dA, dB, 1)
+    masks = (int(mask_a), int(mask_b))
     ints, floats = [0] * _K.KHEAD, []
     head = ints
-    deg = []
-    for l in range(top + 1):
-        entry = []
-        ins = []
-        for M in (_hm.j_matrix(l), _hm.j_matrix(l).T):
-            entry.append(len(floats))
-            for b, block in _blocks(M, l):
-                ins.append(b)
-                floats += [float(v) for v in block.ravel()]
-        deg += entry + ins
-    head[_K.K_I_DEG] = len(ints)
-    ints += deg
+
+    def put(values):
+        start = len(ints)
+        ints.extend(int(v) for v in values)
+        return start
+
+    # the dense class blocks of J_l and J_lᵀ, once for every degree the bodies use; the
+    # programs' rows read them again as padded chunks (after the program is built)
+    block_at = {}
+    chunks = []
+    for l in range(2, top + 1):
+        for which, M in ((0, _hm.j_matrix(l)), (1, _hm.j_matrix(l).T)):
+            entry = []
+            for b, blk in _blocks(M, l):
+                entry.append((b, len(floats), blk.shape[1]))
+                floats += [float(v) for v in blk.ravel()]
+            block_at[(l, which)] = entry
+    # the generators about x and y: two (column, value) pairs per global row l² + position
     gcols, gvals = [], []
     for l in range(top + 1):
         G = _hm.generators(l)
-        perm = permutation(l)
-        pos = np.argsort(perm)                    # natural index -> class position
-        for i in perm:
+        pos = np.argsort(permutation(l))          # natural index -> class position
+        for i in permutation(l):
             for k in (0, 1):
                 nz = [int(c) for c in np.nonzero(G[k][i])[0]]
                 if len(nz) > 2:
                     raise AssertionError(f"generator {k} of degree {l} has {len(nz)} entries "
                                          f"in row {i}")
                 gvals += [float(G[k][i, c]) for c in nz] + [0.0] * (2 - len(nz))
-                gcols += [int(pos[c]) for c in nz] + [int(pos[i])] * (2 - len(nz))
-    head[_K.K_I_GC] = len(ints)
-    ints += gcols
+                cols = [l * l + int(pos[c]) for c in nz] + [l * l + int(pos[i])] * (2 - len(nz))
+                gcols.append(pack(*cols))
+    head[_K.K_I_GC] = put(gcols)
     head[_K.K_F_G] = len(floats)
     floats += gvals
-    pairs = []
+
+    offset = 0
+    regions = {}
+    for key, size in ((_K.K_S_A, (dA + 1) ** 2), (_K.K_S_B, (dB + 1) ** 2),
+                      (_K.K_S_GA, (dA + 1) ** 2), (_K.K_S_GB, (dB + 1) ** 2),
+                      (_K.K_S_T1, (top + 1) ** 2), (_K.K_S_T2, (top + 1) ** 2),
+                      (_K.K_S_TRIG, 10 * (top + 1)), (_K.K_S_W, N + 2)):
+        head[key] = regions[key] = offset
+        offset += size
+    head[_K.K_SCRATCH] = offset
+
+    # each body's program: its degrees 2..d that are not masked out; degrees above the mixed
+    # terms' (l > min(d, N − 2)) only m = 0, ±1 in the last product
+    for body, (d, src, dst, acc, slots) in enumerate((
+            (dA, 0, regions[_K.K_S_A], regions[_K.K_S_GA], (0, 1, 2)),
+            (dB, (dA + 1) ** 2, regions[_K.K_S_B], regions[_K.K_S_GB], (3, 4, -1)))):
+        kmix = min(d, N - 2)
+        lists = {name: [] for name in ("load", "j", "x1", "jt", "x2", "row")}
+
+        def blk_row(fo, i, nb):
+            return floats[fo + i * nb:fo + (i + 1) * nb]
+        for l in range(2, d + 1):
+            if not (masks[body] >> l) & 1:
+                continue
+            full = l <= kmix
+            base = l * l
+            pairs = [(base + position(l, m), base + position(l, -m), m) if m else
+                     (base, base, 0) for m in range(l + 1)]
+            lists["load"] += pairs
+            sizes = [len(c) for c in classes(l)]
+            off = np.concatenate([[0], np.cumsum(sizes)])
+            for which, name in ((0, "j"), (1, "jt")):
+                for a, (b, fo, nb) in enumerate(block_at[(l, which)]):
+                    rows = sizes[a] if which == 0 or full else (0 if a == 2 else min(sizes[a], 1))
+                    for i in range(rows):
+                        # a row in chunks of CHUNK columns: (destination, source, chunk
+                        # weights, accumulate). A chunk reads CHUNK consecutive entries of
+                        # this degree only (2l + 1 >= 5), shifted back at the degree's end,
+                        # with zero weights where it overlaps other columns: it reads only
+                        # entries this evaluation has written
+                        row = blk_row(fo, i, nb)
+                        for c0 in range(0, max(nb, 1), CHUNK):
+                            st = min(off[b] + c0, 2 * l + 1 - CHUNK)
+                            w = [row[st + q - off[b]] if c0 <= st + q - off[b] < min(c0 + CHUNK, nb)
+                                 else 0.0 for q in range(CHUNK)]
+                            lists[name].append((base + off[a] + i, base + st, len(chunks),
+                                                int(c0 > 0)))
+                            chunks.append(w)
+            lists["x1"] += pairs[1:]
+            lists["x2"] += pairs[1:] if full else pairs[1:2]
+            lists["row"] += range(base, base + (2 * l + 1 if full else 1))
+        prog = [0] * _K.PROGRAM_WIDTH
+        for nkey, okey, name in ((_K.P_NLOAD, _K.P_LOAD, "load"), (_K.P_NJ, _K.P_J, "j"),
+                                 (_K.P_NX1, _K.P_X1, "x1"), (_K.P_NJT, _K.P_JT, "jt"),
+                                 (_K.P_NX2, _K.P_X2, "x2"), (_K.P_NROW, _K.P_ROW, "row")):
+            items = lists[name]
+            prog[nkey] = len(items)
+            if name in ("load", "x1", "x2"):              # (p, q, m): one int
+                packed = [pack(*it) for it in items]
+            elif name in ("j", "jt"):                       # (dst, src, chunk, add): two
+                packed = [v for d, s_, c, add in items for v in (pack(d, s_, add), c)]
+            else:
+                packed = list(items)
+            prog[okey] = put(packed)
+        if slots[2] < 0:
+            prog[_K.P_NX2] = 0
+        prog[_K.P_SRC], prog[_K.P_DST], prog[_K.P_ACC] = src, dst, acc
+        prog[_K.P_Z0], prog[_K.P_Z1], prog[_K.P_Z2] = slots
+        at = _K.K_PROG_A if body == 0 else _K.K_PROG_B
+        head[at:at + _K.PROGRAM_WIDTH] = prog
+
+    # the chunk weights: rows referred to them by index, now by float offset
+    chunk0 = len(floats)
+    for c in chunks:
+        floats += c
+    for at in (_K.K_PROG_A, _K.K_PROG_B):
+        for nkey, okey in ((_K.P_NJ, _K.P_J), (_K.P_NJT, _K.P_JT)):
+            o = head[at + okey]
+            for e in range(head[at + nkey]):
+                ints[o + 2 * e + 1] = chunk0 + CHUNK * ints[o + 2 * e + 1]
+    # the interaction terms (ia, ib, L) with their couplings, and the z-torque pairs
+    terms, kvals = [], []
     for l1 in range(dA + 1):
         for l2 in range(min(dB, N - l1) + 1):
-            if l1 == 1 or l2 == 1 or not (mask_a >> l1) & 1 or not (mask_b >> l2) & 1:
+            if l1 == 1 or l2 == 1 or not (masks[0] >> l1) & 1 or not (masks[1] >> l2) & 1:
                 continue
             K = _hm.coupling(l1, l2)
             mn = min(l1, l2)
-            pairs += [l1, l2, len(floats)]
-            # the couplings of |m| <= mn in class order of the smaller degree's classes
-            floats += [float(K[l1 + m, l2 + m]) for cls in classes(mn) for m in cls]
-    head[_K.K_I_PAIR] = len(ints)
-    ints += pairs
-    head[_K.K_N], head[_K.K_DA], head[_K.K_DB] = N, dA, dB
-    head[_K.K_KA], head[_K.K_KB] = min(dA, N - 2), min(dB, N - 2)
-    head[_K.K_TOP] = top
+            for m in range(-mn, mn + 1):
+                terms.append(pack(l1 * l1 + position(l1, m), l2 * l2 + position(l2, m), l1 + l2))
+                kvals.append(float(K[l1 + m, l2 + m]))
+    head[_K.K_NTERM] = len(kvals)
+    head[_K.K_I_TERM] = put(terms)
+    head[_K.K_F_TERM] = len(floats)
+    floats += kvals
+    bz = []
+    for l in range(2, min(dB, N - 2) + 1):
+        if (masks[1] >> l) & 1:
+            bz += [pack(l * l + position(l, m), l * l + position(l, -m), m)
+                   for m in range(1, l + 1)]
+    head[_K.K_NBZ] = len(bz)
+    head[_K.K_I_BZ] = put(bz)
     head[_K.K_ROW_B] = (dA + 1) ** 2
-    head[_K.K_MASK_A], head[_K.K_MASK_B] = int(mask_a) & ALL_DEGREES, int(mask_b) & ALL_DEGREES
-    head[_K.K_NPAIR] = len(pairs) // 3
-    offset = 0
-    for key, size in ((_K.K_S_A, (dA + 1) ** 2), (_K.K_S_B, (dB + 1) ** 2),
-                      (_K.K_S_GA, (dA + 1) ** 2), (_K.K_S_GB, (dB + 1) ** 2),
-                      (_K.K_S_T1, 2 * top + 1), (_K.K_S_T2, 2 * top + 1),
-                      (_K.K_S_TRIG, 10 * (top + 1)), (_K.K_S_W, N + 2)):
-        head[key] = offset
-        offset += size
-    head[_K.K_SCRATCH] = offset
+    head[_K.K_NPOW] = N + 1
+    head[_K.K_TOP] = top
     ints_arr = np.array(ints, dtype=np.int32)
     floats_arr = np.array(floats + [0.0], dtype=np.float64)     # never empty
     ints_arr.setflags(write=False)
