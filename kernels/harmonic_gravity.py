@@ -131,34 +131,36 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
             cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
             scr[k, o + m] = cm
             scr[k, o + top + 1 + m] = sm
-    # both bodies into the frame L by their programs: the member's coefficients copied, then
-    # three passes (X; J then X; Jᵀ then X), one loop over the bodies and one over the passes
-    # so that each helper has one call site (every ti.func call is inlined; compile time
-    # grows with the copies)
+    # both bodies into the frame L by their programs: the member's coefficients read with
+    # the first z-rotation, then two passes (J then X; Jᵀ then X), in one loop over the
+    # bodies and one over the passes, so that each helper has one call site (every ti.func
+    # call is inlined; compile time grows with the copies)
     for body in range(2):
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         src = tab_i[pg + _K.P_SRC]
         dst = tab_i[pg + _K.P_DST]
         scr[k, dst] = rows[j, src]                       # degree 0: the mass
+        # the member's coefficients, turned by the first z-rotation as they are read
         o = tab_i[pg + _K.P_LOAD]
+        z0 = trig + n2 * tab_i[pg + _K.P_Z0]
         for e in range(tab_i[pg + _K.P_NLOAD]):
             w = tab_i[o + e]
             p = w & _MASK
             q = (w >> _BITS) & _MASK
-            scr[k, t1 + p] = rows[j, src + p]
-            scr[k, t1 + q] = rows[j, src + q]
-        for step in range(3):
-            fields = ti.Vector([_K.P_NLOAD, _K.P_LOAD, _K.P_Z0, 0, 0])
-            vec, src_ = t1, t1
-            if step == 1:
-                fields = ti.Vector([_K.P_NX1, _K.P_X1, _K.P_Z1, _K.P_NJ, _K.P_J])
-                vec, src_ = t2, t1
-            elif step == 2:
+            m = w >> (2 * _BITS)
+            c = scr[k, z0 + m]
+            s_ = scr[k, z0 + top + 1 + m]
+            a = rows[j, src + p]
+            b = rows[j, src + q]
+            scr[k, t1 + p] = c * a - s_ * b
+            scr[k, t1 + q] = s_ * a + c * b
+        for step in range(1, 3):
+            fields = ti.Vector([_K.P_NX1, _K.P_X1, _K.P_Z1, _K.P_NJ, _K.P_J])
+            vec, src_ = t2, t1
+            if step == 2:
                 fields = ti.Vector([_K.P_NX2, _K.P_X2, _K.P_Z2, _K.P_NJT, _K.P_JT])
                 vec, src_ = dst, t2
-            if step > 0:                                 # the J (or Jᵀ) rows into vec
-                _rows(scr, k, tab_i, tab_f, tab_i[pg + fields[3]], tab_i[pg + fields[4]], vec,
-                      src_)
+            _rows(scr, k, tab_i, tab_f, tab_i[pg + fields[3]], tab_i[pg + fields[4]], vec, src_)
             _pairs(scr, k, tab_i, tab_i[pg + fields[0]], tab_i[pg + fields[1]], vec,
                    trig + n2 * tab_i[pg + fields[2]], top)
         acc0 = tab_i[pg + _K.P_ACC]
