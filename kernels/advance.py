@@ -56,7 +56,7 @@ from .tableau import CASH_KARP, DEFAULT_METHOD, METHODS, check_method
 NEWTON_MAX_ITER = DEFAULT_CONTROLLER.event_max_iter
 #: Orders up to this one use the hand-written potential; the kernels take
 #: ``KERNEL_ORDER`` as their ``order`` template for every order above it (the tables carry
-#: the true order: ``kernels/multipole_gravity.py``).
+#: the true order: ``kernels/harmonic_gravity.py``).
 HAND_WRITTEN_MAX, KERNEL_ORDER = _MP.HAND_WRITTEN_MAX, _MP.KERNEL_ORDER
 #: Largest stage matrix (stages x state components) kept in registers with unrolled
 #: component loops: Cash-Karp planar (6 x 10). Larger ones (Cash-Karp 3-D 6 x 30, DOP853

@@ -154,15 +154,16 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
             b = rows[j, src + q]
             scr[k, t1 + p] = c * a - s_ * b
             scr[k, t1 + q] = s_ * a + c * b
-        for step in range(1, 3):
-            fields = ti.Vector([_K.P_NX1, _K.P_X1, _K.P_Z1, _K.P_NJ, _K.P_J])
-            vec, src_ = t2, t1
+        for step in range(1, 3):                         # J then X; Jᵀ then X
+            nrow, orow, npair, opair, slot, vec, src_ = (
+                tab_i[pg + _K.P_NJ], tab_i[pg + _K.P_J], tab_i[pg + _K.P_NX1],
+                tab_i[pg + _K.P_X1], tab_i[pg + _K.P_Z1], t2, t1)
             if step == 2:
-                fields = ti.Vector([_K.P_NX2, _K.P_X2, _K.P_Z2, _K.P_NJT, _K.P_JT])
-                vec, src_ = dst, t2
-            _rows(scr, k, tab_i, tab_f, tab_i[pg + fields[3]], tab_i[pg + fields[4]], vec, src_)
-            _pairs(scr, k, tab_i, tab_i[pg + fields[0]], tab_i[pg + fields[1]], vec,
-                   trig + n2 * tab_i[pg + fields[2]], top)
+                nrow, orow, npair, opair, slot, vec, src_ = (
+                    tab_i[pg + _K.P_NJT], tab_i[pg + _K.P_JT], tab_i[pg + _K.P_NX2],
+                    tab_i[pg + _K.P_X2], tab_i[pg + _K.P_Z2], dst, t2)
+            _rows(scr, k, tab_i, tab_f, nrow, orow, vec, src_)
+            _pairs(scr, k, tab_i, npair, opair, vec, trig + n2 * slot, top)
         acc0 = tab_i[pg + _K.P_ACC]
         scr[k, acc0] = 0.0
         o = tab_i[pg + _K.P_ROW]
@@ -197,7 +198,7 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     # line of centres (R × ∂U/∂R)_z = 0)
     oc = tab_i[_K.K_I_GC]
     of = tab_i[_K.K_F_G]
-    tau = ti.Matrix([[0.0, 0.0], [0.0, 0.0]], ti.f64)
+    ax, ay, bx, by = 0.0, 0.0, 0.0, 0.0
     for body in range(2):
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         base = tab_i[pg + _K.P_DST]
@@ -214,8 +215,10 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
                         + tab_f[f + 1] * scr[k, base + ((wx >> _BITS) & _MASK)])
             ty += av * (tab_f[f + 2] * scr[k, base + (wy & _MASK)]
                         + tab_f[f + 3] * scr[k, base + ((wy >> _BITS) & _MASK)])
-        tau[body, 0] = -tx
-        tau[body, 1] = -ty
+        if body == 0:
+            ax, ay = -tx, -ty
+        else:
+            bx, by = -tx, -ty
     bz = 0.0
     ob = tab_i[_K.K_I_BZ]
     for e in range(tab_i[_K.K_NBZ]):
@@ -223,8 +226,8 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
         gp = w & _MASK
         gm = (w >> _BITS) & _MASK
         bz += (w >> (2 * _BITS)) * (scr[k, sGB + gp] * scr[k, sB + gm] - scr[k, sGB + gm] * scr[k, sB + gp])
-    tauA = vec3(tau[0, 0], tau[0, 1], -bz)
-    tauB = vec3(tau[1, 0], tau[1, 1], bz)
+    tauA = vec3(ax, ay, -bz)
+    tauB = vec3(bx, by, bz)
     s = tauA + tauB
     dU = vec3(s[1] * inv_r, -s[0] * inv_r, dUdr)
     LT = L.transpose()

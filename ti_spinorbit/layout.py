@@ -75,9 +75,9 @@ class planar:
 
 
 class multipole:
-    """The order-N mutual potential's tables (``ti_spinorbit.engine.multipole_tables``,
-    ``kernels/multipole_gravity.py``): the positions of the header at the start of the
-    integer table. Every other position (table sections, per-member scratch offsets) is read
+    """The order-N mutual potential's Cartesian tables (``ti_spinorbit.engine.multipole_tables``,
+    ``kernels/multipole_gravity.py``, the kernels' independent check; the integrators use
+    :class:`harmonic`'s): the positions of the header at the start of the integer table. Every other position (table sections, per-member scratch offsets) is read
     from this header at run time, so the kernels hold no size of their own."""
 
     #: Highest truncation order the tables and the kernels accept (the host reference's).

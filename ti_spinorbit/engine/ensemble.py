@@ -154,8 +154,8 @@ class Ensemble:
         Initial scaled states (``BinarySystem.initial_state``).
     order : int
         Truncation order of the mutual potential: 0 or 2 to 16. Up to 4 the hand-written
-        kernels; above 4 the table-driven ones (``kernels/multipole_gravity.py``), which
-        need ``multipole_rows``.
+        kernels; above 4 the table-driven harmonic ones (``kernels/harmonic_gravity.py``),
+        which need ``multipole_rows``.
     rtol, atol : float
         Tolerances on the scaled state (error in tolerance units, max norm).
     model : {"auto", "planar", "3d"}

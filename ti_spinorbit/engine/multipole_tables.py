@@ -1,7 +1,11 @@
 """Tables of the order-N mutual potential, built once on the host per (order, degree caps,
 odd terms), and the per-member integral rows that go with them (NumPy only).
 
-The kernels (``kernels/multipole_gravity.py``) evaluate the mutual potential, the force and
+The integral rows are what every order-N run carries (member tables, checkpoints, results);
+:class:`Multipole` turns them into the harmonic coefficient rows and tables the integrators
+use (``harmonic_tables``, ``kernels/harmonic_gravity.py``, docs/physics.md §3.8a). The
+Cartesian tables below serve the kernels' independent check, ``kernels/multipole_gravity.py``
+(:meth:`Multipole.cartesian_arguments`), which evaluates the mutual potential, the force and
 both torques of two rigid bodies at any truncation order N by walking these tables at run
 time: every member walks the same entries in the same order, so no thread diverges, and no
 term is unrolled at compile time, so one compiled kernel serves every order above 4
