@@ -66,17 +66,21 @@ def _pairs(scr: ti.template(), k, tab_i: ti.template(), n, o, v, trig, top):
 
 @ti.func
 def _rows(scr: ti.template(), k, tab_i: ti.template(), tab_f: ti.template(), n, o, dst, src):
-    """Dense block rows in chunks ((destination, source, accumulate) packed, weights): four
-    products each, the weights past a row's end zero (``harmonic_tables.CHUNK``)."""
+    """Dense block rows in chunks ((destination, source, flag) packed, weights): four
+    products each, the weights past a row's end zero (``harmonic_tables.CHUNK``); flag 0
+    stores the sum, 1 adds it, 2 stores a zero (a class known to be zero)."""
     for e in range(n):
         w = tab_i[o + 2 * e]
-        s0 = src + ((w >> _BITS) & _MASK)
-        f = tab_i[o + 2 * e + 1]
-        acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
-               + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
+        flag = w >> (2 * _BITS)
         d = dst + (w & _MASK)
-        if w >> (2 * _BITS):
-            acc += scr[k, d]
+        acc = 0.0
+        if flag != 2:
+            s0 = src + ((w >> _BITS) & _MASK)
+            f = tab_i[o + 2 * e + 1]
+            acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
+                   + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
+            if flag == 1:
+                acc += scr[k, d]
         scr[k, d] = acc
 
 
@@ -87,7 +91,6 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     order and degree caps the tables were built for; member j's coefficient row
     (``rows[j]``), slot k's scratch (``scr[k]``)."""
     top = tab_i[_K.K_TOP]
-    t1 = tab_i[_K.K_S_T1]
     t2 = tab_i[_K.K_S_T2]
     trig = tab_i[_K.K_S_TRIG]
     sw = tab_i[_K.K_S_W]
@@ -139,6 +142,7 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         src = tab_i[pg + _K.P_SRC]
         dst = tab_i[pg + _K.P_DST]
+        t1 = tab_i[pg + _K.P_T1]
         scr[k, dst] = rows[j, src]                       # degree 0: the mass
         # the member's coefficients, turned by the first z-rotation as they are read
         o = tab_i[pg + _K.P_LOAD]

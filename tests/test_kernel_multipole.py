@@ -150,6 +150,55 @@ def test_kernel_at_degenerate_angles(rng, order):
                                                       * np.linalg.norm(ref[1])), k
 
 
+@pytest.mark.parametrize("pair", ["cloud-ellipsoid", "ellipsoid-cloud"])
+def test_kernel_with_one_mirror_symmetric_body(rng, pair):
+    """A lumpy body beside an ellipsoid: the ellipsoid's program skips its odd degrees and
+    orders (the tables' masks), the other's does not, and the two share the kernel's
+    buffers; the result still equals the reference to 1e-13."""
+    TA, TB, contact = cloud_pair(rng, 8)
+    EA, EB, _ = ellipsoid_pair(8)
+    if pair == "cloud-ellipsoid":
+        TB = {k: v * 0.1 / EB[(0, 0, 0)] for k, v in EB.items()}
+    else:
+        TA = EA
+    R, S = configurations(rng, 1.6)
+    got = kernel(TA, TB, R, S, 8)
+    for k in range(len(R)):
+        ref = reference(TA, TB, R[k], S[k], 8)
+        for g, r in zip(got[:2] + got[3:], ref[:2] + ref[3:]):
+            assert relative(g[k], r) <= TOL, k
+
+
+@pytest.mark.parametrize("symmetric", ["primary", "secondary"])
+def test_a_failed_state_leaves_nothing_in_the_scratch(rng, symmetric):
+    """A non-finite state evaluated in a slot does not change what the next state evaluated
+    in that slot gives (every scratch entry the kernel reads was written by the same
+    evaluation or never written at all; the chunks of the J rows read only their own
+    degree; each body has its own first buffer, so the lumpy body's entries never reach the
+    ellipsoid's skipped ones)."""
+    from ti_spinorbit.kernels import harmonic_gravity as K
+
+    TA, TB, contact = cloud_pair(rng, 8)
+    EA, EB, _ = ellipsoid_pair(8)
+    if symmetric == "secondary":
+        TB = {k: v * 0.1 / EB[(0, 0, 0)] for k, v in EB.items()}  # masked classes too
+    else:
+        TA = EA
+    R, S = configurations(rng, contact, n=1)
+    row = np.concatenate([vector(TA, 8), vector(TB, 8)])[None]
+    mp = MT.Multipole(MT.tables(8, 8, 8, True), row)
+    rows, scr, ints, floats = mp.arguments(1)
+    fresh = np.zeros((1, 10))
+    K.evaluate_multipole(rows, R, S, scr.copy(), ints, floats, fresh, 1.0)
+    used = scr.copy()
+    bad = np.zeros((1, 10))
+    K.evaluate_multipole(rows, np.full((1, 3), np.nan), S, used, ints, floats, bad, 1.0)
+    assert np.all(np.isnan(bad))
+    after = np.zeros((1, 10))
+    K.evaluate_multipole(rows, R, S, used, ints, floats, after, 1.0)
+    np.testing.assert_array_equal(after, fresh)
+
+
 def test_conservation_identity_of_the_torques(rng):
     """R × F + τ_A + τ_B = 0 to round-off: the kernel takes τ_A from the identity, the
     reference computes it on its own, and the two agree (above), so the identity holds."""

@@ -107,6 +107,8 @@ ALL_DEGREES = (1 << (MAX_ORDER + 1)) - 1
 #: 12) is one or two chunks of fixed width, a loop-free 4-term product in the kernel
 #: (measured faster than a loop over the row's columns, whose length is 1 to 7).
 CHUNK = 4
+#: The third field of a J row: 0 store the chunk's sum, 1 add it, ZERO store a zero.
+ZERO = 2
 
 
 #: Bits of a position in a packed table entry: positions within a body's region are below
@@ -131,18 +133,23 @@ def position(l, m):
 
 
 @lru_cache(maxsize=32)
-def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES) -> HarmonicTables:
+def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, even_a=0,
+           even_b=0) -> HarmonicTables:
     """The harmonic tables of the order-``order`` potential with degree caps
     (``degree_a``, ``degree_b``), built once per process (module docstring). ``mask_a``,
     ``mask_b``: bit l clear when that body's degree-l coefficients are zero for every member
     (:func:`degree_mask`; e.g. the odd degrees of ellipsoids), so its rotation and its terms
-    are left out."""
+    are left out. ``even_a``, ``even_b``: bit l set when only the cos-even class of that
+    degree is non-zero in every member (:func:`even_mask`: a body with three mirror planes in
+    its frame, e.g. an ellipsoid), so the first z-rotation skips the odd orders and the first
+    J product stores zeros for the classes it would read from them."""
     N, dA, dB = int(order), int(degree_a), int(degree_b)
     if not 0 <= N <= MAX_ORDER or not 0 <= dA <= N or not 0 <= dB <= N:
         raise ValueError(f"tables need 0 <= degrees <= order <= {MAX_ORDER} (got order {N}, "
                          f"degrees ({dA}, {dB}))")
     top = max(dA, dB, 1)
     masks = (int(mask_a), int(mask_b))
+    evens = (int(even_a), int(even_b))
     ints, floats = [0] * _K.KHEAD, []
     head = ints
 
@@ -184,7 +191,7 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES) ->
     regions = {}
     for key, size in ((_K.K_S_A, (dA + 1) ** 2), (_K.K_S_B, (dB + 1) ** 2),
                       (_K.K_S_GA, (dA + 1) ** 2), (_K.K_S_GB, (dB + 1) ** 2),
-                      (_K.K_S_T1, (top + 1) ** 2), (_K.K_S_T2, (top + 1) ** 2),
+                      (_K.K_S_T1, 2 * (top + 1) ** 2), (_K.K_S_T2, (top + 1) ** 2),
                       (_K.K_S_TRIG, 10 * (top + 1)), (_K.K_S_W, N + 2)):
         head[key] = regions[key] = offset
         offset += size
@@ -192,9 +199,10 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES) ->
 
     # each body's program: its degrees 2..d that are not masked out; degrees above the mixed
     # terms' (l > min(d, N − 2)) only m = 0, ±1 in the last product
-    for body, (d, src, dst, acc, slots) in enumerate((
-            (dA, 0, regions[_K.K_S_A], regions[_K.K_S_GA], (0, 1, 2)),
-            (dB, (dA + 1) ** 2, regions[_K.K_S_B], regions[_K.K_S_GB], (3, 4, -1)))):
+    for body, (d, src, dst, acc, t1, slots) in enumerate((
+            (dA, 0, regions[_K.K_S_A], regions[_K.K_S_GA], regions[_K.K_S_T1], (0, 1, 2)),
+            (dB, (dA + 1) ** 2, regions[_K.K_S_B], regions[_K.K_S_GB],
+             regions[_K.K_S_T1] + (top + 1) ** 2, (3, 4, -1)))):
         kmix = min(d, N - 2)
         lists = {name: [] for name in ("load", "j", "x1", "jt", "x2", "row")}
 
@@ -204,16 +212,24 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES) ->
             if not (masks[body] >> l) & 1:
                 continue
             full = l <= kmix
+            even = bool((evens[body] >> l) & 1)
             base = l * l
             pairs = [(base + position(l, m), base + position(l, -m), m) if m else
                      (base, base, 0) for m in range(l + 1)]
-            lists["load"] += pairs
+            # only cos-even coefficients: after the first z-rotation only the cos-even and
+            # sin-even classes are non-zero (the odd orders' entries of the buffer are never
+            # written, so they stay zero)
+            lists["load"] += [p_ for p_ in pairs if not even or p_[2] % 2 == 0]
             sizes = [len(c) for c in classes(l)]
             off = np.concatenate([[0], np.cumsum(sizes)])
             for which, name in ((0, "j"), (1, "jt")):
                 for a, (b, fo, nb) in enumerate(block_at[(l, which)]):
                     rows = sizes[a] if which == 0 or full else (0 if a == 2 else min(sizes[a], 1))
                     for i in range(rows):
+                        if which == 0 and even and b in (1, 3):
+                            # reads the cos-odd or sin-odd class, zero here: store a zero
+                            lists[name].append((base + off[a] + i, base, 0, ZERO))
+                            continue
                         # a row in chunks of CHUNK columns: (destination, source, chunk
                         # weights, accumulate). A chunk reads CHUNK consecutive entries of
                         # this degree only (2l + 1 >= 5), shifted back at the degree's end,
@@ -245,7 +261,7 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES) ->
             prog[okey] = put(packed)
         if slots[2] < 0:
             prog[_K.P_NX2] = 0
-        prog[_K.P_SRC], prog[_K.P_DST], prog[_K.P_ACC] = src, dst, acc
+        prog[_K.P_SRC], prog[_K.P_DST], prog[_K.P_ACC], prog[_K.P_T1] = src, dst, acc, t1
         prog[_K.P_Z0], prog[_K.P_Z1], prog[_K.P_Z2] = slots
         at = _K.K_PROG_A if body == 0 else _K.K_PROG_B
         head[at:at + _K.PROGRAM_WIDTH] = prog
@@ -308,6 +324,18 @@ def coefficient_rows(rows, degree_a, degree_b):
     return out
 
 
+def even_mask(coefficient_rows_, degree, first=0):
+    """Bit l set when a body's degree-l coefficients are zero outside the cos-even class (the
+    first l // 2 + 1 of the degree in class order) in every row: a body with three mirror
+    planes in its frame (an ellipsoid; the projection keeps those zeros exact)."""
+    rows = np.asarray(coefficient_rows_)
+    mask = 0
+    for l in range(2, degree + 1):
+        if not np.any(rows[:, first + l * l + l // 2 + 1:first + (l + 1) ** 2] != 0.0):
+            mask |= 1 << l
+    return mask
+
+
 def degree_mask(coefficient_rows_, degree, first=0):
     """Bit l set when a body's degree-l coefficients (columns first + l² .. first + (l+1)² of
     the rows) are not all exactly zero for some row (an ellipsoid's odd degrees are: its odd
@@ -320,5 +348,5 @@ def degree_mask(coefficient_rows_, degree, first=0):
     return mask
 
 
-__all__ = ["HarmonicTables", "tables", "coefficient_rows", "degree_mask",
+__all__ = ["HarmonicTables", "tables", "coefficient_rows", "degree_mask", "even_mask",
            "classes", "permutation", "ALL_DEGREES"]

@@ -362,14 +362,17 @@ class Multipole:
     def harmonic(self):
         """(coefficient rows, harmonic tables) of the kernels (``harmonic_tables``): the rows
         in real solid harmonics, and tables that skip each body's degrees that are zero in
-        every row (an ellipsoid's odd degrees). Built on first use and kept."""
+        every row (an ellipsoid's odd degrees) and its classes that are (an ellipsoid's odd
+        orders). Built on first use and kept."""
         cached = self.__dict__.get("_harmonic")
         if cached is None:
             from . import harmonic_tables as _ht
             dA, dB = self.degrees
             rows = _ht.coefficient_rows(self.rows, dA, dB)
+            rB = (dA + 1) ** 2
             tab = _ht.tables(self.order, dA, dB, _ht.degree_mask(rows, dA),
-                             _ht.degree_mask(rows, dB, first=(dA + 1) ** 2))
+                             _ht.degree_mask(rows, dB, first=rB), _ht.even_mask(rows, dA),
+                             _ht.even_mask(rows, dB, first=rB))
             cached = (rows, tab)
             object.__setattr__(self, "_harmonic", cached)
         return cached
