@@ -35,6 +35,7 @@ memory
 
     python experiments/bench_orders.py                        # everything, ~10 min on 2 cores
     python experiments/bench_orders.py --sections rates --models 3d --orders 4 6 8
+    python experiments/bench_orders.py --sections rates --models 3d --orders 4 6 8 --rounds 3
     python experiments/bench_orders.py --quick                # N = 16, 0.2 s per point
     python experiments/bench_orders.py --pair radar --sections rates --orders 4 6 8 12
 """
@@ -149,27 +150,51 @@ def run(par, y0, rows, degrees, order, model, orbits):
             cpu / rhs * 1e9)
 
 
-def rates(models, orders, n, seconds):
+def rates(models, orders, n, seconds, rounds=1):
+    """The rate of every (model, order, caps) point; with ``rounds`` > 1 the points are
+    measured round after round (every point once per round) and each figure is the median
+    over the rounds, the ratio to order 4 taken within each round first (the machine may be
+    shared: a ratio of two runs minutes apart carries the load's changes)."""
+    points = [(model, order, caps) for model in models for order in orders
+              for caps in [None] + ([CAPS[order]] if order in CAPS else [])]
+    setup = {}
+    for model, order, caps in points:
+        par, y0, mp, degrees = members(n, order, caps)
+        run(par[:1], y0[:1], None if mp is None else mp[:1], degrees, order, model, 0.01)
+        rate, _, _ = run(par[:16], y0[:16], None if mp is None else mp[:16], degrees,
+                         order, model, 0.02)               # pilot: sizes the timed run
+        orbits = max(0.05, float(f"{seconds * rate / n:.2g}"))
+        setup[(model, order, caps)] = (par, y0, mp, degrees, orbits)
+    measured = {p: [] for p in points}
+    for rnd in range(rounds):
+        for point in points:
+            par, y0, mp, degrees, orbits = setup[point]
+            measured[point].append(run(par, y0, mp, degrees, point[1], point[0], orbits))
+            rate, steps, ns = measured[point][-1]
+            print(f"  {'' if rounds == 1 else f'round {rnd + 1}: '}{point[0]:6s} order "
+                  f"{point[1]:2d} degrees {str(degrees or (point[1],) * 2):8s} {rate:9.1f} "
+                  f"member-orbits/s, {steps:5.0f} steps/orbit, {ns:7.0f} ns per RHS (one "
+                  f"core), {orbits:g} orbits", flush=True)
     rows = []
-    for model in models:
-        for order in orders:
-            for caps in [None] + ([CAPS[order]] if order in CAPS else []):
-                par, y0, mp, degrees = members(n, order, caps)
-                run(par[:1], y0[:1], None if mp is None else mp[:1], degrees, order, model, 0.01)
-                rate, _, _ = run(par[:16], y0[:16], None if mp is None else mp[:16], degrees,
-                                 order, model, 0.02)           # pilot: sizes the timed run
-                orbits = max(0.05, float(f"{seconds * rate / n:.2g}"))
-                rate, steps, ns = run(par, y0, mp, degrees, order, model, orbits)
-                rows.append({"model": model, "order": order, "degrees": degrees or (order, order),
-                             "members": n, "orbits": orbits, "member_orbits_per_s": rate,
-                             "steps_per_orbit": steps, "cpu_ns_per_rhs": ns})
-                print(f"  {model:6s} order {order:2d} degrees {str(degrees or (order, order)):8s}"
-                      f" {rate:9.1f} member-orbits/s, {steps:5.0f} steps/orbit, "
-                      f"{ns:7.0f} ns per RHS (one core), {orbits:g} orbits", flush=True)
-    for r in rows:
-        four = [q for q in rows if q["model"] == r["model"] and q["order"] == 4]
-        r["ratio_to_order_4"] = r["member_orbits_per_s"] / four[0]["member_orbits_per_s"] \
-            if four else None
+    for point in points:
+        model, order, caps = point
+        par, y0, mp, degrees, orbits = setup[point]
+        four = (model, 4, None)
+        ratios = [m[0] / f[0] for m, f in zip(measured[point], measured[four])] \
+            if four in measured else None
+        rows.append({"model": model, "order": order, "degrees": degrees or (order, order),
+                     "members": n, "orbits": orbits, "rounds": rounds,
+                     "member_orbits_per_s": float(np.median([m[0] for m in measured[point]])),
+                     "steps_per_orbit": float(np.median([m[1] for m in measured[point]])),
+                     "cpu_ns_per_rhs": float(np.median([m[2] for m in measured[point]])),
+                     "ratio_to_order_4": float(np.median(ratios)) if ratios else None,
+                     "ratio_to_order_4_range": (min(ratios), max(ratios)) if ratios else None})
+        if rounds > 1:
+            r = rows[-1]
+            print(f"  median {model:6s} order {order:2d} degrees {str(r['degrees']):8s} "
+                  f"{r['member_orbits_per_s']:9.1f} member-orbits/s, {r['cpu_ns_per_rhs']:7.0f} "
+                  f"ns per RHS, ratio to order 4 {r['ratio_to_order_4'] or float('nan'):.4f}",
+                  flush=True)
     return rows
 
 
@@ -281,6 +306,9 @@ def main():
     ap.add_argument("--orders", nargs="+", type=int, default=list(ORDERS))
     ap.add_argument("--members", type=int, default=1024)
     ap.add_argument("--seconds", type=float, default=8.0)
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="measure every rate point this many times, round after round, and "
+                         "report medians (ratios to order 4 taken within each round)")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", default=None, help="JSON path (default: print only)")
     ap.add_argument("--pair", choices=("ellipsoid", "radar"), default="ellipsoid",
@@ -299,7 +327,8 @@ def main():
         report["memory"] = memory(args.orders)
     if "rates" in args.sections:
         print("rates", flush=True)
-        report["rates"] = rates(args.models, args.orders, args.members, args.seconds)
+        report["rates"] = rates(args.models, args.orders, args.members, args.seconds,
+                                args.rounds)
         for r in report["rates"]:
             if r["model"] == "3d" and r["order"] in TARGETS and r["degrees"] == (r["order"],) * 2 \
                     and r["ratio_to_order_4"] is not None:

@@ -1,5 +1,6 @@
 """Tables of the order-N mutual potential in real solid harmonics along the line of centres,
-built once per (order, degree caps) on the host, and the members' coefficient rows (NumPy).
+built once per (order, degree caps, masks) on the host, and the members' coefficient rows
+(NumPy).
 
 The kernels (``kernels/harmonic_gravity.py``) walk these tables; the formulation is that of
 ``ti_spinorbit.harmonics`` (its module docstring; docs/physics.md §3.8a), whose functions give
@@ -14,22 +15,33 @@ What the kernels need from the host:
   l² .. l² + 2l of each body in class order (``layout.harmonic``: cos even, cos odd, sin
   even, sin odd), the secondary after (dA + 1)² columns;
 * **integer table**: the header of ``ti_spinorbit.layout.harmonic`` and, per body, a
-  program of flat lists that the kernel walks in order: the pairs (p, q, m) that load the
-  member's coefficients turned by the first z-rotation, the rows of J (destination, source,
-  columns, value offset: each output class of J_l reads one input class as a dense block,
-  about a quarter of the degree's (2l+1)² entries, all others zero, checked when the tables
-  are built), the pairs of the next z-rotation, the rows of Jᵀ, the pairs of the last
-  z-rotation (the primary's), and the rows of ∂U/∂C the torque reads; then the interaction
-  terms (ia, ib, l1 + l2) for l1 ≤ dA, l2 ≤ dB, l1 + l2 ≤ N, neither 1 (first moments vanish
-  about the centres of mass) nor a masked degree, |m| ≤ min(l1, l2); the secondary's
-  z-torque pairs; the generators about x and y, two (column, value) pairs per global row.
-  Degrees above the mixed terms' (l > min(d, N − 2)) meet only the other body's monopole:
-  their Jᵀ rows and last pairs are those of m = 0, ±1 only;
-* **float table**: the dense blocks of J and Jᵀ, the generators' values and the couplings
-  K_{l1 l2}[m, m] of the terms.
+  program of flat lists that the kernel walks in order:
+
+  - the pairs (p, q, m) that load the member's coefficients turned by the first z-rotation;
+  - the rows of J as chunks of :data:`CHUNK` columns ((destination, source, flag) and a
+    weight offset): each output class of J_l reads one input class as a dense block, about
+    a quarter of the degree's (2l+1)² entries, all others zero (checked when the tables are
+    built); a chunk reads consecutive entries of its own degree only;
+  - the pairs of the second z-rotation, the rows of Jᵀ, the pairs of the last z-rotation
+    (the primary's only);
+  - the rows of ∂U/∂C that the torque reads (zeroed first);
+
+  then the interaction terms (ia, ib, l1 + l2) for l1 ≤ dA, l2 ≤ dB, l1 + l2 ≤ N, neither 1
+  (first moments vanish about the centres of mass) nor a masked degree, |m| ≤ min(l1, l2);
+  the secondary's z-torque pairs; the generators about x and y, two (column, value) pairs
+  per global row. Entries of three small fields are packed into one int32 (:func:`pack`);
+* **float table**: the dense blocks of J and Jᵀ, their chunks, the generators' values and
+  the couplings K_{l1 l2}[m, m] of the terms.
+
+What the programs leave out: degrees above the mixed terms' (l > min(d, N − 2)) meet only
+the other body's monopole, so their Jᵀ rows and last pairs are those of m = 0, ±1 only; a
+body's degrees that are zero in every member (:func:`degree_mask`: an ellipsoid's odd
+degrees) are skipped; for a body whose coefficients are cos-even only (:func:`even_mask`:
+three mirror planes, an ellipsoid) the first z-rotation skips the odd orders and the first
+J stores zeros for the classes it would read from them.
 
 Every member walks the same tables in the same order, so threads never diverge; one compiled
-kernel serves every order and degree cap (``layout.multipole.KERNEL_ORDER``).
+kernel serves every order, cap and mask (``layout.multipole.KERNEL_ORDER``).
 """
 
 from dataclasses import dataclass
