@@ -40,9 +40,13 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 
 
-def harmonic_kernel():
+def loop_kernel(potential, rotation):
+    """The benchmark loop over an order-N ``potential`` func (the kernels' signature): per
+    member i, ``rotation(i)`` as its attitude and a dependent chain of ``repeats``
+    evaluations (nothing hoisted); out[i] = the last [U, dU/dR, mu1, mu2] and the chain's
+    sum. bench_orders.py's ``split`` uses it too."""
     import taichi as ti
-    from ti_spinorbit.kernels.harmonic_gravity import mutual_h, vec3
+    from ti_spinorbit.kernels.mutual_gravity import vec3
 
     nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
     nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
@@ -53,11 +57,11 @@ def harmonic_kernel():
              repeats: ti.i32):
         for i in range(R_nd.shape[0]):
             R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])
-            S = _rotation(i)
+            S = rotation(i)
             acc = 0.0
-            U, dU, m1, m2 = mutual_h(rows, i, scr, i, ints, floats, 1.0, R, S)
+            U, dU, m1, m2 = potential(rows, i, scr, i, ints, floats, 1.0, R, S)
             for _ in range(repeats):
-                U, dU, m1, m2 = mutual_h(rows, i, scr, i, ints, floats, 1.0, R, S)
+                U, dU, m1, m2 = potential(rows, i, scr, i, ints, floats, 1.0, R, S)
                 acc += U + m2[2]
                 R[0] += 1e-14 * dU[0]            # a dependent chain: nothing hoisted
             _store(out, i, U, dU, m1, m2, acc)
@@ -87,31 +91,6 @@ def _taichi_helpers():
             out[i, 4 + c] = m1[c]
             out[i, 7 + c] = m2[c]
         out[i, 10] = acc
-
-
-def cartesian_kernel():
-    import taichi as ti
-    from ti_spinorbit.kernels.multipole_gravity import mutual_n, vec3
-
-    nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
-    nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
-    nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
-
-    @ti.kernel
-    def loop(rows: nd2f, R_nd: nd2f, scr: nd2f, ints: nd1i, floats: nd1f, out: nd2f,
-             repeats: ti.i32):
-        for i in range(R_nd.shape[0]):
-            R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])
-            S = _rotation(i)
-            acc = 0.0
-            U, dU, m1, m2 = mutual_n(rows, i, scr, i, ints, floats, 1.0, R, S)
-            for _ in range(repeats):
-                U, dU, m1, m2 = mutual_n(rows, i, scr, i, ints, floats, 1.0, R, S)
-                acc += U + m2[2]
-                R[0] += 1e-14 * dU[0]
-            _store(out, i, U, dU, m1, m2, acc)
-
-    return loop
 
 
 def measure(order, caps, n, reps, odd):
@@ -179,7 +158,10 @@ def main():
     import ti_spinorbit as tso
     tso.init(cpu_max_num_threads=1)
     _taichi_helpers()
-    KERNELS.update(harmonic=harmonic_kernel(), cartesian=cartesian_kernel())
+    from ti_spinorbit.kernels.harmonic_gravity import mutual_h
+    from ti_spinorbit.kernels.multipole_gravity import mutual_n
+    KERNELS.update(harmonic=loop_kernel(mutual_h, _rotation),
+                   cartesian=loop_kernel(mutual_n, _rotation))
     orders = [6] if args.quick else args.orders
     n, reps = (16, 5) if args.quick else (256, 100)
     rows = []

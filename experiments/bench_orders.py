@@ -201,27 +201,18 @@ def rates(models, orders, n, seconds, rounds=1):
 def split(orders, n=256, reps=200):
     """ns per order-N evaluation on one core, whole and with parts switched off."""
     import taichi as ti
+    import bench_harmonics as BH
     from ti_spinorbit.engine import multipole_tables as MT
-    from ti_spinorbit.kernels.multipole_gravity import mutual_n, vec3
+    from ti_spinorbit.kernels.multipole_gravity import mutual_n
     from ti_spinorbit.layout import multipole as H
 
-    nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
-    nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
-    nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
+    @ti.func
+    def z_rotation(i):
+        c, s = ti.cos(0.3 * i), ti.sin(0.3 * i)
+        return ti.Matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], ti.f64)
 
-    @ti.kernel
-    def loop(rows: nd2f, R_nd: nd2f, scr: nd2f, ints: nd1i, floats: nd1f, out: nd1f,
-             repeats: ti.i32):
-        for i in range(R_nd.shape[0]):
-            R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])
-            c, s = ti.cos(0.3 * i), ti.sin(0.3 * i)
-            S = ti.Matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], ti.f64)
-            acc = 0.0
-            for _ in range(repeats):
-                U, dUdR, mu1, mu2 = mutual_n(rows, i, scr, i, ints, floats, 1.0, R, S)
-                acc += U + mu2[2]
-                R[0] += 1e-14 * dUdR[0]              # a dependent chain: nothing hoisted
-            out[i] = acc
+    BH._taichi_helpers()
+    loop = BH.loop_kernel(mutual_n, z_rotation)
 
     s = system()
     R = np.column_stack([0.95 + 0.1 * np.sin(np.arange(n)), 0.2 * np.cos(np.arange(n)),
@@ -243,7 +234,7 @@ def split(orders, n=256, reps=200):
                 for k, v in patch.items():
                     ints[k] = v
                 scr = np.zeros((n, tab.scratch))
-                res = np.zeros(n)
+                res = np.zeros((n, 11))
                 loop(rows, R, scr, ints, tab.floats, res, 1)
                 t0 = time.process_time()
                 loop(rows, R, scr, ints, tab.floats, res, reps)

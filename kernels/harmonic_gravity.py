@@ -41,7 +41,7 @@ import taichi as ti
 
 from ti_spinorbit.layout import harmonic as _K
 
-from .mutual_gravity import vec3
+from .mutual_gravity import make_evaluate, vec3
 
 _BITS = 9                       # harmonic_tables.BITS: a packed entry is a | b << 9 | c << 18
 _MASK = (1 << _BITS) - 1
@@ -238,23 +238,6 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     return U, LT @ dU, LT @ tauA, LT @ tauB
 
 
-nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
-nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
-nd3f = ti.types.ndarray(dtype=ti.f64, ndim=3)
-nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
-
-
-@ti.kernel
-def evaluate_multipole(rows: nd2f, R_nd: nd2f, S_nd: nd3f, scr: nd2f, tab_i: nd1i,
-                       tab_f: nd1f, out: nd2f, G: ti.f64):
-    """The order-N potential for each row i (member i's coefficients, R_nd[i], S_nd[i]):
-    out = [U, dU/dR (3), mu1 (3), mu2 (3)], scratch row i."""
-    for i in range(R_nd.shape[0]):
-        R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])
-        S = ti.Matrix([[S_nd[i, r, c] for c in ti.static(range(3))] for r in ti.static(range(3))])
-        U, dUdR, mu1, mu2 = mutual_h(rows, i, scr, i, tab_i, tab_f, G, R, S)
-        out[i, 0] = U
-        for c in ti.static(range(3)):
-            out[i, 1 + c] = dUdR[c]
-            out[i, 4 + c] = mu1[c]
-            out[i, 7 + c] = mu2[c]
+#: The order-N potential for each row i (member i's coefficients, R_nd[i], S_nd[i]):
+#: out = [U, dU/dR (3), mu1 (3), mu2 (3)], scratch row i (``mutual_gravity.make_evaluate``).
+evaluate_multipole = make_evaluate(mutual_h)
