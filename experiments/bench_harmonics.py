@@ -3,7 +3,7 @@
 Benchmark-only prototype (the package kernels are unchanged): the mutual potential, force and
 both torques of ``ti_spinorbit.harmonics`` (real solid harmonics, both bodies turned into the
 frame whose z axis is the line of centres by z-rotations and the fixed matrices J, the
-interaction then diagonal in m; docs/physics.md §3.8a) written as a Taichi function over host
+interaction then diagonal in m; docs/physics.md §3.8.2) written as a Taichi function over host
 tables, timed beside the package's Cartesian table-driven ``kernels/multipole_gravity.mutual_n``
 on the same members, in the same loop (the ``split`` harness of bench_orders.py: one member
 per iteration, a dependent chain of evaluations, one core, process CPU time).

@@ -8,7 +8,7 @@ throughput benchmark's (``bench_throughput.starts``: θ_p, θ̇_p/n on an R2 seq
 order-N integral rows come from the ellipsoids' closed form (``system.integrals``), so the
 script runs whatever order the bodies store. Integration through ``Ensemble`` (Cash-Karp,
 rtol = atol = 1e-12, escape distance 1000 a); orders up to 4 run the hand-written kernels,
-higher ones the table-driven harmonic ones (docs/physics.md §3.8a). Each point integrates about
+higher ones the table-driven harmonic ones (docs/physics.md §3.8.2). Each point integrates about
 ``--seconds`` of wall time (a pilot run sizes it; at least 0.05 orbit), after a 1-member
 launch that compiles or loads the variant. Sections:
 

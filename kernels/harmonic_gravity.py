@@ -2,7 +2,7 @@
 real solid harmonics along the line of centres.
 
 The formulation is that of ``ti_spinorbit.harmonics`` (its module docstring; docs/physics.md
-§3.8a) and the tables those of ``ti_spinorbit.engine.harmonic_tables``: both bodies' harmonic
+§3.8.2) and the tables those of ``ti_spinorbit.engine.harmonic_tables``: both bodies' harmonic
 coefficients are turned into the frame whose z axis is the line of centres, by z-rotations (4
 products per pair ±m) and the fixed sparse matrices J_l and J_lᵀ,
 

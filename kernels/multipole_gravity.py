@@ -2,14 +2,14 @@
 table-driven, in Cartesian form: the kernels' independent check.
 
 The integrators evaluate the order-N potential in real solid harmonics
-(``harmonic_gravity.py``, docs/physics.md §3.8a), which costs a fraction of this form's work
+(``harmonic_gravity.py``, docs/physics.md §3.8.2), which costs a fraction of this form's work
 at every order above 4; this Cartesian kernel stays, tested against the host reference to
 1e-13 (tests/test_kernel_multipole.py), as a second formulation in Taichi to hold the
 harmonic one to, and as the baseline of experiments/bench_harmonics.py. Its arguments come
 from ``multipole_tables.Multipole.cartesian_arguments``.
 
 The formulation and the tables are those of ``ti_spinorbit.engine.multipole_tables`` (its
-module docstring; docs/physics.md §3.8): the Cartesian multipole–multipole expansion
+module docstring; docs/physics.md §3.8.1): the Cartesian multipole–multipole expansion
 
     U_N = −G Σ_{|α|+|β| ≤ N} t̂_A^α t̂_B'^β D_{α+β}(R),   D_γ = ∂^γ(1/|R|),
 

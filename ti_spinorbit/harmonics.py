@@ -2,7 +2,7 @@
 
 A second, independent route to the truncated mutual potential, force and torques of
 ``ti_spinorbit.multipole`` (the Cartesian multipole–multipole form), built as the host
-reference of a cheaper formulation for the kernels (docs/physics.md §3.8a). It depends on NumPy
+reference of a cheaper formulation for the kernels (docs/physics.md §3.8.2). It depends on NumPy
 and on ``ti_spinorbit.multipole`` (for exact Cartesian rotations and the coefficients of 1/r
 only while its tables are built).
 

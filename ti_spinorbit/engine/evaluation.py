@@ -57,7 +57,7 @@ def mutual_potential(primary: Body, secondary: Body, R, S, order: int = 4, degre
         (|S^T S − 1| <= 1e-9) and proper (det S = +1; a reflection is no rigid motion).
     order : int
         Truncation order, 0 or 2..16 (docs/physics.md §3; Ashenberg 2007; Hou et al. 2017):
-        up to 4 the hand-written kernels, above 4 the table-driven ones (§3.8a), which need
+        up to 4 the hand-written kernels, above 4 the table-driven ones (§3.8.2), which need
         each body's integrals to the degree used (``body.integral``).
     degrees : (int, int), optional
         Order > 4 only: degree caps (primary, secondary) of the integrals, in [0, order];

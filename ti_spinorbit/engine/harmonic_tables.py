@@ -3,7 +3,7 @@ built once per (order, degree caps, masks) on the host, and the members' coeffic
 (NumPy).
 
 The kernels (``kernels/harmonic_gravity.py``) walk these tables; the formulation is that of
-``ti_spinorbit.harmonics`` (its module docstring; docs/physics.md §3.8a), whose functions give
+``ti_spinorbit.harmonics`` (its module docstring; docs/physics.md §3.8.2), whose functions give
 every number here: the fixed matrices J_l = M_l(Rx(90°)) and their transposes, the axial
 couplings K_{l1 l2} (diagonal in m) and the rotation generators about x and y.
 

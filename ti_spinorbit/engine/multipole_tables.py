@@ -3,13 +3,13 @@ odd terms), and the per-member integral rows that go with them (NumPy only).
 
 The integral rows are what every order-N run carries (member tables, checkpoints, results);
 :class:`Multipole` turns them into the harmonic coefficient rows and tables the integrators
-use (``harmonic_tables``, ``kernels/harmonic_gravity.py``, docs/physics.md §3.8a). The
+use (``harmonic_tables``, ``kernels/harmonic_gravity.py``, docs/physics.md §3.8.2). The
 Cartesian tables below serve the kernels' independent check, ``kernels/multipole_gravity.py``
 (:meth:`Multipole.cartesian_arguments`), which evaluates the mutual potential, the force and
 both torques of two rigid bodies at any truncation order N by walking these tables at run
 time: every member walks the same entries in the same order, so no thread diverges, and no
 term is unrolled at compile time, so one compiled kernel serves every order above 4
-(``layout.multipole.KERNEL_ORDER``). What the tables encode (docs/physics.md §3.8 derives
+(``layout.multipole.KERNEL_ORDER``). What the tables encode (docs/physics.md §3.8.1 derives
 it; ``ti_spinorbit.multipole`` is the independent host reference):
 
 Normalised quantities. With D_γ(R) = ∂^γ(1/|R|) (γ a multi-index, |γ| its degree),

@@ -75,7 +75,7 @@ class Integrator:
     order : int
         Order of the mutual potential's expansion in inertia integrals: 0 or 2 to 16 (4, the
         paper's, by default). Up to 4 the hand-written kernels; above 4 the table-driven
-        ones (docs/physics.md §3.8a), which need both bodies' integrals to that degree.
+        ones (docs/physics.md §3.8.2), which need both bodies' integrals to that degree.
     degrees : (int, int), optional
         Above order 4 only: caps (primary, secondary) on the degree of each body's integrals,
         each in [0, order] (a small secondary usually needs fewer); default (order, order).
