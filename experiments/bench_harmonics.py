@@ -40,59 +40,6 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 
 
-def loop_kernel(potential, rotation):
-    """The benchmark loop over an order-N ``potential`` func (the kernels' signature): per
-    member i, ``rotation(i)`` as its attitude and a dependent chain of ``repeats``
-    evaluations (nothing hoisted); out[i] = the last [U, dU/dR, mu1, mu2] and the chain's
-    sum. bench_orders.py's ``split`` uses it too."""
-    import taichi as ti
-    from ti_spinorbit.kernels.mutual_gravity import vec3
-
-    nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
-    nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
-    nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
-
-    @ti.kernel
-    def loop(rows: nd2f, R_nd: nd2f, scr: nd2f, ints: nd1i, floats: nd1f, out: nd2f,
-             repeats: ti.i32):
-        for i in range(R_nd.shape[0]):
-            R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])
-            S = rotation(i)
-            acc = 0.0
-            U, dU, m1, m2 = potential(rows, i, scr, i, ints, floats, 1.0, R, S)
-            for _ in range(repeats):
-                U, dU, m1, m2 = potential(rows, i, scr, i, ints, floats, 1.0, R, S)
-                acc += U + m2[2]
-                R[0] += 1e-14 * dU[0]            # a dependent chain: nothing hoisted
-            _store(out, i, U, dU, m1, m2, acc)
-
-    return loop
-
-
-def _taichi_helpers():
-    import taichi as ti
-
-    global _rotation, _store
-
-    @ti.func
-    def _rotation(i):
-        """A member's attitude: a rotation about a tilted axis (every Euler angle non-zero)."""
-        a, b = 0.3 * i + 0.2, 0.7 + 0.05 * i
-        ca, sa, cb, sb = ti.cos(a), ti.sin(a), ti.cos(b), ti.sin(b)
-        Rz = ti.Matrix([[ca, -sa, 0.0], [sa, ca, 0.0], [0.0, 0.0, 1.0]], ti.f64)
-        Rx = ti.Matrix([[1.0, 0.0, 0.0], [0.0, cb, -sb], [0.0, sb, cb]], ti.f64)
-        return Rz @ Rx @ Rz.transpose() @ Rx
-
-    @ti.func
-    def _store(out: ti.template(), i, U, dU, m1, m2, acc):
-        out[i, 0] = U
-        for c in ti.static(range(3)):
-            out[i, 1 + c] = dU[c]
-            out[i, 4 + c] = m1[c]
-            out[i, 7 + c] = m2[c]
-        out[i, 10] = acc
-
-
 def measure(order, caps, n, reps, odd):
     """One row: ns per evaluation of both forms, their agreement, the table sizes."""
     import bench_orders as B
@@ -157,11 +104,12 @@ def main():
     args = ap.parse_args()
     import ti_spinorbit as tso
     tso.init(cpu_max_num_threads=1)
-    _taichi_helpers()
+    from _order_n_loop import loop_kernel, tilted_rotation
     from ti_spinorbit.kernels.harmonic_gravity import mutual_h
     from ti_spinorbit.kernels.multipole_gravity import mutual_n
-    KERNELS.update(harmonic=loop_kernel(mutual_h, _rotation),
-                   cartesian=loop_kernel(mutual_n, _rotation))
+    rotation = tilted_rotation()
+    KERNELS.update(harmonic=loop_kernel(mutual_h, rotation),
+                   cartesian=loop_kernel(mutual_n, rotation))
     orders = [6] if args.quick else args.orders
     n, reps = (16, 5) if args.quick else (256, 100)
     rows = []

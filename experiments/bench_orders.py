@@ -201,7 +201,7 @@ def rates(models, orders, n, seconds, rounds=1):
 def split(orders, n=256, reps=200):
     """ns per order-N evaluation on one core, whole and with parts switched off."""
     import taichi as ti
-    import bench_harmonics as BH
+    from _order_n_loop import loop_kernel
     from ti_spinorbit.engine import multipole_tables as MT
     from ti_spinorbit.kernels.multipole_gravity import mutual_n
     from ti_spinorbit.layout import multipole as H
@@ -211,8 +211,7 @@ def split(orders, n=256, reps=200):
         c, s = ti.cos(0.3 * i), ti.sin(0.3 * i)
         return ti.Matrix([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], ti.f64)
 
-    BH._taichi_helpers()
-    loop = BH.loop_kernel(mutual_n, z_rotation)
+    loop = loop_kernel(mutual_n, z_rotation)
 
     s = system()
     R = np.column_stack([0.95 + 0.1 * np.sin(np.arange(n)), 0.2 * np.cos(np.arange(n)),
