@@ -69,7 +69,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .multipole import (G_SI, _check_C, _check_R, _check_degrees, _check_order,  # noqa: F401
+from .multipole import (G_SI, _check_C, _check_R, _check_degrees, _check_order,
                         _generator, _integral_vector, _rotate_vector, _table,
                         inverse_distance_coefficients)
 

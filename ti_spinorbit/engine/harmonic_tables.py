@@ -51,13 +51,9 @@ import numpy as np
 
 from .. import harmonics as _hm
 from ..layout import harmonic as _K, multipole as _MP
+from ..multipole import _count as count    # a Cartesian integral row's columns, degree <= d
 
 MAX_ORDER = _MP.MAX_ORDER
-
-
-def count(degree):
-    """Multi-indices of degree <= ``degree`` (a Cartesian integral row's columns)."""
-    return (degree + 1) * (degree + 2) * (degree + 3) // 6
 
 
 def classes(l):
@@ -256,7 +252,8 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                                                 int(c0 > 0)))
                             chunks.append(w)
             lists["x1"] += pairs[1:]
-            lists["x2"] += pairs[1:] if full else pairs[1:2]
+            if slots[2] >= 0:                # the last z-rotation: the primary's only
+                lists["x2"] += pairs[1:] if full else pairs[1:2]
             lists["row"] += range(base, base + (2 * l + 1 if full else 1))
         prog = [0] * _K.PROGRAM_WIDTH
         for nkey, okey, name in ((_K.P_NLOAD, _K.P_LOAD, "load"), (_K.P_NJ, _K.P_J, "j"),
@@ -271,8 +268,6 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
             else:
                 packed = list(items)
             prog[okey] = put(packed)
-        if slots[2] < 0:
-            prog[_K.P_NX2] = 0
         prog[_K.P_SRC], prog[_K.P_DST], prog[_K.P_ACC], prog[_K.P_T1] = src, dst, acc, t1
         prog[_K.P_Z0], prog[_K.P_Z1], prog[_K.P_Z2] = slots
         at = _K.K_PROG_A if body == 0 else _K.K_PROG_B
@@ -309,7 +304,6 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                    for m in range(1, l + 1)]
     head[_K.K_NBZ] = len(bz)
     head[_K.K_I_BZ] = put(bz)
-    head[_K.K_ROW_B] = (dA + 1) ** 2
     head[_K.K_NPOW] = N + 1
     head[_K.K_TOP] = top
     ints_arr = np.array(ints, dtype=np.int32)
