@@ -27,7 +27,14 @@ above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
 * r^−(L+1) is tabulated once per evaluation; the angles come from matrix entries, never from
   trigonometric calls (multiple angles by the addition recurrence);
 * the primary's z-torque is the secondary's with the opposite sign: along the line of
-  centres (R × ∂U/∂R)_z = 0.
+  centres (R × ∂U/∂R)_z = 0;
+* on the LLVM backends (CPU, CUDA) the body is one Taichi real function (``ti.real_func``),
+  compiled once per kernel and called, not inlined: inlined in the integrator's state
+  machine, its short loops ran 1.5 × slower than the same code in a small kernel (the
+  register pressure of the stage matrix around them), and the call also compiles faster
+  (experiments/README.md, "bench_orders.py"). The body is written as one function, with no
+  nested ``ti.func`` that takes an array: inside a real function such a call crashes at
+  launch in Taichi 1.7.
 
 Per-member data, passed as arguments of the kernels beside the parameter rows (the same four
 arrays as the Cartesian kernels'): ``rows`` (members × width) the coefficient rows
@@ -47,49 +54,18 @@ _BITS = 9                       # harmonic_tables.BITS: a packed entry is a | b 
 _MASK = (1 << _BITS) - 1
 
 
-@ti.func
-def _pairs(scr: ti.template(), k, tab_i: ti.template(), n, o, v, trig, top):
-    """X(ψ) in place on the pairs (p, q, m) of a list (packed: ``harmonic_tables.pack``):
-    v[p], v[q] ← rotated by mψ."""
-    for e in range(n):
-        w = tab_i[o + e]
-        p = v + (w & _MASK)
-        q = v + ((w >> _BITS) & _MASK)
-        m = w >> (2 * _BITS)
-        c = scr[k, trig + m]
-        s = scr[k, trig + top + 1 + m]
-        a = scr[k, p]
-        b = scr[k, q]
-        scr[k, p] = c * a - s * b
-        scr[k, q] = s * a + c * b
+_nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
+_nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
+_nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
+_mat3 = ti.types.matrix(3, 3, ti.f64)
+_Result = ti.types.struct(U=ti.f64, dU=vec3, mu1=vec3, mu2=vec3)
 
 
-@ti.func
-def _rows(scr: ti.template(), k, tab_i: ti.template(), tab_f: ti.template(), n, o, dst, src):
-    """Dense block rows in chunks ((destination, source, flag) packed, weights): four
-    products each, the weights past a row's end zero (``harmonic_tables.CHUNK``); flag 0
-    stores the sum, 1 adds it, 2 stores a zero (a class known to be zero)."""
-    for e in range(n):
-        w = tab_i[o + 2 * e]
-        flag = w >> (2 * _BITS)
-        d = dst + (w & _MASK)
-        acc = 0.0
-        if flag != 2:
-            s0 = src + ((w >> _BITS) & _MASK)
-            f = tab_i[o + 2 * e + 1]
-            acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
-                   + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
-            if flag == 1:
-                acc += scr[k, d]
-        scr[k, d] = acc
-
-
-@ti.func
-def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template(),
-             tab_f: ti.template(), G, R, S):
-    """Mutual potential U, gradient dU/dR, torque on A (mu1) and on B (mu2), frame A, at the
-    order and degree caps the tables were built for; member j's coefficient row
-    (``rows[j]``), slot k's scratch (``scr[k]``)."""
+def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_f: _nd1f,
+               G: ti.f64, R: vec3, S: _mat3) -> _Result:
+    """The body of :func:`mutual_h`, compiled as a real function (module docstring) or
+    inlined. Written as one function with no nested ``ti.func`` taking an array: inside a
+    Taichi 1.7 real function such a call crashes at launch."""
     top = tab_i[_K.K_TOP]
     t2 = tab_i[_K.K_S_T2]
     trig = tab_i[_K.K_S_TRIG]
@@ -166,8 +142,36 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
                 nrow, orow, npair, opair, slot, vec, src_ = (
                     tab_i[pg + _K.P_NJT], tab_i[pg + _K.P_JT], tab_i[pg + _K.P_NX2],
                     tab_i[pg + _K.P_X2], tab_i[pg + _K.P_Z2], dst, t2)
-            _rows(scr, k, tab_i, tab_f, nrow, orow, vec, src_)
-            _pairs(scr, k, tab_i, npair, opair, vec, trig + n2 * slot, top)
+            # the J (or Jᵀ) rows in chunks ((destination, source, flag) packed, weights):
+            # four products each, the weights past a row's end zero
+            # (``harmonic_tables.CHUNK``); flag 0 stores the sum, 1 adds it, 2 stores a zero
+            # (a class known to be zero)
+            for e in range(nrow):
+                w = tab_i[orow + 2 * e]
+                flag = w >> (2 * _BITS)
+                d = vec + (w & _MASK)
+                acc = 0.0
+                if flag != 2:
+                    s0 = src_ + ((w >> _BITS) & _MASK)
+                    f = tab_i[orow + 2 * e + 1]
+                    acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
+                           + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
+                    if flag == 1:
+                        acc += scr[k, d]
+                scr[k, d] = acc
+            # then X(ψ) in place on the pairs (p, q, m) of the list: v[p], v[q] rotated by mψ
+            tz = trig + n2 * slot
+            for e in range(npair):
+                w = tab_i[opair + e]
+                p = vec + (w & _MASK)
+                q = vec + ((w >> _BITS) & _MASK)
+                m = w >> (2 * _BITS)
+                c = scr[k, tz + m]
+                s_ = scr[k, tz + top + 1 + m]
+                a = scr[k, p]
+                b = scr[k, q]
+                scr[k, p] = c * a - s_ * b
+                scr[k, q] = s_ * a + c * b
         acc0 = tab_i[pg + _K.P_ACC]
         scr[k, acc0] = 0.0
         o = tab_i[pg + _K.P_ROW]
@@ -235,9 +239,41 @@ def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template()
     s = tauA + tauB
     dU = vec3(s[1] * inv_r, -s[0] * inv_r, dUdr)
     LT = L.transpose()
-    return U, LT @ dU, LT @ tauA, LT @ tauB
+    return _Result(U=U, dU=LT @ dU, mu1=LT @ tauA, mu2=LT @ tauB)
+
+
+_REAL = ti.real_func(_potential)
+_INLINE = ti.func(_potential)
+#: Taichi's real functions exist on its LLVM backends only
+_LLVM_ARCHS = (ti.x64, ti.arm64, ti.cuda, ti.amdgpu)
+
+
+@ti.func
+def mutual_h(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template(),
+             tab_f: ti.template(), G, R, S):
+    """Mutual potential U, gradient dU/dR, torque on A (mu1) and on B (mu2), frame A, at the
+    order and degree caps the tables were built for; member j's coefficient row
+    (``rows[j]``), slot k's scratch (``scr[k]``). A call to one real function on the LLVM
+    backends (CPU, CUDA), inlined on the others."""
+    r = _Result(U=0.0, dU=vec3(0.0, 0.0, 0.0), mu1=vec3(0.0, 0.0, 0.0), mu2=vec3(0.0, 0.0, 0.0))
+    if ti.static(ti.lang.impl.current_cfg().arch in _LLVM_ARCHS):
+        r = _REAL(rows, j, scr, k, tab_i, tab_f, G, R, S)
+    else:
+        r = _INLINE(rows, j, scr, k, tab_i, tab_f, G, R, S)
+    return r.U, r.dU, r.mu1, r.mu2
+
+
+@ti.func
+def mutual_h_inline(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.template(),
+                    tab_f: ti.template(), G, R, S):
+    """:func:`mutual_h` always inlined (what the non-LLVM backends run; the tests hold the
+    real function to it bit for bit)."""
+    r = _INLINE(rows, j, scr, k, tab_i, tab_f, G, R, S)
+    return r.U, r.dU, r.mu1, r.mu2
 
 
 #: The order-N potential for each row i (member i's coefficients, R_nd[i], S_nd[i]):
 #: out = [U, dU/dR (3), mu1 (3), mu2 (3)], scratch row i (``mutual_gravity.make_evaluate``).
 evaluate_multipole = make_evaluate(mutual_h)
+#: The same with :func:`mutual_h_inline`.
+evaluate_multipole_inline = make_evaluate(mutual_h_inline)
