@@ -52,6 +52,11 @@ from .mutual_gravity import make_evaluate, vec3
 
 _BITS = 9                       # harmonic_tables.BITS: a packed entry is a | b << 9 | c << 18
 _MASK = (1 << _BITS) - 1
+_M_FIELD = 31                   # c of a pair: m | ZERO_SIN; of a term: L | FIRST_A | FIRST_B
+_L_FIELD = 63
+_ZERO_SIN = 1 << (2 * _BITS + 5)          # harmonic_tables.ZERO_SIN, FIRST_A, FIRST_B in place
+_FIRST_A = 1 << (2 * _BITS + 6)
+_FIRST_B = 1 << (2 * _BITS + 7)
 
 
 _nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -92,24 +97,22 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
     cg, sg = ca * Q[1, 1] - sa * Q[0, 1], ca * Q[1, 0] - sa * Q[0, 0]
     L = ti.Matrix([[ca, sa, 0.0], [-sa, ca, 0.0], [0.0, 0.0, 1.0]], ti.f64) @ P
     # the multiple angles of the five angles (slots 0..4: −φ, −θ, −α for the primary, γ, β for
-    # the secondary): cos mψ at trig + slot·2(top+1) + m, sin mψ top + 1 further; m = 1 put
-    # first, the rest in one loop (one call site for all five)
+    # the secondary): cos mψ at trig + slot·2(top+1) + m, sin mψ top + 1 further, by the
+    # addition recurrence, the five side by side in one loop over m
     n2 = 2 * (top + 1)
-    cs = ti.Vector([cf, -sf, ct, -st, ca, -sa, cg, sg, cb, sb], ti.f64)
+    c1 = ti.Vector([cf, ct, ca, cg, cb], ti.f64)
+    s1 = ti.Vector([-sf, -st, -sa, sg, sb], ti.f64)
+    cm, sm = c1, s1
     for a in ti.static(range(5)):
-        scr[k, trig + a * n2 + 1] = cs[2 * a]
-        scr[k, trig + a * n2 + top + 2] = cs[2 * a + 1]
-    for a in range(5):
-        o = trig + a * n2
-        c1 = scr[k, o + 1]
-        s1 = scr[k, o + top + 2]
-        scr[k, o] = 1.0
-        scr[k, o + top + 1] = 0.0
-        cm, sm = c1, s1
-        for m in range(2, top + 1):
-            cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
-            scr[k, o + m] = cm
-            scr[k, o + top + 1 + m] = sm
+        scr[k, trig + a * n2] = 1.0
+        scr[k, trig + a * n2 + top + 1] = 0.0
+        scr[k, trig + a * n2 + 1] = c1[a]
+        scr[k, trig + a * n2 + top + 2] = s1[a]
+    for m in range(2, top + 1):                  # the five angles side by side
+        cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
+        for a in ti.static(range(5)):
+            scr[k, trig + a * n2 + m] = cm[a]
+            scr[k, trig + a * n2 + top + 1 + m] = sm[a]
     # both bodies into the frame L by their programs: the member's coefficients read with
     # the first z-rotation, then two passes (J then X; Jᵀ then X), in one loop over the
     # bodies and one over the passes, so that each helper has one call site (every ti.func
@@ -127,37 +130,35 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
             w = tab_i[o + e]
             p = w & _MASK
             q = (w >> _BITS) & _MASK
-            m = w >> (2 * _BITS)
+            m = (w >> (2 * _BITS)) & _M_FIELD
             c = scr[k, z0 + m]
             s_ = scr[k, z0 + top + 1 + m]
             a = rows[j, src + p]
-            b = rows[j, src + q]
+            b = 0.0
+            if w & _ZERO_SIN == 0:                       # (a sin partner known zero: not read)
+                b = rows[j, src + q]
             scr[k, t1 + p] = c * a - s_ * b
             scr[k, t1 + q] = s_ * a + c * b
         for step in range(1, 3):                         # J then X; Jᵀ then X
-            nrow, orow, npair, opair, slot, vec, src_ = (
-                tab_i[pg + _K.P_NJ], tab_i[pg + _K.P_J], tab_i[pg + _K.P_NX1],
-                tab_i[pg + _K.P_X1], tab_i[pg + _K.P_Z1], t2, t1)
+            nrow, orow, frow, npair, opair, slot, vec, src_ = (
+                tab_i[pg + _K.P_NJ], tab_i[pg + _K.P_J], tab_i[pg + _K.P_FJ],
+                tab_i[pg + _K.P_NX1], tab_i[pg + _K.P_X1], tab_i[pg + _K.P_Z1], t2, t1)
             if step == 2:
-                nrow, orow, npair, opair, slot, vec, src_ = (
-                    tab_i[pg + _K.P_NJT], tab_i[pg + _K.P_JT], tab_i[pg + _K.P_NX2],
-                    tab_i[pg + _K.P_X2], tab_i[pg + _K.P_Z2], dst, t2)
-            # the J (or Jᵀ) rows in chunks ((destination, source, flag) packed, weights):
-            # four products each, the weights past a row's end zero
-            # (``harmonic_tables.CHUNK``); flag 0 stores the sum, 1 adds it, 2 stores a zero
-            # (a class known to be zero)
+                nrow, orow, frow, npair, opair, slot, vec, src_ = (
+                    tab_i[pg + _K.P_NJT], tab_i[pg + _K.P_JT], tab_i[pg + _K.P_FJT],
+                    tab_i[pg + _K.P_NX2], tab_i[pg + _K.P_X2], tab_i[pg + _K.P_Z2], dst, t2)
+            # the J (or Jᵀ) rows in chunks ((destination, source, add) packed; the list's
+            # weights in its order, four per chunk, zero past a row's end:
+            # ``harmonic_tables.CHUNK``); a chunk stores its sum or adds it to its row's
             for e in range(nrow):
-                w = tab_i[orow + 2 * e]
-                flag = w >> (2 * _BITS)
+                w = tab_i[orow + e]
                 d = vec + (w & _MASK)
-                acc = 0.0
-                if flag != 2:
-                    s0 = src_ + ((w >> _BITS) & _MASK)
-                    f = tab_i[orow + 2 * e + 1]
-                    acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
-                           + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
-                    if flag == 1:
-                        acc += scr[k, d]
+                s0 = src_ + ((w >> _BITS) & _MASK)
+                f = frow + 4 * e
+                acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
+                       + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
+                if w >> (2 * _BITS) != 0:
+                    acc += scr[k, d]
                 scr[k, d] = acc
             # then X(ψ) in place on the pairs (p, q, m) of the list: v[p], v[q] rotated by mψ
             tz = trig + n2 * slot
@@ -165,19 +166,17 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
                 w = tab_i[opair + e]
                 p = vec + (w & _MASK)
                 q = vec + ((w >> _BITS) & _MASK)
-                m = w >> (2 * _BITS)
+                m = (w >> (2 * _BITS)) & _M_FIELD
                 c = scr[k, tz + m]
                 s_ = scr[k, tz + top + 1 + m]
                 a = scr[k, p]
-                b = scr[k, q]
+                b = 0.0
+                if w & _ZERO_SIN == 0:
+                    b = scr[k, q]
                 scr[k, p] = c * a - s_ * b
                 scr[k, q] = s_ * a + c * b
-        acc0 = tab_i[pg + _K.P_ACC]
-        scr[k, acc0] = 0.0
-        o = tab_i[pg + _K.P_ROW]
-        for e in range(tab_i[pg + _K.P_NROW]):
-            scr[k, acc0 + tab_i[o + e]] = 0.0
-    # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C
+    # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C (each row's first term
+    # stores, the others add: no zeroing first)
     inv_r = 1.0 / r
     wr = -G * inv_r
     for q in range(tab_i[_K.K_NPOW]):
@@ -191,15 +190,21 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
         w = tab_i[ot + e]
         ia = w & _MASK
         ib = (w >> _BITS) & _MASK
-        Lt = w >> (2 * _BITS)
+        Lt = (w >> (2 * _BITS)) & _L_FIELD
         kv = scr[k, sw + Lt] * tab_f[ok + e]
         a = scr[k, sA + ia]
         b = scr[k, sB + ib]
         u = a * kv * b
         U += u
         dUdr -= (Lt + 1) * u
-        scr[k, sGA + ia] += kv * b
-        scr[k, sGB + ib] += kv * a
+        ga = kv * b                                      # a row's first term stores
+        if w & _FIRST_A == 0:
+            ga += scr[k, sGA + ia]
+        scr[k, sGA + ia] = ga
+        gb = kv * a
+        if w & _FIRST_B == 0:
+            gb += scr[k, sGB + ib]
+        scr[k, sGB + ib] = gb
     dUdr *= inv_r
     # torques in the frame L: x, y from the generators (4 entries per row), z of the
     # secondary analytically ((G_z C)_±m = ∓m C_∓m), the primary's z opposite (along the

@@ -136,28 +136,35 @@ def test_host_harmonic_form_equals_the_cartesian_reference(rng, order, degrees):
 
 def test_tables_hold_the_matrices_and_rows_do_not_depend_on_their_neighbours(rng):
     """The primary's program (its J and Jᵀ rows: dense class blocks in chunks of
-    ``CHUNK`` columns) rebuilds J_l and J_lᵀ exactly, every row of a degree present, every
-    chunk inside its degree; an ellipsoid's odd degrees are masked out and a cloud's are
-    not; a member's coefficient row is bit for bit the same alone and among other rows."""
+    ``CHUNK`` columns) rebuilds J_l exactly and the rows of J_lᵀ its degree needs (|m| up
+    to one past what its terms reach), every chunk inside its degree; an ellipsoid's odd
+    degrees are masked out and a cloud's are not; a member's coefficient row is bit for bit
+    the same alone and among other rows."""
     from ti_spinorbit.layout import harmonic as K
-    tab = HT.tables(12, 8, 8)                      # degrees <= 8 all in the mixed terms
+    tab = HT.tables(12, 8, 8)                      # degrees 2..8, reaching m = 4..8
+    tops = HT.top_orders(12, 8, 8)[0]
+    assert tops == {2: 2, 3: 3, 4: 4, 5: 5, 6: 6, 7: 5, 8: 4}
     pg, W = K.K_PROG_A, HT.CHUNK
-    for which, (nkey, okey) in enumerate(((K.P_NJ, K.P_J), (K.P_NJT, K.P_JT))):
-        n, o = tab.ints[pg + nkey], tab.ints[pg + okey]
-        packed = tab.ints[o:o + 2 * n].reshape(n, 2)         # (dst | src << 9 | add << 18, f)
-        mask = (1 << HT.BITS) - 1
-        entries = np.column_stack([packed[:, 0] & mask, (packed[:, 0] >> HT.BITS) & mask,
-                                   packed[:, 1], packed[:, 0] >> 2 * HT.BITS])
-        assert len(set(entries[:, 0])) == sum(2 * l + 1 for l in range(2, 9))
+    mask = (1 << HT.BITS) - 1
+    for which, (nkey, okey, fkey) in enumerate(((K.P_NJ, K.P_J, K.P_FJ),
+                                                (K.P_NJT, K.P_JT, K.P_FJT))):
+        n, o, f0 = tab.ints[pg + nkey], tab.ints[pg + okey], tab.ints[pg + fkey]
+        packed = tab.ints[o:o + n]                           # dst | src << 9 | add << 18
+        dst, src = packed & mask, (packed >> HT.BITS) & mask
         for l in range(2, 9):
+            reach = 8 if which == 0 else min(l, tops[l] + 1)
+            rows = [l * l + HT.position(l, m) for m in range(-l, l + 1) if abs(m) <= reach]
             J = np.zeros((2 * l + 1, 2 * l + 1))
-            mine = entries[(entries[:, 0] >= l * l) & (entries[:, 0] < (l + 1) ** 2)]
-            assert np.all(mine[:, 1] >= l * l) and np.all(mine[:, 1] + W <= (l + 1) ** 2)
-            for dst, src, f, _ in mine:
-                J[dst - l * l, src - l * l:src - l * l + W] += tab.floats[f:f + W]
+            mine = np.nonzero((dst >= l * l) & (dst < (l + 1) ** 2))[0]
+            assert set(dst[mine]) == set(rows)
+            assert np.all(src[mine] >= l * l) and np.all(src[mine] + W <= (l + 1) ** 2)
+            for e in mine:
+                J[dst[e] - l * l, src[e] - l * l:src[e] - l * l + W] += \
+                    tab.floats[f0 + W * e:f0 + W * (e + 1)]
             target = H.j_matrix(l) if which == 0 else H.j_matrix(l).T
             perm = HT.permutation(l)
-            np.testing.assert_array_equal(J, target[np.ix_(perm, perm)])
+            kept = [r - l * l for r in rows]
+            np.testing.assert_array_equal(J[kept], target[np.ix_(perm, perm)][kept])
     ell = MT.body_integrals(_Ell(), 6)
     rows = np.concatenate([ell, ell])[None]
     mask = HT.degree_mask(HT.coefficient_rows(rows, 6, 6), 6)

@@ -130,7 +130,7 @@ class harmonic:
     # then its row offset, its scratch regions (coefficients, ∂U/∂C, its own first buffer:
     # entries a program never writes stay zero) and angle slots (−1: none)
     (P_NLOAD, P_LOAD, P_NJ, P_J, P_NX1, P_X1, P_NJT, P_JT, P_NX2, P_X2, P_NROW, P_ROW,
-     P_SRC, P_DST, P_ACC, P_T1, P_Z0, P_Z1, P_Z2, PROGRAM_WIDTH) = range(20)
+     P_FJ, P_FJT, P_SRC, P_DST, P_ACC, P_T1, P_Z0, P_Z1, P_Z2, PROGRAM_WIDTH) = range(22)
     K_PROG_B = K_PROG_A + PROGRAM_WIDTH
     KHEAD = K_PROG_B + PROGRAM_WIDTH
 

@@ -115,8 +115,11 @@ ALL_DEGREES = (1 << (MAX_ORDER + 1)) - 1
 #: 12) is one or two chunks of fixed width, a loop-free 4-term product in the kernel
 #: (measured faster than a loop over the row's columns, whose length is 1 to 7).
 CHUNK = 4
-#: The third field of a J row: 0 store the chunk's sum, 1 add it, ZERO store a zero.
-ZERO = 2
+#: Flags in the third field of packed entries: a pair (p, q, m) whose q entry is known to be
+#: zero (not read); the first term of a ∂U/∂C row of the primary, of the secondary (stores
+#: instead of adding). The third field of a J row is 1 when the chunk adds to its row.
+ZERO_SIN = 1 << 5
+FIRST_A, FIRST_B = 1 << 6, 1 << 7
 
 
 #: Bits of a position in a packed table entry: positions within a body's region are below
@@ -138,6 +141,22 @@ def position(l, m):
     if m >= 0:
         return m // 2 if m % 2 == 0 else n0 + (m - 1) // 2
     return n0 + n1 + (-m // 2 - 1) if m % 2 == 0 else n0 + n1 + n2 + (-m - 1) // 2
+
+
+def top_orders(order, degree_a, degree_b, masks=(ALL_DEGREES, ALL_DEGREES)):
+    """For each body, {degree l: the largest |m| its interaction terms reach}: min(l, the
+    largest partner degree l2 of the other body, l2 = 0 or 2 <= l2 <= min(d_other, N − l),
+    not masked out). Degrees above N − 2 meet only the monopole (0)."""
+    N = int(order)
+    degs = (int(degree_a), int(degree_b))
+    out = ({}, {})
+    for body in (0, 1):
+        other = 1 - body
+        for l in range(2, degs[body] + 1):
+            partners = [l2 for l2 in range(2, min(degs[other], N - l) + 1)
+                        if (masks[other] >> l2) & 1]
+            out[body][l] = min(l, max(partners, default=0))
+    return out
 
 
 @lru_cache(maxsize=32)
@@ -168,14 +187,13 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
 
     # the dense class blocks of J_l and J_lᵀ, once for every degree the bodies use; the
     # programs' rows read them again as padded chunks (after the program is built)
-    block_at = {}
-    chunks = []
+    block_at, dense = {}, []
     for l in range(2, top + 1):
         for which, M in ((0, _hm.j_matrix(l)), (1, _hm.j_matrix(l).T)):
             entry = []
             for b, blk in _blocks(M, l):
-                entry.append((b, len(floats), blk.shape[1]))
-                floats += [float(v) for v in blk.ravel()]
+                entry.append((b, len(dense), blk.shape[1]))
+                dense += [float(v) for v in blk.ravel()]
             block_at[(l, which)] = entry
     # the generators about x and y: two (column, value) pairs per global row l² + position
     gcols, gvals = [], []
@@ -205,85 +223,83 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
         offset += size
     head[_K.K_SCRATCH] = offset
 
-    # each body's program: its degrees 2..d that are not masked out; degrees above the mixed
-    # terms' (l > min(d, N − 2)) only m = 0, ±1 in the last product
+    # each body's program: its degrees 2..d that are not masked out. Only the orders a degree
+    # needs are computed: its terms reach |m| <= top_m (:func:`top_orders`), the torques read
+    # its coefficients one order further (the generators' neighbours), so the Jᵀ rows and
+    # last pairs stop at |m| <= top_m + 1 and the rows of ∂U/∂C at |m| <= top_m
+    tops = top_orders(N, dA, dB, masks)
     for body, (d, src, dst, acc, t1, slots) in enumerate((
             (dA, 0, regions[_K.K_S_A], regions[_K.K_S_GA], regions[_K.K_S_T1], (0, 1, 2)),
             (dB, (dA + 1) ** 2, regions[_K.K_S_B], regions[_K.K_S_GB],
              regions[_K.K_S_T1] + (top + 1) ** 2, (3, 4, -1)))):
-        kmix = min(d, N - 2)
         lists = {name: [] for name in ("load", "j", "x1", "jt", "x2", "row")}
-
-        def blk_row(fo, i, nb):
-            return floats[fo + i * nb:fo + (i + 1) * nb]
+        weights = {"j": [], "jt": []}
         for l in range(2, d + 1):
             if not (masks[body] >> l) & 1:
                 continue
-            full = l <= kmix
-            even = bool((evens[body] >> l) & 1)
+            mt = tops[body][l]
+            reach = min(l, mt + 1)
+            # (an even degree: at an odd one J sends the cos-even class elsewhere)
+            even = bool((evens[body] >> l) & 1) and l % 2 == 0
             base = l * l
             pairs = [(base + position(l, m), base + position(l, -m), m) if m else
                      (base, base, 0) for m in range(l + 1)]
-            # only cos-even coefficients: after the first z-rotation only the cos-even and
-            # sin-even classes are non-zero (the odd orders' entries of the buffer are never
-            # written, so they stay zero)
-            lists["load"] += [p_ for p_ in pairs if not even or p_[2] % 2 == 0]
+            if even:
+                # only cos-even coefficients: the first z-rotation reads the cos-even ones
+                # (their sin partners are zero: not read), the first J computes only the
+                # classes it fills from them (cos even, cos odd; the others would read
+                # zeros), and every pair of the second z-rotation then has a zero sin
+                # partner (not read; both written)
+                lists["load"] += [(p_, q_, m | ZERO_SIN if m else 0)
+                                  for p_, q_, m in pairs if m % 2 == 0]
+                lists["x1"] += [(p_, q_, m | ZERO_SIN) for p_, q_, m in pairs[1:]]
+            else:
+                lists["load"] += pairs
+                lists["x1"] += pairs[1:]
             sizes = [len(c) for c in classes(l)]
             off = np.concatenate([[0], np.cumsum(sizes)])
             for which, name in ((0, "j"), (1, "jt")):
                 for a, (b, fo, nb) in enumerate(block_at[(l, which)]):
-                    rows = sizes[a] if which == 0 or full else (0 if a == 2 else min(sizes[a], 1))
-                    for i in range(rows):
-                        if which == 0 and even and b in (1, 3):
-                            # reads the cos-odd or sin-odd class, zero here: store a zero
-                            lists[name].append((base + off[a] + i, base, 0, ZERO))
+                    if which == 0 and even and b in (1, 3):
+                        continue                   # reads the cos-odd or sin-odd class
+                    for i in range(sizes[a]):
+                        if which == 1 and abs(classes(l)[a][i]) > reach:
                             continue
-                        # a row in chunks of CHUNK columns: (destination, source, chunk
-                        # weights, accumulate). A chunk reads CHUNK consecutive entries of
-                        # this degree only (2l + 1 >= 5), shifted back at the degree's end,
-                        # with zero weights where it overlaps other columns: it reads only
-                        # entries this evaluation has written
-                        row = blk_row(fo, i, nb)
+                        # a row in chunks of CHUNK columns: (destination, source, add). A
+                        # chunk reads CHUNK consecutive entries of this degree only
+                        # (2l + 1 >= 5), shifted back at the degree's end, with zero weights
+                        # where it overlaps other columns: it reads only entries this
+                        # evaluation has written
+                        row = dense[fo + i * nb:fo + (i + 1) * nb]
                         for c0 in range(0, max(nb, 1), CHUNK):
                             st = min(off[b] + c0, 2 * l + 1 - CHUNK)
-                            w = [row[st + q - off[b]] if c0 <= st + q - off[b] < min(c0 + CHUNK, nb)
-                                 else 0.0 for q in range(CHUNK)]
-                            lists[name].append((base + off[a] + i, base + st, len(chunks),
-                                                int(c0 > 0)))
-                            chunks.append(w)
-            lists["x1"] += pairs[1:]
+                            weights[name].append(
+                                [row[st + q - off[b]] if c0 <= st + q - off[b] < min(c0 + CHUNK, nb)
+                                 else 0.0 for q in range(CHUNK)])
+                            lists[name].append((base + off[a] + i, base + st, int(c0 > 0)))
             if slots[2] >= 0:                # the last z-rotation: the primary's only
-                lists["x2"] += pairs[1:] if full else pairs[1:2]
-            lists["row"] += range(base, base + (2 * l + 1 if full else 1))
+                lists["x2"] += pairs[1:reach + 1]
+            lists["row"] += [base + position(l, m) for m in range(-mt, mt + 1)]
         prog = [0] * _K.PROGRAM_WIDTH
         for nkey, okey, name in ((_K.P_NLOAD, _K.P_LOAD, "load"), (_K.P_NJ, _K.P_J, "j"),
                                  (_K.P_NX1, _K.P_X1, "x1"), (_K.P_NJT, _K.P_JT, "jt"),
                                  (_K.P_NX2, _K.P_X2, "x2"), (_K.P_NROW, _K.P_ROW, "row")):
             items = lists[name]
             prog[nkey] = len(items)
-            if name in ("load", "x1", "x2"):              # (p, q, m): one int
-                packed = [pack(*it) for it in items]
-            elif name in ("j", "jt"):                       # (dst, src, chunk, add): two
-                packed = [v for d, s_, c, add in items for v in (pack(d, s_, add), c)]
-            else:
-                packed = list(items)
-            prog[okey] = put(packed)
+            prog[okey] = put(list(items) if name == "row" else [pack(*it) for it in items])
+        # each J list's chunk weights in its own order: entry e's at P_FJ (P_FJT) + CHUNK e
+        for fkey, name in ((_K.P_FJ, "j"), (_K.P_FJT, "jt")):
+            prog[fkey] = len(floats)
+            for w in weights[name]:
+                floats += w
         prog[_K.P_SRC], prog[_K.P_DST], prog[_K.P_ACC], prog[_K.P_T1] = src, dst, acc, t1
         prog[_K.P_Z0], prog[_K.P_Z1], prog[_K.P_Z2] = slots
         at = _K.K_PROG_A if body == 0 else _K.K_PROG_B
         head[at:at + _K.PROGRAM_WIDTH] = prog
 
-    # the chunk weights: rows referred to them by index, now by float offset
-    chunk0 = len(floats)
-    for c in chunks:
-        floats += c
-    for at in (_K.K_PROG_A, _K.K_PROG_B):
-        for nkey, okey in ((_K.P_NJ, _K.P_J), (_K.P_NJT, _K.P_JT)):
-            o = head[at + okey]
-            for e in range(head[at + nkey]):
-                ints[o + 2 * e + 1] = chunk0 + CHUNK * ints[o + 2 * e + 1]
     # the interaction terms (ia, ib, L) with their couplings, and the z-torque pairs
     terms, kvals = [], []
+    touched = (set(), set())
     for l1 in range(dA + 1):
         for l2 in range(min(dB, N - l1) + 1):
             if l1 == 1 or l2 == 1 or not (masks[0] >> l1) & 1 or not (masks[1] >> l2) & 1:
@@ -291,7 +307,14 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
             K = _hm.coupling(l1, l2)
             mn = min(l1, l2)
             for m in range(-mn, mn + 1):
-                terms.append(pack(l1 * l1 + position(l1, m), l2 * l2 + position(l2, m), l1 + l2))
+                ia, ib = l1 * l1 + position(l1, m), l2 * l2 + position(l2, m)
+                # the first term of each ∂U/∂C row stores instead of adding: the rows need
+                # no zeroing first, and every row the torques read is one some term wrote
+                flags = (FIRST_A if ia not in touched[0] else 0) | \
+                    (FIRST_B if ib not in touched[1] else 0)
+                touched[0].add(ia)
+                touched[1].add(ib)
+                terms.append(pack(ia, ib, (l1 + l2) | flags))
                 kvals.append(float(K[l1 + m, l2 + m]))
     head[_K.K_NTERM] = len(kvals)
     head[_K.K_I_TERM] = put(terms)
@@ -301,7 +324,7 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
     for l in range(2, min(dB, N - 2) + 1):
         if (masks[1] >> l) & 1:
             bz += [pack(l * l + position(l, m), l * l + position(l, -m), m)
-                   for m in range(1, l + 1)]
+                   for m in range(1, tops[1][l] + 1)]
     head[_K.K_NBZ] = len(bz)
     head[_K.K_I_BZ] = put(bz)
     head[_K.K_NPOW] = N + 1
