@@ -28,9 +28,10 @@ def loop_kernel(potential, rotation):
     nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
     nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
     nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
+    ndf = ti.types.ndarray(dtype=ti.f64)          # rows and scratch: 2-D or flat (harmonic)
 
     @ti.kernel
-    def loop(rows: nd2f, R_nd: nd2f, scr: nd2f, ints: nd1i, floats: nd1f, out: nd2f,
+    def loop(rows: ndf, R_nd: nd2f, scr: ndf, ints: nd1i, floats: nd1f, out: nd2f,
              repeats: ti.i32):
         for i in range(R_nd.shape[0]):
             R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])

@@ -63,11 +63,12 @@ def measure(order, caps, n, reps, odd):
     ints, floats, width = ht.ints, ht.floats, ht.scratch
     kh, kc = KERNELS["harmonic"], KERNELS["cartesian"]
     out_c, out_h = np.zeros((n, 11)), np.zeros((n, 11))
-    scr_c, scr_h = np.zeros((n, tab.scratch)), np.zeros((n, width))
+    scr_c, scr_h = np.zeros((n, tab.scratch)), np.zeros(n * width)
     t0 = time.perf_counter()
     kc(rows_c, R, scr_c, tab.ints, tab.floats, out_c, 0)
     compile_c = time.perf_counter() - t0
     t0 = time.perf_counter()
+    rows_h = rows_h.ravel()                  # the harmonic kernels' rows are one flat array
     kh(rows_h, R, scr_h, ints, floats, out_h, 0)
     compile_h = time.perf_counter() - t0
     diff = max(float(np.max(np.abs(out_h[:, sl] - out_c[:, sl]))

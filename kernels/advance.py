@@ -250,7 +250,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
                 h_nd: nd1f, t_end: nd1f, t_stop: nd1f, status: nd1i, counters: nd2l,
                 events: nd3f, n_events: nd1i, samples: nd3f, n_samples: nd1i, next_sample: nd1f,
                 shadow_nd: nd2f, shadow_f_nd: nd2f, ind: nd2f,
-                mpr: nd2f, mps: nd2f, mpi: nd1i, mpf: nd1f,
+                mpr: nd1f, mps: nd1f, mpi: nd1i, mpf: nd1f,
                 rtol: ti.f64, atol: ti.f64, min_step: ti.f64, sample_dt: ti.f64, d0: ti.f64,
                 max_steps: ti.i64, order: ti.template(), odd: ti.template(), sampling: ti.template(),
                 indicators: ti.template()):
@@ -472,7 +472,7 @@ def make_kernels(model, tableau=CASH_KARP, controller=DEFAULT_CONTROLLER, unroll
             _store(out, i, rhs(par, i, _load(y_nd, i), order, odd, par, par, par, par))
 
     @ti.kernel
-    def evaluate_rhs_mp(par: nd2f, y_nd: nd2f, out: nd2f, mpr: nd2f, mps: nd2f, mpi: nd1i,
+    def evaluate_rhs_mp(par: nd2f, y_nd: nd2f, out: nd2f, mpr: nd1f, mps: nd1f, mpi: nd1i,
                         mpf: nd1f, order: ti.template(), odd: ti.template()):
         """:func:`evaluate_rhs` at any order (order-N rows, scratch row i, tables)."""
         for i in range(y_nd.shape[0]):
@@ -541,7 +541,7 @@ def diagnostics(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, order: ti.templa
 
 
 @ti.kernel
-def diagnostics_mp(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, mpr: nd2f, mps: nd2f,
+def diagnostics_mp(par: nd2f, y_nd: nd2f, member: nd1i, out: nd2f, mpr: nd1f, mps: nd1f,
                    mpi: nd1i, mpf: nd1f, order: ti.template(), odd: ti.template()):
     """:func:`diagnostics` at any order: member[k]'s order-N integral row, scratch row k."""
     for k in range(y_nd.shape[0]):

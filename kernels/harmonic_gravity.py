@@ -21,9 +21,12 @@ above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
   z-rotation pairs and dense J-block rows, so the kernel runs a few flat loops with no
   per-degree logic and each helper has one call site (compile time grows with inlined
   copies);
-* degrees above the mixed terms' (l > min(d, N − 2)) enter only through m = 0 (the other
-  body's monopole) and the generators' neighbours m = ±1, so their last product computes
-  those three rows only; a body's degrees that are zero in every member are left out;
+* a degree's terms reach only |m| <= m_l (m_l = 0 above N − 2: the other body's
+  monopole), so its last product computes |m| <= m_l + 1 only (the generators'
+  neighbours); a body's degrees that are zero in every member are left out, and a
+  mirror-symmetric body's zero classes are neither computed nor read (the tables' flags);
+* the rows of ∂U/∂C are stored by the terms (a run of terms per primary row summed in a
+  register, the secondary's first term storing), never zeroed first;
 * r^−(L+1) is tabulated once per evaluation; the angles come from matrix entries, never from
   trigonometric calls (multiple angles by the addition recurrence);
 * the primary's z-torque is the secondary's with the opposite sign: along the line of
@@ -36,10 +39,13 @@ above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
   nested ``ti.func`` that takes an array: inside a real function such a call crashes at
   launch in Taichi 1.7.
 
-Per-member data, passed as arguments of the kernels beside the parameter rows (the same four
-arrays as the Cartesian kernels'): ``rows`` (members × width) the coefficient rows
-(``harmonic_tables.coefficient_rows``), ``scr`` (slots × scratch) per-slot scratch, ``tab_i``
-(int32, the header of ``ti_spinorbit.layout.harmonic`` first) and ``tab_f`` (float64).
+Per-member data, passed as arguments of the kernels beside the parameter rows (the four
+arrays of ``Multipole.arguments``): ``rows`` the coefficient rows
+(``harmonic_tables.coefficient_rows``) as one flat array, member j's at j · K_WIDTH, ``scr``
+the per-slot scratch as one flat array, slot k's at k · K_SCRATCH (flat because Taichi
+reloads a 2-D array's stride from memory after every store: 15-20 % of the order-6
+potential), ``tab_i`` (int32, the header of ``ti_spinorbit.layout.harmonic`` first) and
+``tab_f`` (float64).
 Conventions as in ``mutual_gravity.py`` (primary frame A; R from A's centre of mass to B's; S
 maps B-frame vectors into A; ``dUdR`` = ∂U/∂R; mu2 the torque on B, mu1 on A).
 """
@@ -52,10 +58,10 @@ from .mutual_gravity import make_evaluate, vec3
 
 _BITS = 9                       # harmonic_tables.BITS: a packed entry is a | b << 9 | c << 18
 _MASK = (1 << _BITS) - 1
-_M_FIELD = 31                   # c of a pair: m | ZERO_SIN; of a term: L | FIRST_A | FIRST_B
+_M_FIELD = 31                   # c of a pair: m | ZERO_SIN; of a term: L | LAST_A | FIRST_B
 _L_FIELD = 63
-_ZERO_SIN = 1 << (2 * _BITS + 5)          # harmonic_tables.ZERO_SIN, FIRST_A, FIRST_B in place
-_FIRST_A = 1 << (2 * _BITS + 6)
+_ZERO_SIN = 1 << (2 * _BITS + 5)          # harmonic_tables.ZERO_SIN, LAST_A, FIRST_B in place
+_LAST_A = 1 << (2 * _BITS + 6)
 _FIRST_B = 1 << (2 * _BITS + 7)
 
 
@@ -66,11 +72,14 @@ _mat3 = ti.types.matrix(3, 3, ti.f64)
 _Result = ti.types.struct(U=ti.f64, dU=vec3, mu1=vec3, mu2=vec3)
 
 
-def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_f: _nd1f,
+def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_f: _nd1f,
                G: ti.f64, R: vec3, S: _mat3) -> _Result:
     """The body of :func:`mutual_h`, compiled as a real function (module docstring) or
     inlined. Written as one function with no nested ``ti.func`` taking an array: inside a
     Taichi 1.7 real function such a call crashes at launch."""
+    # member j's coefficient row and slot k's scratch row in the flat arrays
+    j0 = j * tab_i[_K.K_WIDTH]
+    k0 = k * tab_i[_K.K_SCRATCH]
     top = tab_i[_K.K_TOP]
     t2 = tab_i[_K.K_S_T2]
     trig = tab_i[_K.K_S_TRIG]
@@ -104,15 +113,15 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
     s1 = ti.Vector([-sf, -st, -sa, sg, sb], ti.f64)
     cm, sm = c1, s1
     for a in ti.static(range(5)):
-        scr[k, trig + a * n2] = 1.0
-        scr[k, trig + a * n2 + top + 1] = 0.0
-        scr[k, trig + a * n2 + 1] = c1[a]
-        scr[k, trig + a * n2 + top + 2] = s1[a]
+        scr[k0 + trig + a * n2] = 1.0
+        scr[k0 + trig + a * n2 + top + 1] = 0.0
+        scr[k0 + trig + a * n2 + 1] = c1[a]
+        scr[k0 + trig + a * n2 + top + 2] = s1[a]
     for m in range(2, top + 1):                  # the five angles side by side
         cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
         for a in ti.static(range(5)):
-            scr[k, trig + a * n2 + m] = cm[a]
-            scr[k, trig + a * n2 + top + 1 + m] = sm[a]
+            scr[k0 + trig + a * n2 + m] = cm[a]
+            scr[k0 + trig + a * n2 + top + 1 + m] = sm[a]
     # both bodies into the frame L by their programs: the member's coefficients read with
     # the first z-rotation, then two passes (J then X; Jᵀ then X), in one loop over the
     # bodies and one over the passes, so that each helper has one call site (every ti.func
@@ -122,7 +131,7 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
         src = tab_i[pg + _K.P_SRC]
         dst = tab_i[pg + _K.P_DST]
         t1 = tab_i[pg + _K.P_T1]
-        scr[k, dst] = rows[j, src]                       # degree 0: the mass
+        scr[k0 + dst] = rows[j0 + src]                     # degree 0: the mass
         # the member's coefficients, turned by the first z-rotation as they are read
         o = tab_i[pg + _K.P_LOAD]
         z0 = trig + n2 * tab_i[pg + _K.P_Z0]
@@ -131,14 +140,14 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
             p = w & _MASK
             q = (w >> _BITS) & _MASK
             m = (w >> (2 * _BITS)) & _M_FIELD
-            c = scr[k, z0 + m]
-            s_ = scr[k, z0 + top + 1 + m]
-            a = rows[j, src + p]
+            c = scr[k0 + z0 + m]
+            s_ = scr[k0 + z0 + top + 1 + m]
+            a = rows[j0 + src + p]
             b = 0.0
             if w & _ZERO_SIN == 0:                       # (a sin partner known zero: not read)
-                b = rows[j, src + q]
-            scr[k, t1 + p] = c * a - s_ * b
-            scr[k, t1 + q] = s_ * a + c * b
+                b = rows[j0 + src + q]
+            scr[k0 + t1 + p] = c * a - s_ * b
+            scr[k0 + t1 + q] = s_ * a + c * b
         for step in range(1, 3):                         # J then X; Jᵀ then X
             nrow, orow, frow, npair, opair, slot, vec, src_ = (
                 tab_i[pg + _K.P_NJ], tab_i[pg + _K.P_J], tab_i[pg + _K.P_FJ],
@@ -155,11 +164,11 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
                 d = vec + (w & _MASK)
                 s0 = src_ + ((w >> _BITS) & _MASK)
                 f = frow + 4 * e
-                acc = (tab_f[f] * scr[k, s0] + tab_f[f + 1] * scr[k, s0 + 1]
-                       + tab_f[f + 2] * scr[k, s0 + 2] + tab_f[f + 3] * scr[k, s0 + 3])
+                acc = (tab_f[f] * scr[k0 + s0] + tab_f[f + 1] * scr[k0 + s0 + 1]
+                       + tab_f[f + 2] * scr[k0 + s0 + 2] + tab_f[f + 3] * scr[k0 + s0 + 3])
                 if w >> (2 * _BITS) != 0:
-                    acc += scr[k, d]
-                scr[k, d] = acc
+                    acc += scr[k0 + d]
+                scr[k0 + d] = acc
             # then X(ψ) in place on the pairs (p, q, m) of the list: v[p], v[q] rotated by mψ
             tz = trig + n2 * slot
             for e in range(npair):
@@ -167,67 +176,67 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
                 p = vec + (w & _MASK)
                 q = vec + ((w >> _BITS) & _MASK)
                 m = (w >> (2 * _BITS)) & _M_FIELD
-                c = scr[k, tz + m]
-                s_ = scr[k, tz + top + 1 + m]
-                a = scr[k, p]
+                c = scr[k0 + tz + m]
+                s_ = scr[k0 + tz + top + 1 + m]
+                a = scr[k0 + p]
                 b = 0.0
                 if w & _ZERO_SIN == 0:
-                    b = scr[k, q]
-                scr[k, p] = c * a - s_ * b
-                scr[k, q] = s_ * a + c * b
-    # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C (each row's first term
-    # stores, the others add: no zeroing first)
+                    b = scr[k0 + q]
+                scr[k0 + p] = c * a - s_ * b
+                scr[k0 + q] = s_ * a + c * b
+    # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C (no row zeroed first: the
+    # primary's rows are runs of consecutive terms, of the secondary's the first stores)
     inv_r = 1.0 / r
     wr = -G * inv_r
     for q in range(tab_i[_K.K_NPOW]):
-        scr[k, sw + q] = wr                              # −G r^−(q+1)
+        scr[k0 + sw + q] = wr                              # −G r^−(q+1)
         wr *= inv_r
     ot = tab_i[_K.K_I_TERM]
     ok = tab_i[_K.K_F_TERM]
     U = 0.0
     dUdr = 0.0
+    ga = 0.0
     for e in range(tab_i[_K.K_NTERM]):
         w = tab_i[ot + e]
         ia = w & _MASK
         ib = (w >> _BITS) & _MASK
         Lt = (w >> (2 * _BITS)) & _L_FIELD
-        kv = scr[k, sw + Lt] * tab_f[ok + e]
-        a = scr[k, sA + ia]
-        b = scr[k, sB + ib]
+        kv = scr[k0 + sw + Lt] * tab_f[ok + e]
+        a = scr[k0 + sA + ia]
+        b = scr[k0 + sB + ib]
         u = a * kv * b
         U += u
         dUdr -= (Lt + 1) * u
-        ga = kv * b                                      # a row's first term stores
-        if w & _FIRST_A == 0:
-            ga += scr[k, sGA + ia]
-        scr[k, sGA + ia] = ga
-        gb = kv * a
+        ga += kv * b                                     # the primary's row: a run of terms
+        if w & _LAST_A != 0:
+            scr[k0 + sGA + ia] = ga
+            ga = 0.0
+        gb = kv * a                                      # the secondary's: its first stores
         if w & _FIRST_B == 0:
-            gb += scr[k, sGB + ib]
-        scr[k, sGB + ib] = gb
+            gb += scr[k0 + sGB + ib]
+        scr[k0 + sGB + ib] = gb
     dUdr *= inv_r
     # torques in the frame L: x, y from the generators (4 entries per row), z of the
     # secondary analytically ((G_z C)_±m = ∓m C_∓m), the primary's z opposite (along the
     # line of centres (R × ∂U/∂R)_z = 0)
-    oc = tab_i[_K.K_I_GC]
-    of = tab_i[_K.K_F_G]
     ax, ay, bx, by = 0.0, 0.0, 0.0, 0.0
     for body in range(2):
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         base = tab_i[pg + _K.P_DST]
         acc0 = tab_i[pg + _K.P_ACC]
         o = tab_i[pg + _K.P_ROW]
+        fo = tab_i[pg + _K.P_FROW]
         tx, ty = 0.0, 0.0
-        for e in range(tab_i[pg + _K.P_NROW]):
-            g = tab_i[o + e]
-            av = scr[k, acc0 + g]
-            wx = tab_i[oc + 2 * g]
-            wy = tab_i[oc + 2 * g + 1]
-            f = of + 4 * g
-            tx += av * (tab_f[f] * scr[k, base + (wx & _MASK)]
-                        + tab_f[f + 1] * scr[k, base + ((wx >> _BITS) & _MASK)])
-            ty += av * (tab_f[f + 2] * scr[k, base + (wy & _MASK)]
-                        + tab_f[f + 3] * scr[k, base + ((wy >> _BITS) & _MASK)])
+        for e in range(tab_i[pg + _K.P_NROW]):          # (row, columns x, columns y)
+            g = tab_i[o + 3 * e]
+            av = scr[k0 + acc0 + g]
+            wx = tab_i[o + 3 * e + 1]
+            wy = tab_i[o + 3 * e + 2]
+            f = fo + 4 * e
+            tx += av * (tab_f[f] * scr[k0 + base + (wx & _MASK)]
+                        + tab_f[f + 1] * scr[k0 + base + ((wx >> _BITS) & _MASK)])
+            ty += av * (tab_f[f + 2] * scr[k0 + base + (wy & _MASK)]
+                        + tab_f[f + 3] * scr[k0 + base + ((wy >> _BITS) & _MASK)])
         if body == 0:
             ax, ay = -tx, -ty
         else:
@@ -238,7 +247,8 @@ def _potential(rows: _nd2f, j: ti.i32, scr: _nd2f, k: ti.i32, tab_i: _nd1i, tab_
         w = tab_i[ob + e]
         gp = w & _MASK
         gm = (w >> _BITS) & _MASK
-        bz += (w >> (2 * _BITS)) * (scr[k, sGB + gp] * scr[k, sB + gm] - scr[k, sGB + gm] * scr[k, sB + gp])
+        bz += (w >> (2 * _BITS)) * (scr[k0 + sGB + gp] * scr[k0 + sB + gm]
+                                    - scr[k0 + sGB + gm] * scr[k0 + sB + gp])
     tauA = vec3(ax, ay, -bz)
     tauB = vec3(bx, by, bz)
     s = tauA + tauB
@@ -280,6 +290,6 @@ def mutual_h_inline(rows: ti.template(), j, scr: ti.template(), k, tab_i: ti.tem
 
 #: The order-N potential for each row i (member i's coefficients, R_nd[i], S_nd[i]):
 #: out = [U, dU/dR (3), mu1 (3), mu2 (3)], scratch row i (``mutual_gravity.make_evaluate``).
-evaluate_multipole = make_evaluate(mutual_h)
+evaluate_multipole = make_evaluate(mutual_h, flat=True)
 #: The same with :func:`mutual_h_inline`.
-evaluate_multipole_inline = make_evaluate(mutual_h_inline)
+evaluate_multipole_inline = make_evaluate(mutual_h_inline, flat=True)

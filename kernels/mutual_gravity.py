@@ -245,18 +245,20 @@ def mutual(p: ti.template(), i, offA: ti.template(), offB: ti.template(), G, R, 
     return -G * U, dUdR, mu1, mu2
 
 
-def make_evaluate(potential):
+def make_evaluate(potential, flat=False):
     """A kernel evaluating an order-N ``potential`` func (``harmonic_gravity.mutual_h`` or
     ``multipole_gravity.mutual_n``: (rows, j, scr, k, tab_i, tab_f, G, R, S) -> (U, dU/dR,
     mu1, mu2)) for each row i of R_nd (3) and S_nd (3, 3): out[i] = [U, dU/dR, mu1, mu2],
-    member i's row and scratch row i."""
+    member i's row and scratch slot i (``flat``: rows and scratch as the harmonic kernels'
+    flat arrays, row i at i times the row's width; else one row per member)."""
     nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
     nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
     nd3f = ti.types.ndarray(dtype=ti.f64, ndim=3)
     nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
+    ndsf = ti.types.ndarray(dtype=ti.f64, ndim=1 if flat else 2)
 
     @ti.kernel
-    def evaluate_multipole(rows: nd2f, R_nd: nd2f, S_nd: nd3f, scr: nd2f, tab_i: nd1i,
+    def evaluate_multipole(rows: ndsf, R_nd: nd2f, S_nd: nd3f, scr: ndsf, tab_i: nd1i,
                            tab_f: nd1f, out: nd2f, G: ti.f64):
         for i in range(R_nd.shape[0]):
             R = vec3(R_nd[i, 0], R_nd[i, 1], R_nd[i, 2])

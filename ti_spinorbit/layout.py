@@ -119,18 +119,20 @@ class harmonic:
      K_TOP,                # max(dA, dB, 1): the multiple angles' top order
      K_NTERM, K_I_TERM, K_F_TERM,   # the interaction terms: (ia, ib, L) and K
      K_NBZ, K_I_BZ,        # the secondary's z-torque pairs: (g+, g−, m)
-     K_I_GC, K_F_G,        # generators about x and y: 4 columns, 4 values per global row
      K_S_A, K_S_B, K_S_GA, K_S_GB, K_S_T1, K_S_T2, K_S_TRIG, K_S_W,   # scratch offsets
                            # (K_S_T1: the primary's first buffer, the secondary's after it)
      K_SCRATCH,            # scratch columns per member
-     K_PROG_A) = range(19)  # the primary's program; the secondary's PROGRAM_WIDTH after
+     K_WIDTH,              # columns of a coefficient row: (dA + 1)² + (dB + 1)²
+     K_PROG_A) = range(18)  # the primary's program; the secondary's PROGRAM_WIDTH after
     # fields of a body's program: count and integer offset of each list (load pairs
     # (p, q, m); J rows (dst, src, columns, value offset); pairs (p, q, m) on the J output;
-    # Jᵀ rows; pairs on the final coefficients; the rows its torque reads, zeroed first),
-    # then its row offset, its scratch regions (coefficients, ∂U/∂C, its own first buffer:
+    # Jᵀ rows; pairs on the final coefficients; the rows its torque reads: (row, the
+    # generators' columns about x, about y)), the float offsets of the J rows', the Jᵀ rows'
+    # and the torque rows' weights, then its row offset, its scratch regions (coefficients, ∂U/∂C, its own first buffer:
     # entries a program never writes stay zero) and angle slots (−1: none)
     (P_NLOAD, P_LOAD, P_NJ, P_J, P_NX1, P_X1, P_NJT, P_JT, P_NX2, P_X2, P_NROW, P_ROW,
-     P_FJ, P_FJT, P_SRC, P_DST, P_ACC, P_T1, P_Z0, P_Z1, P_Z2, PROGRAM_WIDTH) = range(22)
+     P_FJ, P_FJT, P_FROW, P_SRC, P_DST, P_ACC, P_T1, P_Z0, P_Z1, P_Z2,
+     PROGRAM_WIDTH) = range(23)
     K_PROG_B = K_PROG_A + PROGRAM_WIDTH
     KHEAD = K_PROG_B + PROGRAM_WIDTH
 

@@ -18,27 +18,34 @@ What the kernels need from the host:
   program of flat lists that the kernel walks in order:
 
   - the pairs (p, q, m) that load the member's coefficients turned by the first z-rotation;
-  - the rows of J as chunks of :data:`CHUNK` columns ((destination, source, flag) and a
-    weight offset): each output class of J_l reads one input class as a dense block, about
-    a quarter of the degree's (2l+1)² entries, all others zero (checked when the tables are
-    built); a chunk reads consecutive entries of its own degree only;
-  - the pairs of the second z-rotation, the rows of Jᵀ, the pairs of the last z-rotation
-    (the primary's only);
-  - the rows of ∂U/∂C that the torque reads (zeroed first);
+  - the rows of J as chunks of :data:`CHUNK` columns ((destination, source, add), one int):
+    each output class of J_l reads one input class as a dense block, about a quarter of the
+    degree's (2l+1)² entries, all others zero (checked when the tables are built); a chunk
+    reads consecutive entries of its own degree only, and its weights are the list's e-th
+    group of CHUNK floats (from the program's P_FJ);
+  - the pairs of the second z-rotation, the rows of Jᵀ (weights from P_FJT), the pairs of
+    the last z-rotation (the primary's only);
+  - the rows of ∂U/∂C that the torque reads, each with its generators' two columns about x
+    and about y (packed) and their four values (from P_FROW);
 
-  then the interaction terms (ia, ib, l1 + l2) for l1 ≤ dA, l2 ≤ dB, l1 + l2 ≤ N, neither 1
-  (first moments vanish about the centres of mass) nor a masked degree, |m| ≤ min(l1, l2);
-  the secondary's z-torque pairs; the generators about x and y, two (column, value) pairs
-  per global row. Entries of three small fields are packed into one int32 (:func:`pack`);
-* **float table**: the dense blocks of J and Jᵀ, their chunks, the generators' values and
-  the couplings K_{l1 l2}[m, m] of the terms.
+  then the interaction terms (ia, ib, l1 + l2 and flags) for l1 ≤ dA, l2 ≤ dB,
+  l1 + l2 ≤ N, neither 1 (first moments vanish about the centres of mass) nor a masked
+  degree, |m| ≤ min(l1, l2), in the order (l1, m, l2), so that each of the primary's ∂U/∂C
+  rows is a run of consecutive terms (summed in a register, stored by the last: LAST_A) and
+  each of the secondary's is stored by its first term (FIRST_B): nothing is zeroed first;
+  then the secondary's z-torque pairs. Entries of three small fields are packed into one
+  int32 (:func:`pack`);
+* **float table**: the chunks of J and Jᵀ and the generators' values of each program's
+  torque rows, each in its list's order, and the couplings K_{l1 l2}[m, m] of the terms.
 
-What the programs leave out: degrees above the mixed terms' (l > min(d, N − 2)) meet only
-the other body's monopole, so their Jᵀ rows and last pairs are those of m = 0, ±1 only; a
-body's degrees that are zero in every member (:func:`degree_mask`: an ellipsoid's odd
-degrees) are skipped; for a body whose coefficients are cos-even only (:func:`even_mask`:
-three mirror planes, an ellipsoid) the first z-rotation skips the odd orders and the first
-J stores zeros for the classes it would read from them.
+What the programs leave out (docs/physics.md §3.8.2): a degree's terms reach only
+|m| ≤ m_l (:func:`top_orders`), so its Jᵀ rows and last pairs stop at |m| ≤ m_l + 1 (the
+torques read the generators' neighbours) and its rows of ∂U/∂C at |m| ≤ m_l; a body's degrees
+that are zero in every member (:func:`degree_mask`: an ellipsoid's odd degrees) are skipped;
+for a body whose coefficients are cos-even only at an even degree (:func:`even_mask`: three
+mirror planes, an ellipsoid) the load reads no sines, the first J computes only the two cos
+classes (the others would read zeros), and the second z-rotation's pairs are flagged
+(ZERO_SIN) not to read their zero sines.
 
 Every member walks the same tables in the same order, so threads never diverge; one compiled
 kernel serves every order, cap and mask (``layout.multipole.KERNEL_ORDER``).
@@ -116,10 +123,11 @@ ALL_DEGREES = (1 << (MAX_ORDER + 1)) - 1
 #: (measured faster than a loop over the row's columns, whose length is 1 to 7).
 CHUNK = 4
 #: Flags in the third field of packed entries: a pair (p, q, m) whose q entry is known to be
-#: zero (not read); the first term of a ∂U/∂C row of the primary, of the secondary (stores
-#: instead of adding). The third field of a J row is 1 when the chunk adds to its row.
+#: zero (not read); the last term of a ∂U/∂C row of the primary (stores the row's sum), the
+#: first of one of the secondary (stores instead of adding). The third field of a J row is 1
+#: when the chunk adds to its row.
 ZERO_SIN = 1 << 5
-FIRST_A, FIRST_B = 1 << 6, 1 << 7
+LAST_A, FIRST_B = 1 << 6, 1 << 7
 
 
 #: Bits of a position in a packed table entry: positions within a body's region are below
@@ -168,8 +176,8 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
     (:func:`degree_mask`; e.g. the odd degrees of ellipsoids), so its rotation and its terms
     are left out. ``even_a``, ``even_b``: bit l set when only the cos-even class of that
     degree is non-zero in every member (:func:`even_mask`: a body with three mirror planes in
-    its frame, e.g. an ellipsoid), so the first z-rotation skips the odd orders and the first
-    J product stores zeros for the classes it would read from them."""
+    its frame, e.g. an ellipsoid), so at even degrees the load reads no sines, the first J
+    product computes only the cos classes and the second z-rotation reads no sines."""
     N, dA, dB = int(order), int(degree_a), int(degree_b)
     if not 0 <= N <= MAX_ORDER or not 0 <= dA <= N or not 0 <= dB <= N:
         raise ValueError(f"tables need 0 <= degrees <= order <= {MAX_ORDER} (got order {N}, "
@@ -195,7 +203,8 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                 entry.append((b, len(dense), blk.shape[1]))
                 dense += [float(v) for v in blk.ravel()]
             block_at[(l, which)] = entry
-    # the generators about x and y: two (column, value) pairs per global row l² + position
+    # the generators about x and y: two (column, value) pairs per global row l² + position,
+    # copied into each torque row of the programs
     gcols, gvals = [], []
     for l in range(top + 1):
         G = _hm.generators(l)
@@ -209,9 +218,6 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                 gvals += [float(G[k][i, c]) for c in nz] + [0.0] * (2 - len(nz))
                 cols = [l * l + int(pos[c]) for c in nz] + [l * l + int(pos[i])] * (2 - len(nz))
                 gcols.append(pack(*cols))
-    head[_K.K_I_GC] = put(gcols)
-    head[_K.K_F_G] = len(floats)
-    floats += gvals
 
     offset = 0
     regions = {}
@@ -222,6 +228,7 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
         head[key] = regions[key] = offset
         offset += size
     head[_K.K_SCRATCH] = offset
+    head[_K.K_WIDTH] = (dA + 1) ** 2 + (dB + 1) ** 2
 
     # each body's program: its degrees 2..d that are not masked out. Only the orders a degree
     # needs are computed: its terms reach |m| <= top_m (:func:`top_orders`), the torques read
@@ -286,9 +293,14 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                                  (_K.P_NX2, _K.P_X2, "x2"), (_K.P_NROW, _K.P_ROW, "row")):
             items = lists[name]
             prog[nkey] = len(items)
-            prog[okey] = put(list(items) if name == "row" else [pack(*it) for it in items])
-        # each J list's chunk weights in its own order: entry e's at P_FJ (P_FJT) + CHUNK e
-        for fkey, name in ((_K.P_FJ, "j"), (_K.P_FJT, "jt")):
+            if name == "row":                 # (g, its generator columns about x, about y)
+                prog[okey] = put([v for g in items for v in (g, gcols[2 * g], gcols[2 * g + 1])])
+            else:
+                prog[okey] = put([pack(*it) for it in items])
+        # the weights in each list's own order: J (Jᵀ) chunk e's CHUNK at P_FJ (P_FJT) +
+        # CHUNK e, torque row e's generator values (x, x, y, y) at P_FROW + 4 e
+        weights["row"] = [gvals[4 * g:4 * g + 4] for g in lists["row"]]
+        for fkey, name in ((_K.P_FJ, "j"), (_K.P_FJT, "jt"), (_K.P_FROW, "row")):
             prog[fkey] = len(floats)
             for w in weights[name]:
                 floats += w
@@ -298,24 +310,26 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
         head[at:at + _K.PROGRAM_WIDTH] = prog
 
     # the interaction terms (ia, ib, L) with their couplings, and the z-torque pairs
+    # in the order (l1, m, l2), so that each of the primary's ∂U/∂C rows is one run of
+    # consecutive terms, summed in a register and stored by its last term (LAST_A); the
+    # first term of each of the secondary's rows stores instead of adding (FIRST_B): no row
+    # is zeroed first, and every row the torques read is one some term wrote
     terms, kvals = [], []
-    touched = (set(), set())
+    touched = set()
     for l1 in range(dA + 1):
-        for l2 in range(min(dB, N - l1) + 1):
-            if l1 == 1 or l2 == 1 or not (masks[0] >> l1) & 1 or not (masks[1] >> l2) & 1:
-                continue
-            K = _hm.coupling(l1, l2)
-            mn = min(l1, l2)
-            for m in range(-mn, mn + 1):
+        if l1 == 1 or not (masks[0] >> l1) & 1:
+            continue
+        partners = [l2 for l2 in range(min(dB, N - l1) + 1)
+                    if l2 != 1 and (masks[1] >> l2) & 1]
+        for m in range(-l1, l1 + 1):
+            mine = [l2 for l2 in partners if abs(m) <= l2]
+            for n_, l2 in enumerate(mine):
                 ia, ib = l1 * l1 + position(l1, m), l2 * l2 + position(l2, m)
-                # the first term of each ∂U/∂C row stores instead of adding: the rows need
-                # no zeroing first, and every row the torques read is one some term wrote
-                flags = (FIRST_A if ia not in touched[0] else 0) | \
-                    (FIRST_B if ib not in touched[1] else 0)
-                touched[0].add(ia)
-                touched[1].add(ib)
+                flags = (LAST_A if n_ == len(mine) - 1 else 0) | \
+                    (FIRST_B if ib not in touched else 0)
+                touched.add(ib)
                 terms.append(pack(ia, ib, (l1 + l2) | flags))
-                kvals.append(float(K[l1 + m, l2 + m]))
+                kvals.append(float(_hm.coupling(l1, l2)[l1 + m, l2 + m]))
     head[_K.K_NTERM] = len(kvals)
     head[_K.K_I_TERM] = put(terms)
     head[_K.K_F_TERM] = len(floats)
@@ -329,8 +343,8 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
     head[_K.K_I_BZ] = put(bz)
     head[_K.K_NPOW] = N + 1
     head[_K.K_TOP] = top
-    ints_arr = np.array(ints, dtype=np.int32)
     floats_arr = np.array(floats + [0.0], dtype=np.float64)     # never empty
+    ints_arr = np.array(ints, dtype=np.int32)
     ints_arr.setflags(write=False)
     floats_arr.setflags(write=False)
     return HarmonicTables(N, dA, dB, ints_arr, floats_arr)
