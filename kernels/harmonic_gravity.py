@@ -63,6 +63,8 @@ _L_FIELD = 63
 _ZERO_SIN = 1 << (2 * _BITS + 5)          # harmonic_tables.ZERO_SIN, LAST_A, FIRST_B in place
 _LAST_A = 1 << (2 * _BITS + 6)
 _FIRST_B = 1 << (2 * _BITS + 7)
+_ADD_P = 1 << (2 * _BITS + 6)             # harmonic_tables.ADD_P, ADD_Q in place
+_ADD_Q = 1 << (2 * _BITS + 7)
 
 
 _nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -149,13 +151,15 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
             scr[k0 + t1 + p] = c * a - s_ * b
             scr[k0 + t1 + q] = s_ * a + c * b
         for step in range(1, 3):                         # J then X; Jᵀ then X
-            nrow, orow, frow, npair, opair, slot, vec, src_ = (
+            nrow, orow, frow, nfx, ofx, ffx, slot, vec, src_ = (
                 tab_i[pg + _K.P_NJ], tab_i[pg + _K.P_J], tab_i[pg + _K.P_FJ],
-                tab_i[pg + _K.P_NX1], tab_i[pg + _K.P_X1], tab_i[pg + _K.P_Z1], t2, t1)
+                tab_i[pg + _K.P_NJX], tab_i[pg + _K.P_JX], tab_i[pg + _K.P_FJX],
+                tab_i[pg + _K.P_Z1], t2, t1)
             if step == 2:
-                nrow, orow, frow, npair, opair, slot, vec, src_ = (
+                nrow, orow, frow, nfx, ofx, ffx, slot, vec, src_ = (
                     tab_i[pg + _K.P_NJT], tab_i[pg + _K.P_JT], tab_i[pg + _K.P_FJT],
-                    tab_i[pg + _K.P_NX2], tab_i[pg + _K.P_X2], tab_i[pg + _K.P_Z2], dst, t2)
+                    tab_i[pg + _K.P_NJTX], tab_i[pg + _K.P_JTX], tab_i[pg + _K.P_FJTX],
+                    tab_i[pg + _K.P_Z2], dst, t2)
             # the J (or Jᵀ) rows in chunks ((destination, source, add) packed; the list's
             # weights in its order, four per chunk, zero past a row's end:
             # ``harmonic_tables.CHUNK``); a chunk stores its sum or adds it to its row's
@@ -169,21 +173,33 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                 if w >> (2 * _BITS) != 0:
                     acc += scr[k0 + d]
                 scr[k0 + d] = acc
-            # then X(ψ) in place on the pairs (p, q, m) of the list: v[p], v[q] rotated by mψ
+            # then each z-rotation pair (p, q, m): the last chunk of J row p and of row q
+            # (added to the rows' partial sums when they are longer: ADD_P, ADD_Q; row q not
+            # computed when its class is known to be zero: ZERO_SIN), then rotated by mψ
             tz = trig + n2 * slot
-            for e in range(npair):
-                w = tab_i[opair + e]
+            for e in range(nfx):
+                w = tab_i[ofx + 2 * e]
+                w2 = tab_i[ofx + 2 * e + 1]
                 p = vec + (w & _MASK)
-                q = vec + ((w >> _BITS) & _MASK)
+                sp = src_ + ((w >> _BITS) & _MASK)
+                f = ffx + 8 * e
+                rp = (tab_f[f] * scr[k0 + sp] + tab_f[f + 1] * scr[k0 + sp + 1]
+                      + tab_f[f + 2] * scr[k0 + sp + 2] + tab_f[f + 3] * scr[k0 + sp + 3])
+                if w & _ADD_P != 0:
+                    rp += scr[k0 + p]
+                q = vec + (w2 & _MASK)
+                rq = 0.0
+                if w & _ZERO_SIN == 0:
+                    sq = src_ + ((w2 >> _BITS) & _MASK)
+                    rq = (tab_f[f + 4] * scr[k0 + sq] + tab_f[f + 5] * scr[k0 + sq + 1]
+                          + tab_f[f + 6] * scr[k0 + sq + 2] + tab_f[f + 7] * scr[k0 + sq + 3])
+                    if w & _ADD_Q != 0:
+                        rq += scr[k0 + q]
                 m = (w >> (2 * _BITS)) & _M_FIELD
                 c = scr[k0 + tz + m]
                 s_ = scr[k0 + tz + top + 1 + m]
-                a = scr[k0 + p]
-                b = 0.0
-                if w & _ZERO_SIN == 0:
-                    b = scr[k0 + q]
-                scr[k0 + p] = c * a - s_ * b
-                scr[k0 + q] = s_ * a + c * b
+                scr[k0 + p] = c * rp - s_ * rq
+                scr[k0 + q] = s_ * rp + c * rq
     # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C (no row zeroed first: the
     # primary's rows are runs of consecutive terms, of the secondary's the first stores)
     inv_r = 1.0 / r

@@ -146,21 +146,28 @@ def test_tables_hold_the_matrices_and_rows_do_not_depend_on_their_neighbours(rng
     assert tops == {2: 2, 3: 3, 4: 4, 5: 5, 6: 6, 7: 5, 8: 4}
     pg, W = K.K_PROG_A, HT.CHUNK
     mask = (1 << HT.BITS) - 1
-    for which, (nkey, okey, fkey) in enumerate(((K.P_NJ, K.P_J, K.P_FJ),
-                                                (K.P_NJT, K.P_JT, K.P_FJT))):
-        n, o, f0 = tab.ints[pg + nkey], tab.ints[pg + okey], tab.ints[pg + fkey]
-        packed = tab.ints[o:o + n]                           # dst | src << 9 | add << 18
-        dst, src = packed & mask, (packed >> HT.BITS) & mask
+    for which, keys in enumerate(((K.P_NJ, K.P_J, K.P_FJ, K.P_NJX, K.P_JX, K.P_FJX),
+                                  (K.P_NJT, K.P_JT, K.P_FJT, K.P_NJTX, K.P_JTX, K.P_FJTX))):
+        n, o, f0, nx, ox, fx = (int(tab.ints[pg + key]) for key in keys)
+        # every chunk as (destination, source, weights): the plain list's, then both rows of
+        # each fused entry (dst | src << 9 | flags << 18 for row p, then dst | src << 9 for q)
+        chunks = [(w & mask, (w >> HT.BITS) & mask, tab.floats[f0 + W * e:f0 + W * (e + 1)])
+                  for e, w in enumerate(tab.ints[o:o + n])]
+        fused = tab.ints[ox:ox + 2 * nx].reshape(nx, 2)
+        for e, (wp, wq) in enumerate(fused):
+            assert not wp >> 2 * HT.BITS & HT.ZERO_SIN            # a cloud: no zero class
+            f = fx + 2 * W * e
+            chunks += [(wp & mask, (wp >> HT.BITS) & mask, tab.floats[f:f + W]),
+                       (wq & mask, (wq >> HT.BITS) & mask, tab.floats[f + W:f + 2 * W])]
         for l in range(2, 9):
             reach = 8 if which == 0 else min(l, tops[l] + 1)
             rows = [l * l + HT.position(l, m) for m in range(-l, l + 1) if abs(m) <= reach]
             J = np.zeros((2 * l + 1, 2 * l + 1))
-            mine = np.nonzero((dst >= l * l) & (dst < (l + 1) ** 2))[0]
-            assert set(dst[mine]) == set(rows)
-            assert np.all(src[mine] >= l * l) and np.all(src[mine] + W <= (l + 1) ** 2)
-            for e in mine:
-                J[dst[e] - l * l, src[e] - l * l:src[e] - l * l + W] += \
-                    tab.floats[f0 + W * e:f0 + W * (e + 1)]
+            mine = [c for c in chunks if l * l <= c[0] < (l + 1) ** 2]
+            assert {c[0] for c in mine} == set(rows)
+            for dst, src, w in mine:
+                assert l * l <= src and src + W <= (l + 1) ** 2
+                J[dst - l * l, src - l * l:src - l * l + W] += w
             target = H.j_matrix(l) if which == 0 else H.j_matrix(l).T
             perm = HT.permutation(l)
             kept = [r - l * l for r in rows]

@@ -130,9 +130,9 @@ class harmonic:
     # generators' columns about x, about y)), the float offsets of the J rows', the Jᵀ rows'
     # and the torque rows' weights, then its row offset, its scratch regions (coefficients, ∂U/∂C, its own first buffer:
     # entries a program never writes stay zero) and angle slots (−1: none)
-    (P_NLOAD, P_LOAD, P_NJ, P_J, P_NX1, P_X1, P_NJT, P_JT, P_NX2, P_X2, P_NROW, P_ROW,
-     P_FJ, P_FJT, P_FROW, P_SRC, P_DST, P_ACC, P_T1, P_Z0, P_Z1, P_Z2,
-     PROGRAM_WIDTH) = range(23)
+    (P_NLOAD, P_LOAD, P_NJ, P_J, P_NJX, P_JX, P_NJT, P_JT, P_NJTX, P_JTX, P_NROW, P_ROW,
+     P_FJ, P_FJX, P_FJT, P_FJTX, P_FROW, P_SRC, P_DST, P_ACC, P_T1, P_Z0, P_Z1, P_Z2,
+     PROGRAM_WIDTH) = range(25)
     K_PROG_B = K_PROG_A + PROGRAM_WIDTH
     KHEAD = K_PROG_B + PROGRAM_WIDTH
 

@@ -128,6 +128,9 @@ CHUNK = 4
 #: when the chunk adds to its row.
 ZERO_SIN = 1 << 5
 LAST_A, FIRST_B = 1 << 6, 1 << 7
+#: Flags of a fused entry (J rows p and q, then their z-rotation): row p (q) adds its last
+#: chunk to the partial sum its earlier chunks left (a row longer than CHUNK).
+ADD_P, ADD_Q = 1 << 6, 1 << 7
 
 
 #: Bits of a position in a packed table entry: positions within a body's region are below
@@ -239,8 +242,8 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
             (dA, 0, regions[_K.K_S_A], regions[_K.K_S_GA], regions[_K.K_S_T1], (0, 1, 2)),
             (dB, (dA + 1) ** 2, regions[_K.K_S_B], regions[_K.K_S_GB],
              regions[_K.K_S_T1] + (top + 1) ** 2, (3, 4, -1)))):
-        lists = {name: [] for name in ("load", "j", "x1", "jt", "x2", "row")}
-        weights = {"j": [], "jt": []}
+        lists = {name: [] for name in ("load", "j", "jx", "jt", "jtx", "row")}
+        weights = {"j": [], "jx": [], "jt": [], "jtx": []}
         for l in range(2, d + 1):
             if not (masks[body] >> l) & 1:
                 continue
@@ -259,13 +262,16 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                 # partner (not read; both written)
                 lists["load"] += [(p_, q_, m | ZERO_SIN if m else 0)
                                   for p_, q_, m in pairs if m % 2 == 0]
-                lists["x1"] += [(p_, q_, m | ZERO_SIN) for p_, q_, m in pairs[1:]]
+                x1 = [(p_, q_, m | ZERO_SIN) for p_, q_, m in pairs[1:]]
             else:
                 lists["load"] += pairs
-                lists["x1"] += pairs[1:]
+                x1 = pairs[1:]
+            # the pairs of the last z-rotation: the primary's only
+            x2 = pairs[1:reach + 1] if slots[2] >= 0 else []
             sizes = [len(c) for c in classes(l)]
             off = np.concatenate([[0], np.cumsum(sizes)])
-            for which, name in ((0, "j"), (1, "jt")):
+            for which, name, xname, xpairs in ((0, "j", "jx", x1), (1, "jt", "jtx", x2)):
+                chunks = {}                        # destination row -> [(source, weights, add)]
                 for a, (b, fo, nb) in enumerate(block_at[(l, which)]):
                     if which == 0 and even and b in (1, 3):
                         continue                   # reads the cos-odd or sin-odd class
@@ -280,27 +286,43 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                         row = dense[fo + i * nb:fo + (i + 1) * nb]
                         for c0 in range(0, max(nb, 1), CHUNK):
                             st = min(off[b] + c0, 2 * l + 1 - CHUNK)
-                            weights[name].append(
-                                [row[st + q - off[b]] if c0 <= st + q - off[b] < min(c0 + CHUNK, nb)
-                                 else 0.0 for q in range(CHUNK)])
-                            lists[name].append((base + off[a] + i, base + st, int(c0 > 0)))
-            if slots[2] >= 0:                # the last z-rotation: the primary's only
-                lists["x2"] += pairs[1:reach + 1]
+                            chunks.setdefault(base + off[a] + i, []).append((base + st, [
+                                row[st + q - off[b]] if c0 <= st + q - off[b] < min(c0 + CHUNK, nb)
+                                else 0.0 for q in range(CHUNK)], int(c0 > 0)))
+                # the rows of a z-rotation pair end in one fused entry: the last chunk of
+                # each row, then the rotation (ADD_P, ADD_Q: the row's earlier chunks are
+                # in the plain list, which runs first); every other chunk is plain
+                fused = {r for p_, q_, _ in xpairs for r in (p_, q_)}
+                for row_, ch in chunks.items():
+                    for s_, w, add in (ch[:-1] if row_ in fused else ch):
+                        lists[name].append((row_, s_, add))
+                        weights[name].append(w)
+                for p_, q_, mf in xpairs:
+                    cp = chunks[p_][-1]
+                    cq = None if mf & ZERO_SIN else chunks[q_][-1]
+                    flags = mf | (ADD_P if cp[2] else 0) | (ADD_Q if cq and cq[2] else 0)
+                    lists[xname].append((pack(p_, cp[0], flags),
+                                         pack(q_, cq[0] if cq else cp[0])))
+                    weights[xname].append(cp[1] + (cq[1] if cq else [0.0] * CHUNK))
             lists["row"] += [base + position(l, m) for m in range(-mt, mt + 1)]
         prog = [0] * _K.PROGRAM_WIDTH
         for nkey, okey, name in ((_K.P_NLOAD, _K.P_LOAD, "load"), (_K.P_NJ, _K.P_J, "j"),
-                                 (_K.P_NX1, _K.P_X1, "x1"), (_K.P_NJT, _K.P_JT, "jt"),
-                                 (_K.P_NX2, _K.P_X2, "x2"), (_K.P_NROW, _K.P_ROW, "row")):
+                                 (_K.P_NJX, _K.P_JX, "jx"), (_K.P_NJT, _K.P_JT, "jt"),
+                                 (_K.P_NJTX, _K.P_JTX, "jtx"), (_K.P_NROW, _K.P_ROW, "row")):
             items = lists[name]
             prog[nkey] = len(items)
             if name == "row":                 # (g, its generator columns about x, about y)
                 prog[okey] = put([v for g in items for v in (g, gcols[2 * g], gcols[2 * g + 1])])
+            elif name in ("jx", "jtx"):       # two packed ints per fused entry
+                prog[okey] = put([v for it in items for v in it])
             else:
                 prog[okey] = put([pack(*it) for it in items])
-        # the weights in each list's own order: J (Jᵀ) chunk e's CHUNK at P_FJ (P_FJT) +
-        # CHUNK e, torque row e's generator values (x, x, y, y) at P_FROW + 4 e
+        # the weights in each list's own order: plain chunk e's CHUNK at P_FJ (P_FJT) +
+        # CHUNK e, fused entry e's 2 CHUNK (row p's, row q's) at P_FJX (P_FJTX) + 2 CHUNK e,
+        # torque row e's generator values (x, x, y, y) at P_FROW + 4 e
         weights["row"] = [gvals[4 * g:4 * g + 4] for g in lists["row"]]
-        for fkey, name in ((_K.P_FJ, "j"), (_K.P_FJT, "jt"), (_K.P_FROW, "row")):
+        for fkey, name in ((_K.P_FJ, "j"), (_K.P_FJX, "jx"), (_K.P_FJT, "jt"),
+                           (_K.P_FJTX, "jtx"), (_K.P_FROW, "row")):
             prog[fkey] = len(floats)
             for w in weights[name]:
                 floats += w
