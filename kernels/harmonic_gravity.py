@@ -94,16 +94,19 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     x, y, z = R[0], R[1], R[2]
     rho = ti.sqrt(x * x + y * y)
     r = ti.sqrt(rho * rho + z * z)
+    inv_r = 1.0 / r
     cf, sf = 1.0, 0.0
     if rho > 0.0:
-        cf, sf = x / rho, y / rho
-    ct, st = z / r, rho / r
+        inv_rho = 1.0 / rho
+        cf, sf = x * inv_rho, y * inv_rho
+    ct, st = z * inv_r, rho * inv_r
     P = ti.Matrix([[ct * cf, ct * sf, -st], [-sf, cf, 0.0], [st * cf, st * sf, ct]], ti.f64)
     Q = P @ S
     h = ti.sqrt(Q[0, 2] * Q[0, 2] + Q[1, 2] * Q[1, 2])
     ca, sa = 1.0, 0.0
     if h > 0.0:
-        ca, sa = Q[0, 2] / h, Q[1, 2] / h
+        inv_h = 1.0 / h
+        ca, sa = Q[0, 2] * inv_h, Q[1, 2] * inv_h
     cb, sb = Q[2, 2], ca * Q[0, 2] + sa * Q[1, 2]
     cg, sg = ca * Q[1, 1] - sa * Q[0, 1], ca * Q[1, 0] - sa * Q[0, 0]
     L = ti.Matrix([[ca, sa, 0.0], [-sa, ca, 0.0], [0.0, 0.0, 1.0]], ti.f64) @ P
@@ -115,8 +118,9 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     s1 = ti.Vector([-sf, -st, -sa, sg, sb], ti.f64)
     cm, sm = c1, s1
     for a in ti.static(range(5)):
-        scr[k0 + trig + a * n2] = 1.0
-        scr[k0 + trig + a * n2 + top + 1] = 0.0
+        if ti.static(a in (0, 3)):               # m = 0: read by the loads only (slots 0, 3)
+            scr[k0 + trig + a * n2] = 1.0
+            scr[k0 + trig + a * n2 + top + 1] = 0.0
         scr[k0 + trig + a * n2 + 1] = c1[a]
         scr[k0 + trig + a * n2 + top + 2] = s1[a]
     for m in range(2, top + 1):                  # the five angles side by side
@@ -202,7 +206,6 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                 scr[k0 + q] = s_ * rp + c * rq
     # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C (no row zeroed first: the
     # primary's rows are runs of consecutive terms, of the secondary's the first stores)
-    inv_r = 1.0 / r
     wr = -G * inv_r
     for q in range(tab_i[_K.K_NPOW]):
         scr[k0 + sw + q] = wr                              # −G r^−(q+1)
