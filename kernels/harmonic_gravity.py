@@ -31,6 +31,8 @@ above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
   trigonometric calls (multiple angles by the addition recurrence);
 * the primary's z-torque is the secondary's with the opposite sign: along the line of
   centres (R × ∂U/∂R)_z = 0;
+* its loops are counted and stepped by numbers read from the table, so that LLVM neither
+  copies nor unrolls them (compile time, and faster inside the integrator);
 * on the CPU the body is one Taichi real function (``ti.real_func``),
   compiled once per kernel and called, not inlined: inlined in the integrator's state
   machine, its short loops ran 1.5 × slower than the same code in a small kernel (the
@@ -83,6 +85,12 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     j0 = j * tab_i[_K.K_WIDTH]
     k0 = k * tab_i[_K.K_SCRATCH]
     top = tab_i[_K.K_TOP]
+    # 2 and 1 read at run time, for the loop counts and steps: LLVM would otherwise copy the
+    # loops over the bodies and the passes and unroll every table loop eight times over,
+    # which cost 0.4-0.5 s of compile and, in the integrator, more time than it saved (the
+    # smaller code ran 5-10 % faster there, though 5 % slower in a small benchmark kernel)
+    two = tab_i[_K.K_TWO]
+    one = two - 1
     t2 = tab_i[_K.K_S_T2]
     trig = tab_i[_K.K_S_TRIG]
     sw = tab_i[_K.K_S_W]
@@ -132,7 +140,7 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     # the first z-rotation, then two passes (J then X; Jᵀ then X), in one loop over the
     # bodies and one over the passes, so that each helper has one call site (every ti.func
     # call is inlined; compile time grows with the copies)
-    for body in range(2):
+    for body in range(two):
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         src = tab_i[pg + _K.P_SRC]
         dst = tab_i[pg + _K.P_DST]
@@ -141,7 +149,8 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
         # the member's coefficients, turned by the first z-rotation as they are read
         o = tab_i[pg + _K.P_LOAD]
         z0 = trig + n2 * tab_i[pg + _K.P_Z0]
-        for e in range(tab_i[pg + _K.P_NLOAD]):
+        e, ne = 0, tab_i[pg + _K.P_NLOAD]
+        while e < ne:
             w = tab_i[o + e]
             p = w & _MASK
             q = (w >> _BITS) & _MASK
@@ -154,20 +163,22 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                 b = rows[j0 + src + q]
             scr[k0 + t1 + p] = c * a - s_ * b
             scr[k0 + t1 + q] = s_ * a + c * b
-        for step in range(1, 3):                         # J then X; Jᵀ then X
-            nrow, orow, frow, nfx, ofx, ffx, slot, vec, src_ = (
-                tab_i[pg + _K.P_NJ], tab_i[pg + _K.P_J], tab_i[pg + _K.P_FJ],
-                tab_i[pg + _K.P_NJX], tab_i[pg + _K.P_JX], tab_i[pg + _K.P_FJX],
+            e += one
+        for step in range(1, 1 + two):                   # J then X; Jᵀ then X
+            nkey_j, orow, frow, nkey_x, ofx, ffx, slot, vec, src_ = (
+                _K.P_NJ, tab_i[pg + _K.P_J], tab_i[pg + _K.P_FJ],
+                _K.P_NJX, tab_i[pg + _K.P_JX], tab_i[pg + _K.P_FJX],
                 tab_i[pg + _K.P_Z1], t2, t1)
             if step == 2:
-                nrow, orow, frow, nfx, ofx, ffx, slot, vec, src_ = (
-                    tab_i[pg + _K.P_NJT], tab_i[pg + _K.P_JT], tab_i[pg + _K.P_FJT],
-                    tab_i[pg + _K.P_NJTX], tab_i[pg + _K.P_JTX], tab_i[pg + _K.P_FJTX],
+                nkey_j, orow, frow, nkey_x, ofx, ffx, slot, vec, src_ = (
+                    _K.P_NJT, tab_i[pg + _K.P_JT], tab_i[pg + _K.P_FJT],
+                    _K.P_NJTX, tab_i[pg + _K.P_JTX], tab_i[pg + _K.P_FJTX],
                     tab_i[pg + _K.P_Z2], dst, t2)
             # the J (or Jᵀ) rows in chunks ((destination, source, add) packed; the list's
             # weights in its order, four per chunk, zero past a row's end:
             # ``harmonic_tables.CHUNK``); a chunk stores its sum or adds it to its row's
-            for e in range(nrow):
+            e, ne = 0, tab_i[pg + nkey_j]
+            while e < ne:
                 w = tab_i[orow + e]
                 d = vec + (w & _MASK)
                 s0 = src_ + ((w >> _BITS) & _MASK)
@@ -177,11 +188,13 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                 if w >> (2 * _BITS) != 0:
                     acc += scr[k0 + d]
                 scr[k0 + d] = acc
+                e += one
             # then each z-rotation pair (p, q, m): the last chunk of J row p and of row q
             # (added to the rows' partial sums when they are longer: ADD_P, ADD_Q; row q not
             # computed when its class is known to be zero: ZERO_SIN), then rotated by mψ
             tz = trig + n2 * slot
-            for e in range(nfx):
+            e, ne = 0, tab_i[pg + nkey_x]
+            while e < ne:
                 w = tab_i[ofx + 2 * e]
                 w2 = tab_i[ofx + 2 * e + 1]
                 p = vec + (w & _MASK)
@@ -204,6 +217,7 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                 s_ = scr[k0 + tz + top + 1 + m]
                 scr[k0 + p] = c * rp - s_ * rq
                 scr[k0 + q] = s_ * rp + c * rq
+                e += one
     # the interaction along ẑ: U, ∂U/∂r and each body's ∂U/∂C (no row zeroed first: the
     # primary's rows are runs of consecutive terms, of the secondary's the first stores)
     wr = -G * inv_r
@@ -215,7 +229,8 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     U = 0.0
     dUdr = 0.0
     ga = 0.0
-    for e in range(tab_i[_K.K_NTERM]):
+    e, ne = 0, tab_i[_K.K_NTERM]
+    while e < ne:
         w = tab_i[ot + e]
         ia = w & _MASK
         ib = (w >> _BITS) & _MASK
@@ -234,19 +249,21 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
         if w & _FIRST_B == 0:
             gb += scr[k0 + sGB + ib]
         scr[k0 + sGB + ib] = gb
+        e += one
     dUdr *= inv_r
     # torques in the frame L: x, y from the generators (4 entries per row), z of the
     # secondary analytically ((G_z C)_±m = ∓m C_∓m), the primary's z opposite (along the
     # line of centres (R × ∂U/∂R)_z = 0)
     ax, ay, bx, by = 0.0, 0.0, 0.0, 0.0
-    for body in range(2):
+    for body in range(two):
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         base = tab_i[pg + _K.P_DST]
         acc0 = tab_i[pg + _K.P_ACC]
         o = tab_i[pg + _K.P_ROW]
         fo = tab_i[pg + _K.P_FROW]
         tx, ty = 0.0, 0.0
-        for e in range(tab_i[pg + _K.P_NROW]):          # (row, columns x, columns y)
+        e, ne = 0, tab_i[pg + _K.P_NROW]
+        while e < ne:          # (row, columns x, columns y)
             g = tab_i[o + 3 * e]
             av = scr[k0 + acc0 + g]
             wx = tab_i[o + 3 * e + 1]
@@ -256,18 +273,21 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                         + tab_f[f + 1] * scr[k0 + base + ((wx >> _BITS) & _MASK)])
             ty += av * (tab_f[f + 2] * scr[k0 + base + (wy & _MASK)]
                         + tab_f[f + 3] * scr[k0 + base + ((wy >> _BITS) & _MASK)])
+            e += one
         if body == 0:
             ax, ay = -tx, -ty
         else:
             bx, by = -tx, -ty
     bz = 0.0
     ob = tab_i[_K.K_I_BZ]
-    for e in range(tab_i[_K.K_NBZ]):
+    e, ne = 0, tab_i[_K.K_NBZ]
+    while e < ne:
         w = tab_i[ob + e]
         gp = w & _MASK
         gm = (w >> _BITS) & _MASK
         bz += (w >> (2 * _BITS)) * (scr[k0 + sGB + gp] * scr[k0 + sB + gm]
                                     - scr[k0 + sGB + gm] * scr[k0 + sB + gp])
+        e += one
     tauA = vec3(ax, ay, -bz)
     tauB = vec3(bx, by, bz)
     s = tauA + tauB

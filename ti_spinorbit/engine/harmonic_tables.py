@@ -232,6 +232,7 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
         offset += size
     head[_K.K_SCRATCH] = offset
     head[_K.K_WIDTH] = (dA + 1) ** 2 + (dB + 1) ** 2
+    head[_K.K_TWO] = 2
 
     # each body's program: its degrees 2..d that are not masked out. Only the orders a degree
     # needs are computed: its terms reach |m| <= top_m (:func:`top_orders`), the torques read
