@@ -161,8 +161,9 @@ def rates(models, orders, n, seconds, rounds=1):
     for model, order, caps in points:
         par, y0, mp, degrees = members(n, order, caps)
         run(par[:1], y0[:1], None if mp is None else mp[:1], degrees, order, model, 0.01)
-        rate, _, _ = run(par[:16], y0[:16], None if mp is None else mp[:16], degrees,
-                         order, model, 0.02)               # pilot: sizes the timed run
+        k = min(n, 256)          # pilot: sizes the timed run (16 members ran ~5x slower per
+        rate, _, _ = run(par[:k], y0[:k], None if mp is None else mp[:k], degrees,  # member
+                         order, model, 0.02)               # and cut every point short)
         orbits = max(0.05, float(f"{seconds * rate / n:.2g}"))
         setup[(model, order, caps)] = (par, y0, mp, degrees, orbits)
     measured = {p: [] for p in points}
