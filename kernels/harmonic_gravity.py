@@ -38,8 +38,7 @@ above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
   machine, its short loops ran 1.5 × slower than the same code in a small kernel (the
   register pressure of the stage matrix around them), and the call also compiles faster
   (experiments/README.md, "bench_orders.py"). The body is written as one function, with no
-  nested ``ti.func`` that takes an array: inside a real function such a call crashes at
-  launch in Taichi 1.7.
+  nested ``ti.func`` call: inside a real function such calls crash at launch in Taichi 1.7.
 
 Per-member data, passed as arguments of the kernels beside the parameter rows (the four
 arrays of ``Multipole.arguments``): ``rows`` the coefficient rows
@@ -67,6 +66,9 @@ _LAST_A = 1 << (2 * _BITS + 6)
 _FIRST_B = 1 << (2 * _BITS + 7)
 _ADD_P = 1 << (2 * _BITS + 6)             # harmonic_tables.ADD_P, ADD_Q in place
 _ADD_Q = 1 << (2 * _BITS + 7)
+_RESTART = 1 << (2 * _BITS + 8)           # harmonic_tables.RESTART, STEP2 in place
+_STEP2 = 1 << (2 * _BITS + 9)
+
 
 
 _nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
@@ -79,8 +81,9 @@ _Result = ti.types.struct(U=ti.f64, dU=vec3, mu1=vec3, mu2=vec3)
 def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_f: _nd1f,
                G: ti.f64, R: vec3, S: _mat3) -> _Result:
     """The body of :func:`mutual_h`, compiled as a real function (module docstring) or
-    inlined. Written as one function with no nested ``ti.func`` taking an array: inside a
-    Taichi 1.7 real function such a call crashes at launch."""
+    inlined. Written as one function with no nested ``ti.func`` call: inside a Taichi 1.7
+    real function such calls crashed at launch (seen with one taking an array and with one
+    taking only vectors)."""
     # member j's coefficient row and slot k's scratch row in the flat arrays
     j0 = j * tab_i[_K.K_WIDTH]
     k0 = k * tab_i[_K.K_SCRATCH]
@@ -92,7 +95,6 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     two = tab_i[_K.K_TWO]
     one = two - 1
     t2 = tab_i[_K.K_S_T2]
-    trig = tab_i[_K.K_S_TRIG]
     sw = tab_i[_K.K_S_W]
     sA = tab_i[_K.K_S_A]
     sB = tab_i[_K.K_S_B]
@@ -118,24 +120,12 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     cb, sb = Q[2, 2], ca * Q[0, 2] + sa * Q[1, 2]
     cg, sg = ca * Q[1, 1] - sa * Q[0, 1], ca * Q[1, 0] - sa * Q[0, 0]
     L = ti.Matrix([[ca, sa, 0.0], [-sa, ca, 0.0], [0.0, 0.0, 1.0]], ti.f64) @ P
-    # the multiple angles of the five angles (slots 0..4: −φ, −θ, −α for the primary, γ, β for
-    # the secondary): cos mψ at trig + slot·2(top+1) + m, sin mψ top + 1 further, by the
-    # addition recurrence, the five side by side in one loop over m
-    n2 = 2 * (top + 1)
+    # the five angles (slots 0..4: −φ, −θ, −α for the primary, γ, β for the secondary); the
+    # pair lists run through each degree's orders in steps of one (of two: STEP2), so their
+    # multiples follow by the addition recurrence as the lists are walked (RESTART: a
+    # degree's first entry, from m = 0), and no table of multiple angles is stored
     c1 = ti.Vector([cf, ct, ca, cg, cb], ti.f64)
     s1 = ti.Vector([-sf, -st, -sa, sg, sb], ti.f64)
-    cm, sm = c1, s1
-    for a in ti.static(range(5)):
-        if ti.static(a in (0, 3)):               # m = 0: read by the loads only (slots 0, 3)
-            scr[k0 + trig + a * n2] = 1.0
-            scr[k0 + trig + a * n2 + top + 1] = 0.0
-        scr[k0 + trig + a * n2 + 1] = c1[a]
-        scr[k0 + trig + a * n2 + top + 2] = s1[a]
-    for m in range(2, top + 1):                  # the five angles side by side
-        cm, sm = cm * c1 - sm * s1, sm * c1 + cm * s1
-        for a in ti.static(range(5)):
-            scr[k0 + trig + a * n2 + m] = cm[a]
-            scr[k0 + trig + a * n2 + top + 1 + m] = sm[a]
     # both bodies into the frame L by their programs: the member's coefficients read with
     # the first z-rotation, then two passes (J then X; Jᵀ then X), in one loop over the
     # bodies and one over the passes, so that each helper has one call site (every ti.func
@@ -148,15 +138,25 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
         scr[k0 + dst] = rows[j0 + src]                     # degree 0: the mass
         # the member's coefficients, turned by the first z-rotation as they are read
         o = tab_i[pg + _K.P_LOAD]
-        z0 = trig + n2 * tab_i[pg + _K.P_Z0]
+        z0 = tab_i[pg + _K.P_Z0]
+        zc, zs = c1[0], s1[0]
+        for a in ti.static(range(1, 5)):                 # (no nested ti.func: see above)
+            if z0 == a:
+                zc, zs = c1[a], s1[a]
+        zc2, zs2 = zc * zc - zs * zs, 2.0 * zc * zs
+        c, s_ = 1.0, 0.0
         e, ne = 0, tab_i[pg + _K.P_NLOAD]
         while e < ne:
             w = tab_i[o + e]
             p = w & _MASK
             q = (w >> _BITS) & _MASK
-            m = (w >> (2 * _BITS)) & _M_FIELD
-            c = scr[k0 + z0 + m]
-            s_ = scr[k0 + z0 + top + 1 + m]
+            if w & _RESTART != 0:
+                c, s_ = 1.0, 0.0
+            if (w >> (2 * _BITS)) & _M_FIELD != 0:      # the next multiple of the angle
+                if w & _STEP2 != 0:
+                    c, s_ = c * zc2 - s_ * zs2, s_ * zc2 + c * zs2
+                else:
+                    c, s_ = c * zc - s_ * zs, s_ * zc + c * zs
             a = rows[j0 + src + p]
             b = 0.0
             if w & _ZERO_SIN == 0:                       # (a sin partner known zero: not read)
@@ -192,7 +192,11 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
             # then each z-rotation pair (p, q, m): the last chunk of J row p and of row q
             # (added to the rows' partial sums when they are longer: ADD_P, ADD_Q; row q not
             # computed when its class is known to be zero: ZERO_SIN), then rotated by mψ
-            tz = trig + n2 * slot
+            zc, zs = c1[0], s1[0]                        # (slot −1: a pass with no pairs)
+            for a in ti.static(range(1, 5)):
+                if slot == a:
+                    zc, zs = c1[a], s1[a]
+            c, s_ = 1.0, 0.0
             e, ne = 0, tab_i[pg + nkey_x]
             while e < ne:
                 w = tab_i[ofx + 2 * e]
@@ -212,9 +216,9 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
                           + tab_f[f + 6] * scr[k0 + sq + 2] + tab_f[f + 7] * scr[k0 + sq + 3])
                     if w & _ADD_Q != 0:
                         rq += scr[k0 + q]
-                m = (w >> (2 * _BITS)) & _M_FIELD
-                c = scr[k0 + tz + m]
-                s_ = scr[k0 + tz + top + 1 + m]
+                if w & _RESTART != 0:                    # m = 1: a degree's first pair
+                    c, s_ = 1.0, 0.0
+                c, s_ = c * zc - s_ * zs, s_ * zc + c * zs
                 scr[k0 + p] = c * rp - s_ * rq
                 scr[k0 + q] = s_ * rp + c * rq
                 e += one

@@ -119,13 +119,13 @@ class harmonic:
      K_TOP,                # max(dA, dB, 1): the multiple angles' top order
      K_NTERM, K_I_TERM, K_F_TERM,   # the interaction terms: (ia, ib, L) and K
      K_NBZ, K_I_BZ,        # the secondary's z-torque pairs: (g+, g−, m)
-     K_S_A, K_S_B, K_S_GA, K_S_GB, K_S_T1, K_S_T2, K_S_TRIG, K_S_W,   # scratch offsets
+     K_S_A, K_S_B, K_S_GA, K_S_GB, K_S_T1, K_S_T2, K_S_W,   # scratch offsets
                            # (K_S_T1: the primary's first buffer, the secondary's after it)
      K_SCRATCH,            # scratch columns per member
      K_WIDTH,              # columns of a coefficient row: (dA + 1)² + (dB + 1)²
      K_TWO,                # 2: the kernel's loop counts and steps (2 and 2 − 1) read at
                            # run time, so that LLVM does not copy or unroll its loops
-     K_PROG_A) = range(19)  # the primary's program; the secondary's PROGRAM_WIDTH after
+     K_PROG_A) = range(18)  # the primary's program; the secondary's PROGRAM_WIDTH after
     # fields of a body's program: count and integer offset of each list (load pairs
     # (p, q, m); J rows (dst, src, columns, value offset); pairs (p, q, m) on the J output;
     # Jᵀ rows; pairs on the final coefficients; the rows its torque reads: (row, the

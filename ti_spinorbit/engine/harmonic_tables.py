@@ -131,6 +131,10 @@ LAST_A, FIRST_B = 1 << 6, 1 << 7
 #: Flags of a fused entry (J rows p and q, then their z-rotation): row p (q) adds its last
 #: chunk to the partial sum its earlier chunks left (a row longer than CHUNK).
 ADD_P, ADD_Q = 1 << 6, 1 << 7
+#: Flags of a pair list's entries: the first entry of its degree (the multiple angle restarts
+#: from m = 0), and an entry two orders after the one before (only the even orders of a
+#: mirror-symmetric body are loaded); the kernel walks the multiples by the addition formula.
+RESTART, STEP2 = 1 << 8, 1 << 9
 
 
 #: Bits of a position in a packed table entry: positions within a body's region are below
@@ -227,7 +231,7 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
     for key, size in ((_K.K_S_A, (dA + 1) ** 2), (_K.K_S_B, (dB + 1) ** 2),
                       (_K.K_S_GA, (dA + 1) ** 2), (_K.K_S_GB, (dB + 1) ** 2),
                       (_K.K_S_T1, 2 * (top + 1) ** 2), (_K.K_S_T2, (top + 1) ** 2),
-                      (_K.K_S_TRIG, 10 * (top + 1)), (_K.K_S_W, N + 2)):
+                      (_K.K_S_W, N + 2)):
         head[key] = regions[key] = offset
         offset += size
     head[_K.K_SCRATCH] = offset
@@ -261,14 +265,17 @@ def tables(order, degree_a, degree_b, mask_a=ALL_DEGREES, mask_b=ALL_DEGREES, ev
                 # classes it fills from them (cos even, cos odd; the others would read
                 # zeros), and every pair of the second z-rotation then has a zero sin
                 # partner (not read; both written)
-                lists["load"] += [(p_, q_, m | ZERO_SIN if m else 0)
+                lists["load"] += [(p_, q_, (m | ZERO_SIN | STEP2) if m else RESTART)
                                   for p_, q_, m in pairs if m % 2 == 0]
-                x1 = [(p_, q_, m | ZERO_SIN) for p_, q_, m in pairs[1:]]
+                x1 = [(p_, q_, m | ZERO_SIN | (RESTART if m == 1 else 0))
+                      for p_, q_, m in pairs[1:]]
             else:
-                lists["load"] += pairs
-                x1 = pairs[1:]
+                lists["load"] += [(p_, q_, m | (RESTART if m == 0 else 0))
+                                  for p_, q_, m in pairs]
+                x1 = [(p_, q_, m | (RESTART if m == 1 else 0)) for p_, q_, m in pairs[1:]]
             # the pairs of the last z-rotation: the primary's only
-            x2 = pairs[1:reach + 1] if slots[2] >= 0 else []
+            x2 = ([(p_, q_, m | (RESTART if m == 1 else 0)) for p_, q_, m in pairs[1:reach + 1]]
+                  if slots[2] >= 0 else [])
             sizes = [len(c) for c in classes(l)]
             off = np.concatenate([[0], np.cumsum(sizes)])
             for which, name, xname, xpairs in ((0, "j", "jx", x1), (1, "jt", "jtx", x2)):
