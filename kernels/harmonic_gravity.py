@@ -87,7 +87,6 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     # member j's coefficient row and slot k's scratch row in the flat arrays
     j0 = j * tab_i[_K.K_WIDTH]
     k0 = k * tab_i[_K.K_SCRATCH]
-    top = tab_i[_K.K_TOP]
     # 2 and 1 read at run time, for the loop counts and steps: LLVM would otherwise copy the
     # loops over the bodies and the passes and unroll every table loop eight times over,
     # which cost 0.4-0.5 s of compile and, in the integrator, more time than it saved (the

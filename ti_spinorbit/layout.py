@@ -116,7 +116,7 @@ class harmonic:
     evaluation into flat lists (a program per body), so the kernel is a few flat loops."""
 
     (K_NPOW,               # powers −G r^−(L+1) tabulated, L = 0..N
-     K_TOP,                # max(dA, dB, 1): the multiple angles' top order
+     K_TOP,                # max(dA, dB, 1): the largest degree (the scratch buffers' size)
      K_NTERM, K_I_TERM, K_F_TERM,   # the interaction terms: (ia, ib, L) and K
      K_NBZ, K_I_BZ,        # the secondary's z-torque pairs: (g+, g−, m)
      K_S_A, K_S_B, K_S_GA, K_S_GB, K_S_T1, K_S_T2, K_S_W,   # scratch offsets

@@ -421,5 +421,5 @@ def degree_mask(coefficient_rows_, degree, first=0):
     return mask
 
 
-__all__ = ["HarmonicTables", "tables", "coefficient_rows", "degree_mask", "even_mask",
+__all__ = ["HarmonicTables", "tables", "top_orders", "coefficient_rows", "degree_mask", "even_mask",
            "classes", "permutation", "ALL_DEGREES"]
