@@ -19,8 +19,7 @@ above 4 (experiments/README.md, "bench_harmonics.py"). Cost-saving details:
 
 * the host turns each body's rotation into a program of flat lists (``harmonic_tables``):
   z-rotation pairs and dense J-block rows, so the kernel runs a few flat loops with no
-  per-degree logic and each helper has one call site (compile time grows with inlined
-  copies);
+  per-degree logic, each written once (compile time grows with every copy);
 * a degree's terms reach only |m| <= m_l (m_l = 0 above N − 2: the other body's
   monopole), so its last product computes |m| <= m_l + 1 only (the generators'
   neighbours); a body's degrees that are zero in every member are left out, and a
@@ -69,9 +68,6 @@ _ADD_Q = 1 << (2 * _BITS + 7)
 _RESTART = 1 << (2 * _BITS + 8)           # harmonic_tables.RESTART, STEP2 in place
 _STEP2 = 1 << (2 * _BITS + 9)
 
-
-
-_nd2f = ti.types.ndarray(dtype=ti.f64, ndim=2)
 _nd1f = ti.types.ndarray(dtype=ti.f64, ndim=1)
 _nd1i = ti.types.ndarray(dtype=ti.i32, ndim=1)
 _mat3 = ti.types.matrix(3, 3, ti.f64)
@@ -127,8 +123,7 @@ def _potential(rows: _nd1f, j: ti.i32, scr: _nd1f, k: ti.i32, tab_i: _nd1i, tab_
     s1 = ti.Vector([-sf, -st, -sa, sg, sb], ti.f64)
     # both bodies into the frame L by their programs: the member's coefficients read with
     # the first z-rotation, then two passes (J then X; Jᵀ then X), in one loop over the
-    # bodies and one over the passes, so that each helper has one call site (every ti.func
-    # call is inlined; compile time grows with the copies)
+    # bodies and one over the passes, so that each table loop is written once
     for body in range(two):
         pg = _K.K_PROG_A + body * _K.PROGRAM_WIDTH
         src = tab_i[pg + _K.P_SRC]
