@@ -17,14 +17,20 @@ What the kernels need from the host:
 * **integer table**: the header of ``ti_spinorbit.layout.harmonic`` and, per body, a
   program of flat lists that the kernel walks in order:
 
-  - the pairs (p, q, m) that load the member's coefficients turned by the first z-rotation;
-  - the rows of J as chunks of :data:`CHUNK` columns ((destination, source, add), one int):
-    each output class of J_l reads one input class as a dense block, about a quarter of the
-    degree's (2l+1)² entries, all others zero (checked when the tables are built); a chunk
-    reads consecutive entries of its own degree only, and its weights are the list's e-th
-    group of CHUNK floats (from the program's P_FJ);
-  - the pairs of the second z-rotation, the rows of Jᵀ (weights from P_FJT), the pairs of
-    the last z-rotation (the primary's only);
+  - the pairs (p, q, m) that load the member's coefficients turned by the first z-rotation,
+    each degree's orders in steps of one (of two: STEP2) from its first entry (RESTART), so
+    that the kernel steps the multiple angles by the addition formula;
+  - the plain chunks of J: :data:`CHUNK` columns of a row ((destination, source, add), one
+    int): each output class of J_l reads one input class as a dense block, about a quarter
+    of the degree's (2l+1)² entries, all others zero (checked when the tables are built); a
+    chunk reads consecutive entries of its own degree only, and its weights are the list's
+    e-th group of CHUNK floats (from the program's P_FJ). Plain are the m = 0 rows and the
+    leading chunks of rows longer than CHUNK;
+  - the fused entries of J and the second z-rotation: for each pair (m, −m) the last chunk
+    of both rows (two ints; 2 CHUNK weights from P_FJX), added to the rows' partial sums
+    (ADD_P, ADD_Q), then rotated by mψ (m = 1, 2, ... from RESTART);
+  - the same two lists for Jᵀ and the last z-rotation (P_JT, P_JTX; the secondary has no
+    last rotation, so all its Jᵀ chunks are plain);
   - the rows of ∂U/∂C that the torque reads, each with its generators' two columns about x
     and about y (packed) and their four values (from P_FROW);
 
@@ -35,8 +41,9 @@ What the kernels need from the host:
   each of the secondary's is stored by its first term (FIRST_B): nothing is zeroed first;
   then the secondary's z-torque pairs. Entries of three small fields are packed into one
   int32 (:func:`pack`);
-* **float table**: the chunks of J and Jᵀ and the generators' values of each program's
-  torque rows, each in its list's order, and the couplings K_{l1 l2}[m, m] of the terms.
+* **float table**: the chunk weights of each J and Jᵀ list (plain and fused) and the
+  generators' values of each program's torque rows, each in its list's order, and the
+  couplings K_{l1 l2}[m, m] of the terms.
 
 What the programs leave out (docs/physics.md §3.8.2): a degree's terms reach only
 |m| ≤ m_l (:func:`top_orders`), so its Jᵀ rows and last pairs stop at |m| ≤ m_l + 1 (the
