@@ -55,6 +55,19 @@ def random_rotation(rng):
     return q
 
 
+def cloud(rng, n, scale, mass, order):
+    """Integrals (a dict, degrees 0..order) of n point masses of total ``mass`` about their
+    centre of mass, spread ``scale`` × (1, 0.7, 0.5): a body with odd integrals and no
+    symmetry (first moments set to exact zeros)."""
+    from ti_spinorbit.system import integrals as I
+    pts = rng.normal(size=(n, 3)) * np.array([1.0, 0.7, 0.5]) * scale
+    m = rng.uniform(0.5, 1.5, n)
+    m *= mass / m.sum()
+    pts -= (m[:, None] * pts).sum(0) / mass
+    T = I.point_mass_integrals(pts, m, order)
+    return {k: (0.0 if sum(k) == 1 else v) for k, v in T.items()}
+
+
 def axis_rotation(axis, angle):
     """The rotation by ``angle`` (rad) about coordinate axis 0, 1 or 2."""
     c, s = math.cos(angle), math.sin(angle)

@@ -15,7 +15,7 @@ from ti_spinorbit.engine import harmonic_tables as HT
 from ti_spinorbit.engine import multipole_tables as MT
 from ti_spinorbit.system import integrals as I
 
-from conftest import axis_rotation, degenerate_geometries, random_rotation
+from conftest import axis_rotation, cloud, degenerate_geometries, random_rotation
 
 
 def evaluate(poly, E, pts):
@@ -105,15 +105,6 @@ def test_coefficients_are_the_harmonic_part_of_the_integrals(rng):
     assert H.coupling(0, 0)[0, 0] == pytest.approx(1.0, abs=1e-15)
     K = H.coupling(3, 5)
     assert np.count_nonzero(K) == 7 and np.count_nonzero(np.diag(K[:, 2:9])) == 7
-
-
-def cloud(rng, n, scale, mass, order):
-    pts = rng.normal(size=(n, 3)) * np.array([1.0, 0.7, 0.5]) * scale
-    m = rng.uniform(0.5, 1.5, n)
-    m *= mass / m.sum()
-    pts -= (m[:, None] * pts).sum(0) / mass
-    T = I.point_mass_integrals(pts, m, order)
-    return {k: (0.0 if sum(k) == 1 else v) for k, v in T.items()}
 
 
 @pytest.mark.parametrize("order,degrees", [(2, None), (4, None), (6, None), (8, None),

@@ -9,24 +9,14 @@ from ti_spinorbit import harmonics as H
 from ti_spinorbit import planar_harmonics as PH
 from ti_spinorbit.system import integrals as I
 
-from conftest import axis_rotation
-
-
-def _cloud(rng, n, scale, mass, order):
-    """Point masses about their centre of mass (odd integrals, no symmetry)."""
-    pts = rng.normal(size=(n, 3)) * np.array([1.0, 0.7, 0.5]) * scale
-    m = rng.uniform(0.5, 1.5, n)
-    m *= mass / m.sum()
-    pts -= (m[:, None] * pts).sum(0) / mass
-    T = I.point_mass_integrals(pts, m, order)
-    return {k: (0.0 if sum(k) == 1 else v) for k, v in T.items()}
+from conftest import axis_rotation, cloud
 
 
 def _pair(rng, kind, order):
     if kind == "ellipsoids":
         return (I.ellipsoid_integrals(1.0, 0.9, 0.8, 1.0, order),
                 I.ellipsoid_integrals(0.3, 0.2, 0.19, 0.05, order))
-    return _cloud(rng, 12, 0.8, 1.0, order), _cloud(rng, 9, 0.25, 0.05, order)
+    return cloud(rng, 12, 0.8, 1.0, order), cloud(rng, 9, 0.25, 0.05, order)
 
 
 @pytest.mark.parametrize("kind", ["ellipsoids", "clouds"])

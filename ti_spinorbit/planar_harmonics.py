@@ -64,6 +64,18 @@ def _split(c, l):
     return u, v
 
 
+def _turned(c, degree, body):
+    """{l: (D u_j, D v_j) for all j}: a body's split coefficients (degrees 0..degree, first
+    moments left out: zero about the centre of mass) turned by its fixed matrix."""
+    out = {}
+    for l in range(degree + 1):
+        if l != 1:
+            u, v = _split(np.asarray(c[l], dtype=float), l)
+            D = fixed_matrices(l)[body]
+            out[l] = (u @ D.T, v @ D.T)
+    return out
+
+
 def fourier_coefficients(cA, cB, order, degrees=None):
     """W (order + 1, dA + 1, dB + 1, 4): the planar Fourier coefficients of the order-``order``
     potential (module docstring; last axis cc, cs, sc, ss) of two bodies with harmonic
@@ -76,18 +88,7 @@ def fourier_coefficients(cA, cB, order, degrees=None):
         raise ValueError(f"fourier_coefficients: degrees ({dA}, {dB}) need 0 <= degree <= order "
                          f"= {N} and coefficients up to each degree")
     W = np.zeros((N + 1, dA + 1, dB + 1, 4))
-    A = {}
-    for l in range(dA + 1):
-        if l != 1:
-            u, v = _split(np.asarray(cA[l], dtype=float), l)
-            D = fixed_matrices(l)[0]
-            A[l] = (u @ D.T, v @ D.T)
-    B = {}
-    for l in range(dB + 1):
-        if l != 1:
-            u, v = _split(np.asarray(cB[l], dtype=float), l)
-            D = fixed_matrices(l)[1]
-            B[l] = (u @ D.T, v @ D.T)
+    A, B = _turned(cA, dA, 0), _turned(cB, dB, 1)
     for l1 in A:
         for l2 in B:
             if l1 + l2 > N:
