@@ -355,8 +355,14 @@ class Multipole:
         return self.tables.degree_a, self.tables.degree_b
 
     def take(self, index) -> "Multipole":
-        """The rows ``index`` (one per state, e.g. the member of each record)."""
-        return Multipole(self.tables, self.rows[np.asarray(index)])
+        """The rows ``index`` (one per state, e.g. the member of each record). The taken rows
+        keep this ensemble's harmonic tables (their masks hold for any subset), so a block
+        of states neither recomputes the projection nor builds tables of its own."""
+        index = np.asarray(index)
+        out = Multipole(self.tables, self.rows[index])
+        rows, tab = self.harmonic
+        object.__setattr__(out, "_harmonic", (rows[index], tab))
+        return out
 
     @property
     def harmonic(self):
